@@ -1,0 +1,57 @@
+#pragma once
+/// @file csv.h
+/// @brief Small CSV reader that knows file and line of every value, for clear bad-input messages.
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/diagnostics.h"
+
+namespace meshnav {
+
+/// One parsed data row; `get` returns NaN-free doubles or nullopt (the caller reports).
+class CsvRow {
+ public:
+  const std::string& file() const { return *file_; }
+  int line() const { return line_; }
+  /// "file:line" for messages.
+  std::string where() const;
+  /// Numeric value of column `name`; nullopt when empty or not a finite number.
+  std::optional<double> number(const std::string& name) const;
+  /// Raw text of column `name` (trimmed).
+  std::string text(const std::string& name) const;
+  bool has(const std::string& name) const;
+
+ private:
+  friend class CsvReader;
+  const std::string* file_ = nullptr;
+  int line_ = 0;
+  const std::map<std::string, int>* columns_ = nullptr;
+  std::vector<std::string> fields_;
+};
+
+/// Reads a comma separated file with a header line. A leading '#' on the header is ignored
+/// (TUM files). Blank lines and lines starting with '#' after the header are skipped.
+class CsvReader {
+ public:
+  /// Opens and reads the header. Throws std::runtime_error("file: ...") when missing/unreadable,
+  /// empty, or when a column of `required` is absent.
+  CsvReader(const std::string& path, const std::vector<std::string>& required);
+  /// Calls `fn` for every data row. Rows with a wrong field count are reported to `diag` as
+  /// "<basename>:bad_row" and skipped.
+  void forEach(const std::function<void(const CsvRow&)>& fn, Diagnostics& diag);
+  const std::vector<std::string>& header() const { return header_; }
+
+ private:
+  std::string path_;
+  std::vector<std::string> header_;
+  std::map<std::string, int> columns_;
+};
+
+/// Base name of a path, for counter keys ("ranges.csv").
+std::string baseName(const std::string& path);
+
+}  // namespace meshnav

@@ -1,0 +1,57 @@
+#pragma once
+/// @file dataset.h
+/// @brief The dataset folder of DESIGN §6: imu.csv, baro.csv, ranges.csv, flight_state.csv,
+/// groundtruth.csv, setup.yaml, truth.yaml. Readers validate every row: bad rows are reported
+/// (file:line), counted in `Diagnostics`, and dropped; they never reach an estimator.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/diagnostics.h"
+#include "common/setup.h"
+#include "common/types.h"
+
+namespace meshnav {
+
+struct Dataset {
+  std::vector<ImuSample> imu;
+  std::vector<BaroSample> baro;
+  std::vector<RangeSample> ranges;
+  std::vector<FlightStateSample> flight_states;
+  std::vector<PoseSample> ground_truth;
+  SystemSetup setup;
+  std::optional<Truth> truth;
+};
+
+/// Limits used when validating ranges [m].
+struct RangeLimits {
+  double min_m = -0.5;   ///< biased short ranges can be slightly negative; below this is absurd
+  double max_m = 500.0;  ///< beyond this a UWB range is absurd
+};
+
+std::vector<ImuSample> readImuCsv(const std::string& path, Diagnostics& diag);
+std::vector<BaroSample> readBaroCsv(const std::string& path, Diagnostics& diag);
+/// Reads the published range format `t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS`
+/// (types as letters 'T'/'A' or ASCII codes 84/65). NaN, negative beyond limits or absurd ranges,
+/// self-ranges and unknown type codes are reported and dropped.
+std::vector<RangeSample> readRangesCsv(const std::string& path, Diagnostics& diag,
+                                       const RangeLimits& limits = {});
+std::vector<FlightStateSample> readFlightStateCsv(const std::string& path, Diagnostics& diag);
+/// TUM format `#t,tx,ty,tz,qx,qy,qz,qw` (comma or space separated).
+std::vector<PoseSample> readTumCsv(const std::string& path, Diagnostics& diag);
+
+void writeImuCsv(const std::vector<ImuSample>& v, const std::string& path);
+void writeBaroCsv(const std::vector<BaroSample>& v, const std::string& path);
+void writeRangesCsv(const std::vector<RangeSample>& v, const std::string& path);
+void writeFlightStateCsv(const std::vector<FlightStateSample>& v, const std::string& path);
+void writeTumCsv(const std::vector<PoseSample>& v, const std::string& path);
+
+/// Reads a whole dataset folder. setup.yaml is required; the sensor files are optional except
+/// ranges.csv; truth.yaml only when `with_truth`. Samples come back sorted by time (a time going
+/// backwards in a file is reported as "<file>:time_backwards" and the file is sorted).
+Dataset readDataset(const std::string& dir, Diagnostics& diag, bool with_truth = false);
+/// Writes every non-empty part of `ds` into `dir` (created if needed).
+void writeDataset(const Dataset& ds, const std::string& dir);
+
+}  // namespace meshnav

@@ -1,0 +1,65 @@
+#pragma once
+/// @file setup.h
+/// @brief `setup.yaml` (what the system may know) and `truth.yaml` (evaluation only), DESIGN §6.
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/types.h"
+
+namespace meshnav {
+
+/// Take-off pad prior.
+struct InitialPose {
+  Eigen::Vector3d p_IinG = Eigen::Vector3d::Zero();  ///< [m]
+  double yaw_deg = 0.0;                              ///< yaw of I in G [deg]
+  double sigma_p_m = 0.1;                            ///< [m]
+  double sigma_yaw_deg = 5.0;                        ///< [deg]
+};
+
+/// Optional noise figures overriding the tuning defaults.
+struct NoiseFigures {
+  std::optional<double> sigma_range_m;
+  std::optional<double> imu_acc_noise_density;   ///< [m/s²/√Hz]
+  std::optional<double> imu_gyro_noise_density;  ///< [rad/s/√Hz]
+  std::optional<double> imu_acc_bias_rw;         ///< [m/s³/√Hz]
+  std::optional<double> imu_gyro_bias_rw;        ///< [rad/s²/√Hz]
+  std::optional<double> baro_pressure_sigma_pa;  ///< [Pa]
+};
+
+/// Everything a user knows about the system before flight.
+struct SystemSetup {
+  SensorId imu_id = 1;
+  SensorId baro_id = 2;
+  std::map<SensorId, Eigen::Vector3d> rel_tag_positions;    ///< p_TinI: tag in IMU frame [m]
+  std::map<SensorId, Eigen::Vector3d> abs_anchor_positions; ///< p_AinG: known anchors [m]
+  /// Extension: position σ of known-but-uncertain anchors [m] (missing: exactly known).
+  std::map<SensorId, double> abs_anchor_sigmas_m;
+  std::vector<PairBias> pair_biases;  ///< a-priori calibrated pairs (missing pair: γ = 0, β = 1)
+  Eigen::Vector3d baro_p_IP = Eigen::Vector3d::Zero();  ///< baro in IMU frame [m]
+  std::optional<double> baro_reference_pressure_pa;      ///< null: taken on the ground at start
+  std::optional<InitialPose> initial_pose;
+  NoiseFigures noise;
+
+  bool isTag(SensorId id) const { return rel_tag_positions.count(id) > 0; }
+  bool isKnownAnchor(SensorId id) const { return abs_anchor_positions.count(id) > 0; }
+  /// Pair bias for (a, b) in either order, if given.
+  std::optional<PairBias> findPairBias(SensorId a, SensorId b) const;
+};
+
+/// Simulated truth (evaluation only; never read by estimator or calibrator).
+struct Truth {
+  std::map<SensorId, Eigen::Vector3d> anchor_positions;  ///< all anchors [m]
+  std::vector<PairBias> pair_biases;                      ///< true γ, β for every pair
+  std::map<std::string, double> scalars;                  ///< anything else simulated (seed, σ_d, ...)
+};
+
+/// Load `setup.yaml`. Throws std::runtime_error naming the file and the key on a malformed file.
+SystemSetup loadSetup(const std::string& path);
+void saveSetup(const SystemSetup& setup, const std::string& path);
+Truth loadTruth(const std::string& path);
+void saveTruth(const Truth& truth, const std::string& path);
+
+}  // namespace meshnav

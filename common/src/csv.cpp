@@ -1,0 +1,118 @@
+#include "common/csv.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace meshnav {
+
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t\r\n");
+  return s.substr(b, e - b + 1);
+}
+
+/// Splits on commas when the line has any, otherwise on white space (TUM files).
+std::vector<std::string> splitFields(const std::string& line) {
+  std::vector<std::string> out;
+  if (line.find(',') != std::string::npos) {
+    std::string field;
+    std::istringstream is(line);
+    while (std::getline(is, field, ',')) out.push_back(trim(field));
+    if (!line.empty() && line.back() == ',') out.push_back("");
+  } else {
+    std::istringstream is(line);
+    std::string field;
+    while (is >> field) out.push_back(field);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string baseName(const std::string& path) {
+  const auto p = path.find_last_of('/');
+  return p == std::string::npos ? path : path.substr(p + 1);
+}
+
+std::string CsvRow::where() const { return (file_ ? *file_ : std::string("?")) + ":" + std::to_string(line_); }
+
+bool CsvRow::has(const std::string& name) const { return columns_->count(name) > 0; }
+
+std::string CsvRow::text(const std::string& name) const {
+  auto it = columns_->find(name);
+  if (it == columns_->end() || it->second >= static_cast<int>(fields_.size())) return "";
+  return fields_[it->second];
+}
+
+std::optional<double> CsvRow::number(const std::string& name) const {
+  const std::string s = text(name);
+  if (s.empty()) return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (end == s.c_str() || *end != '\0' || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+CsvReader::CsvReader(const std::string& path, const std::vector<std::string>& required) : path_(path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open file");
+  std::string line;
+  bool got = false;
+  while (std::getline(in, line)) {
+    if (!trim(line).empty()) {
+      got = true;
+      break;
+    }
+  }
+  if (!got) throw std::runtime_error(path + ": empty file (no header line)");
+  std::string h = trim(line);
+  if (!h.empty() && h[0] == '#') h = trim(h.substr(1));
+  header_ = splitFields(h);
+  for (size_t i = 0; i < header_.size(); ++i) columns_[header_[i]] = static_cast<int>(i);
+  for (const auto& r : required) {
+    if (!columns_.count(r)) {
+      std::string have;
+      for (const auto& c : header_) have += (have.empty() ? "" : ",") + c;
+      throw std::runtime_error(path + ":1: missing column '" + r + "' (header has: " + have + ")");
+    }
+  }
+}
+
+void CsvReader::forEach(const std::function<void(const CsvRow&)>& fn, Diagnostics& diag) {
+  std::ifstream in(path_);
+  if (!in) throw std::runtime_error(path_ + ": cannot open file");
+  std::string line;
+  int line_no = 0;
+  bool header_seen = false;
+  const std::string base = baseName(path_);
+  CsvRow row;
+  row.file_ = &path_;
+  row.columns_ = &columns_;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string t = trim(line);
+    if (t.empty()) continue;
+    if (!header_seen) {
+      header_seen = true;
+      continue;
+    }
+    if (t[0] == '#') continue;
+    row.line_ = line_no;
+    row.fields_ = splitFields(t);
+    if (row.fields_.size() != header_.size()) {
+      diag.report(base + ":bad_row", path_ + ":" + std::to_string(line_no) + ": expected " +
+                                         std::to_string(header_.size()) + " fields, got " +
+                                         std::to_string(row.fields_.size()) + "; row skipped");
+      continue;
+    }
+    fn(row);
+  }
+}
+
+}  // namespace meshnav

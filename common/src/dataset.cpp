@@ -1,0 +1,324 @@
+#include "common/dataset.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "common/csv.h"
+
+namespace meshnav {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Reads column `t` [s] of a row; reports and returns nullopt when missing or not finite.
+std::optional<Timestamp> rowTime(const CsvRow& r, const std::string& key, Diagnostics& d, const char* col = "t") {
+  auto t = r.number(col);
+  if (!t) {
+    d.report(key + ":bad_time", r.where() + ": time '" + r.text(col) + "' is not a finite number; row skipped");
+    return std::nullopt;
+  }
+  return Timestamp::fromSec(*t);
+}
+
+/// Reports samples whose time goes backwards and sorts them (stable).
+template <typename T>
+void checkOrder(std::vector<T>& v, const std::string& path, Diagnostics& d) {
+  const std::string key = baseName(path);
+  bool sorted = true;
+  for (size_t i = 1; i < v.size(); ++i) {
+    if (v[i].t < v[i - 1].t) {
+      sorted = false;
+      d.report(key + ":time_backwards", path + ": sample " + std::to_string(i + 1) + " at t=" +
+                                            formatSeconds(v[i].t) + " s is earlier than the previous one (" +
+                                            formatSeconds(v[i - 1].t) + " s); file will be time-sorted");
+    }
+  }
+  if (!sorted) std::stable_sort(v.begin(), v.end(), [](const T& a, const T& b) { return a.t < b.t; });
+}
+
+std::optional<UwbType> parseType(const std::string& s) {
+  if (s == "T" || s == "84" || s == "t") return UwbType::Tag;
+  if (s == "A" || s == "65" || s == "a") return UwbType::Anchor;
+  return std::nullopt;
+}
+
+std::optional<int64_t> parseId(const std::string& s) {
+  if (s.empty()) return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (end == s.c_str() || *end != '\0' || !std::isfinite(v) || v != std::floor(v) || v < 0 || v > 2e9) {
+    return std::nullopt;
+  }
+  return static_cast<int64_t>(v);
+}
+
+std::ofstream openOut(const std::string& path) {
+  fs::path p(path);
+  if (p.has_parent_path()) fs::create_directories(p.parent_path());
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write file");
+  return out;
+}
+
+}  // namespace
+
+std::vector<ImuSample> readImuCsv(const std::string& path, Diagnostics& diag) {
+  const std::vector<std::string> cols = {"t", "lin_acc_x", "lin_acc_y", "lin_acc_z", "ang_vel_x", "ang_vel_y", "ang_vel_z"};
+  CsvReader reader(path, cols);
+  const std::string key = baseName(path);
+  std::vector<ImuSample> out;
+  reader.forEach(
+      [&](const CsvRow& r) {
+        auto t = rowTime(r, key, diag);
+        if (!t) return;
+        double v[6];
+        for (int i = 0; i < 6; ++i) {
+          auto x = r.number(cols[i + 1]);
+          if (!x) {
+            diag.report(key + ":bad_value", r.where() + ": " + cols[i + 1] + " '" + r.text(cols[i + 1]) +
+                                                "' is not a finite number; row skipped");
+            return;
+          }
+          v[i] = *x;
+        }
+        ImuSample s{*t, {v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+        if (s.acc_m_s2.norm() > 500.0 || s.gyro_rad_s.norm() > 50.0) {
+          diag.report(key + ":absurd_value", r.where() + ": IMU reading beyond 500 m/s^2 or 50 rad/s; row skipped");
+          return;
+        }
+        out.push_back(s);
+      },
+      diag);
+  checkOrder(out, path, diag);
+  return out;
+}
+
+std::vector<BaroSample> readBaroCsv(const std::string& path, Diagnostics& diag) {
+  CsvReader reader(path, {"t", "pressure"});
+  const std::string key = baseName(path);
+  std::vector<BaroSample> out;
+  reader.forEach(
+      [&](const CsvRow& r) {
+        auto t = rowTime(r, key, diag);
+        if (!t) return;
+        auto p = r.number("pressure");
+        if (!p || *p < 1000.0 || *p > 200000.0) {
+          diag.report(key + ":bad_value", r.where() + ": pressure '" + r.text("pressure") +
+                                              "' is not a plausible pressure in Pa; row skipped");
+          return;
+        }
+        out.push_back({*t, *p});
+      },
+      diag);
+  checkOrder(out, path, diag);
+  return out;
+}
+
+std::vector<RangeSample> readRangesCsv(const std::string& path, Diagnostics& diag, const RangeLimits& limits) {
+  CsvReader reader(path, {"t", "range_raw", "UWB_ID1", "UWB_ID2", "type_ID1", "type_ID2"});
+  const std::string key = baseName(path);
+  std::vector<RangeSample> out;
+  reader.forEach(
+      [&](const CsvRow& r) {
+        auto t = rowTime(r, key, diag);
+        if (!t) return;
+        RangeSample s;
+        s.t = *t;
+        auto id1 = parseId(r.text("UWB_ID1"));
+        auto id2 = parseId(r.text("UWB_ID2"));
+        if (!id1 || !id2) {
+          diag.report(key + ":bad_id", r.where() + ": UWB ids '" + r.text("UWB_ID1") + "', '" + r.text("UWB_ID2") +
+                                           "' are not non-negative integers; row skipped");
+          return;
+        }
+        if (*id1 == *id2) {
+          diag.report(key + ":self_range", r.where() + ": range from device " + std::to_string(*id1) +
+                                               " to itself; row skipped");
+          return;
+        }
+        auto ty1 = parseType(r.text("type_ID1"));
+        auto ty2 = parseType(r.text("type_ID2"));
+        if (!ty1 || !ty2) {
+          diag.report(key + ":bad_type", r.where() + ": device types '" + r.text("type_ID1") + "', '" +
+                                             r.text("type_ID2") + "' are not T/A (or 84/65); row skipped");
+          return;
+        }
+        auto z = r.number("range_raw");
+        if (!z) {
+          diag.report(key + ":nan_range", r.where() + ": range '" + r.text("range_raw") +
+                                              "' is not a finite number; row skipped");
+          return;
+        }
+        if (*z < limits.min_m) {
+          diag.report(key + ":negative_range", r.where() + ": range " + r.text("range_raw") + " m is below " +
+                                                   std::to_string(limits.min_m) + " m; row skipped");
+          return;
+        }
+        if (*z > limits.max_m) {
+          diag.report(key + ":absurd_range", r.where() + ": range " + r.text("range_raw") + " m exceeds " +
+                                                 std::to_string(limits.max_m) + " m; row skipped");
+          return;
+        }
+        s.id_initiator = static_cast<SensorId>(*id1);
+        s.id_responder = static_cast<SensorId>(*id2);
+        s.type_initiator = *ty1;
+        s.type_responder = *ty2;
+        s.range_m = *z;
+        s.range_corr_m = r.has("range_corr") ? r.number("range_corr").value_or(0.0) : 0.0;
+        const double R = r.has("R") ? r.number("R").value_or(0.0) : 0.0;
+        s.R_m2 = R > 0.0 ? R : 0.0;
+        if (r.has("LOS")) {
+          const std::string l = r.text("LOS");
+          s.los = !(l == "0" || l == "False" || l == "false");
+        }
+        out.push_back(s);
+      },
+      diag);
+  checkOrder(out, path, diag);
+  return out;
+}
+
+std::vector<FlightStateSample> readFlightStateCsv(const std::string& path, Diagnostics& diag) {
+  CsvReader reader(path, {"t", "landed"});
+  const std::string key = baseName(path);
+  std::vector<FlightStateSample> out;
+  reader.forEach(
+      [&](const CsvRow& r) {
+        auto t = rowTime(r, key, diag);
+        if (!t) return;
+        const std::string l = r.text("landed");
+        bool landed;
+        if (l == "1" || l == "true" || l == "True") landed = true;
+        else if (l == "0" || l == "false" || l == "False") landed = false;
+        else {
+          diag.report(key + ":bad_value", r.where() + ": landed '" + l + "' is not 0/1; row skipped");
+          return;
+        }
+        out.push_back({*t, landed});
+      },
+      diag);
+  checkOrder(out, path, diag);
+  return out;
+}
+
+std::vector<PoseSample> readTumCsv(const std::string& path, Diagnostics& diag) {
+  const std::vector<std::string> cols = {"t", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+  CsvReader reader(path, cols);
+  const std::string key = baseName(path);
+  std::vector<PoseSample> out;
+  reader.forEach(
+      [&](const CsvRow& r) {
+        auto t = rowTime(r, key, diag);
+        if (!t) return;
+        double v[7];
+        for (int i = 0; i < 7; ++i) {
+          auto x = r.number(cols[i + 1]);
+          if (!x) {
+            diag.report(key + ":bad_value", r.where() + ": " + cols[i + 1] + " is not a finite number; row skipped");
+            return;
+          }
+          v[i] = *x;
+        }
+        Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+        if (std::abs(q.norm() - 1.0) > 0.1) {
+          diag.report(key + ":bad_quaternion", r.where() + ": quaternion norm " + std::to_string(q.norm()) +
+                                                   " is far from 1; row skipped");
+          return;
+        }
+        q.normalize();
+        out.push_back({*t, {v[0], v[1], v[2]}, q});
+      },
+      diag);
+  checkOrder(out, path, diag);
+  return out;
+}
+
+void writeImuCsv(const std::vector<ImuSample>& v, const std::string& path) {
+  auto out = openOut(path);
+  out << "t,lin_acc_x,lin_acc_y,lin_acc_z,ang_vel_x,ang_vel_y,ang_vel_z\n";
+  char buf[256];
+  for (const auto& s : v) {
+    std::snprintf(buf, sizeof(buf), "%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", formatSeconds(s.t).c_str(), s.acc_m_s2.x(),
+                  s.acc_m_s2.y(), s.acc_m_s2.z(), s.gyro_rad_s.x(), s.gyro_rad_s.y(), s.gyro_rad_s.z());
+    out << buf;
+  }
+}
+
+void writeBaroCsv(const std::vector<BaroSample>& v, const std::string& path) {
+  auto out = openOut(path);
+  out << "t,pressure\n";
+  char buf[96];
+  for (const auto& s : v) {
+    std::snprintf(buf, sizeof(buf), "%s,%.4f\n", formatSeconds(s.t).c_str(), s.pressure_pa);
+    out << buf;
+  }
+}
+
+void writeRangesCsv(const std::vector<RangeSample>& v, const std::string& path) {
+  auto out = openOut(path);
+  out << "t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS\n";
+  char buf[192];
+  for (const auto& s : v) {
+    std::snprintf(buf, sizeof(buf), "%s,%.6f,%.6f,%.6g,%d,%d,%c,%c,%d\n", formatSeconds(s.t).c_str(), s.range_m,
+                  s.range_corr_m, s.R_m2, s.id_initiator, s.id_responder, static_cast<char>(s.type_initiator),
+                  static_cast<char>(s.type_responder), s.los ? 1 : 0);
+    out << buf;
+  }
+}
+
+void writeFlightStateCsv(const std::vector<FlightStateSample>& v, const std::string& path) {
+  auto out = openOut(path);
+  out << "t,landed\n";
+  for (const auto& s : v) out << formatSeconds(s.t) << "," << (s.landed ? 1 : 0) << "\n";
+}
+
+void writeTumCsv(const std::vector<PoseSample>& v, const std::string& path) {
+  auto out = openOut(path);
+  out << "#t,tx,ty,tz,qx,qy,qz,qw\n";
+  char buf[256];
+  for (const auto& s : v) {
+    std::snprintf(buf, sizeof(buf), "%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", formatSeconds(s.t).c_str(),
+                  s.p_IinG.x(), s.p_IinG.y(), s.p_IinG.z(), s.q_ItoG.x(), s.q_ItoG.y(), s.q_ItoG.z(), s.q_ItoG.w());
+    out << buf;
+  }
+}
+
+Dataset readDataset(const std::string& dir, Diagnostics& diag, bool with_truth) {
+  if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": dataset folder does not exist");
+  Dataset ds;
+  const fs::path d(dir);
+  ds.setup = loadSetup((d / "setup.yaml").string());
+  auto opt = [&](const char* name) { return fs::exists(d / name) ? std::optional<std::string>((d / name).string()) : std::nullopt; };
+  if (auto p = opt("imu.csv")) ds.imu = readImuCsv(*p, diag);
+  if (auto p = opt("baro.csv")) ds.baro = readBaroCsv(*p, diag);
+  if (auto p = opt("ranges.csv")) ds.ranges = readRangesCsv(*p, diag);
+  else throw std::runtime_error((d / "ranges.csv").string() + ": missing (a dataset needs ranges)");
+  if (auto p = opt("flight_state.csv")) ds.flight_states = readFlightStateCsv(*p, diag);
+  if (auto p = opt("groundtruth.csv")) ds.ground_truth = readTumCsv(*p, diag);
+  if (with_truth) {
+    if (auto p = opt("truth.yaml")) ds.truth = loadTruth(*p);
+    else spdlog::warn("{}: no truth.yaml (evaluation of anchors not possible)", dir);
+  }
+  return ds;
+}
+
+void writeDataset(const Dataset& ds, const std::string& dir) {
+  fs::create_directories(dir);
+  const fs::path d(dir);
+  if (!ds.imu.empty()) writeImuCsv(ds.imu, (d / "imu.csv").string());
+  if (!ds.baro.empty()) writeBaroCsv(ds.baro, (d / "baro.csv").string());
+  writeRangesCsv(ds.ranges, (d / "ranges.csv").string());
+  if (!ds.flight_states.empty()) writeFlightStateCsv(ds.flight_states, (d / "flight_state.csv").string());
+  if (!ds.ground_truth.empty()) writeTumCsv(ds.ground_truth, (d / "groundtruth.csv").string());
+  saveSetup(ds.setup, (d / "setup.yaml").string());
+  if (ds.truth) saveTruth(*ds.truth, (d / "truth.yaml").string());
+}
+
+}  // namespace meshnav

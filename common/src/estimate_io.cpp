@@ -1,0 +1,128 @@
+#include "common/estimate_io.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include "common/csv.h"
+#include "common/dataset.h"
+
+namespace meshnav {
+
+namespace {
+
+std::ofstream openOut(const std::string& path, const char* header) {
+  std::filesystem::path p(path);
+  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write file");
+  out << header;
+  return out;
+}
+
+const char* kEstimateHeader = "t,tx,ty,tz,qx,qy,qz,qw,pxx,pxy,pxz,pyy,pyz,pzz,qrr,qrp,qry,qpp,qpy,qyy\n";
+const char* kAnchorsHeader = "t,id,x,y,z,pxx,pxy,pxz,pyy,pyz,pzz\n";
+
+/// Reads the 6 upper-triangle values `names` into a symmetric matrix.
+std::optional<Eigen::Matrix3d> upper(const CsvRow& r, const char* const names[6]) {
+  double v[6];
+  for (int i = 0; i < 6; ++i) {
+    auto x = r.number(names[i]);
+    if (!x) return std::nullopt;
+    v[i] = *x;
+  }
+  Eigen::Matrix3d m;
+  m << v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5];
+  return m;
+}
+
+}  // namespace
+
+EstimateCsvWriter::EstimateCsvWriter(const std::string& path) : out_(openOut(path, kEstimateHeader)) {}
+
+void EstimateCsvWriter::write(const PoseEstimate& e) {
+  const auto& P = e.cov_p_m2;
+  const auto& Q = e.cov_theta_rad2;
+  char buf[512];
+  std::snprintf(buf, sizeof(buf),
+                "%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n",
+                formatSeconds(e.t).c_str(), e.p_IinG.x(), e.p_IinG.y(), e.p_IinG.z(), e.q_ItoG.x(), e.q_ItoG.y(),
+                e.q_ItoG.z(), e.q_ItoG.w(), P(0, 0), P(0, 1), P(0, 2), P(1, 1), P(1, 2), P(2, 2), Q(0, 0), Q(0, 1),
+                Q(0, 2), Q(1, 1), Q(1, 2), Q(2, 2));
+  out_ << buf;
+}
+
+void EstimateCsvWriter::flush() { out_.flush(); }
+
+AnchorsCsvWriter::AnchorsCsvWriter(const std::string& path) : out_(openOut(path, kAnchorsHeader)) {}
+
+void AnchorsCsvWriter::write(const AnchorEstimate& a) {
+  const auto& P = a.cov_p_m2;
+  char buf[384];
+  std::snprintf(buf, sizeof(buf), "%s,%d,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", formatSeconds(a.t).c_str(),
+                a.id, a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z(), P(0, 0), P(0, 1), P(0, 2), P(1, 1), P(1, 2), P(2, 2));
+  out_ << buf;
+}
+
+void AnchorsCsvWriter::flush() { out_.flush(); }
+
+std::vector<PoseEstimate> readEstimateCsv(const std::string& path, Diagnostics& diag) {
+  CsvReader reader(path, {"t", "tx", "ty", "tz", "qx", "qy", "qz", "qw", "pxx", "pxy", "pxz", "pyy", "pyz", "pzz",
+                          "qrr", "qrp", "qry", "qpp", "qpy", "qyy"});
+  static const char* const kP[6] = {"pxx", "pxy", "pxz", "pyy", "pyz", "pzz"};
+  static const char* const kQ[6] = {"qrr", "qrp", "qry", "qpp", "qpy", "qyy"};
+  const std::string key = baseName(path);
+  std::vector<PoseEstimate> out;
+  reader.forEach(
+      [&](const CsvRow& r) {
+        auto t = r.number("t");
+        auto tx = r.number("tx"), ty = r.number("ty"), tz = r.number("tz");
+        auto qx = r.number("qx"), qy = r.number("qy"), qz = r.number("qz"), qw = r.number("qw");
+        auto P = upper(r, kP);
+        auto Q = upper(r, kQ);
+        if (!t || !tx || !ty || !tz || !qx || !qy || !qz || !qw || !P || !Q) {
+          diag.report(key + ":bad_value", r.where() + ": a value is missing or not finite; row skipped");
+          return;
+        }
+        PoseEstimate e;
+        e.t = Timestamp::fromSec(*t);
+        e.p_IinG = {*tx, *ty, *tz};
+        e.q_ItoG = Eigen::Quaterniond(*qw, *qx, *qy, *qz).normalized();
+        e.cov_p_m2 = *P;
+        e.cov_theta_rad2 = *Q;
+        out.push_back(e);
+      },
+      diag);
+  return out;
+}
+
+std::vector<AnchorEstimate> readAnchorsCsv(const std::string& path, Diagnostics& diag) {
+  CsvReader reader(path, {"t", "id", "x", "y", "z", "pxx", "pxy", "pxz", "pyy", "pyz", "pzz"});
+  static const char* const kP[6] = {"pxx", "pxy", "pxz", "pyy", "pyz", "pzz"};
+  const std::string key = baseName(path);
+  std::vector<AnchorEstimate> out;
+  reader.forEach(
+      [&](const CsvRow& r) {
+        auto t = r.number("t"), id = r.number("id"), x = r.number("x"), y = r.number("y"), z = r.number("z");
+        auto P = upper(r, kP);
+        if (!t || !id || !x || !y || !z || !P) {
+          diag.report(key + ":bad_value", r.where() + ": a value is missing or not finite; row skipped");
+          return;
+        }
+        out.push_back({Timestamp::fromSec(*t), static_cast<SensorId>(*id), {*x, *y, *z}, *P});
+      },
+      diag);
+  return out;
+}
+
+std::vector<PoseSample> readPosesAuto(const std::string& path, Diagnostics& diag) {
+  CsvReader probe(path, {});
+  bool is_estimate = false;
+  for (const auto& c : probe.header()) is_estimate |= (c == "pxx");
+  if (!is_estimate) return readTumCsv(path, diag);
+  std::vector<PoseSample> out;
+  for (const auto& e : readEstimateCsv(path, diag)) out.push_back({e.t, e.p_IinG, e.q_ItoG});
+  return out;
+}
+
+}  // namespace meshnav

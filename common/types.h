@@ -1,0 +1,115 @@
+#pragma once
+/// @file types.h
+/// @brief Plain measurement and estimate structs shared by every library. They mirror the LCM
+/// messages of `lcmtypes/` field by field but carry no middleware dependency.
+///
+/// Frames: G is the world (navigation) frame, z up, gravity -9.81 m/s² along z.
+/// I is the IMU/body frame. Rotations are Hamilton quaternions; `q_ItoG` rotates a vector from I
+/// into G (the TUM convention of groundtruth.csv): v_G = q_ItoG * v_I.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/time.h"
+
+namespace meshnav {
+
+/// Unique sensor id (> 0), as in the paper: tags 100/105, anchors 101–110, IMU 1, baro 2.
+using SensorId = int32_t;
+
+/// Kind of UWB device at either end of a range.
+enum class UwbType : char { Tag = 'T', Anchor = 'A' };
+
+/// One IMU reading. Specific force and angular rate in the IMU frame I.
+struct ImuSample {
+  Timestamp t;
+  Eigen::Vector3d acc_m_s2 = Eigen::Vector3d::Zero();     ///< specific force in I [m/s²]
+  Eigen::Vector3d gyro_rad_s = Eigen::Vector3d::Zero();   ///< angular rate of I w.r.t. G, in I [rad/s]
+};
+
+/// One barometer reading.
+struct BaroSample {
+  Timestamp t;
+  double pressure_pa = 0.0;  ///< static pressure [Pa]
+};
+
+/// One two-way range between two UWB devices (`id_initiator` measured it).
+struct RangeSample {
+  Timestamp t;                          ///< instant of the range
+  SensorId id_initiator = 0;            ///< UWB_ID1
+  SensorId id_responder = 0;            ///< UWB_ID2
+  UwbType type_initiator = UwbType::Tag;
+  UwbType type_responder = UwbType::Anchor;
+  double range_m = 0.0;                 ///< raw measured range [m]
+  double range_corr_m = 0.0;            ///< corrected range as published (often = range_m) [m]
+  double R_m2 = 0.0;                    ///< measurement variance given by the source [m²]; 0 = unknown
+  bool los = true;                      ///< line of sight flag (carries no information in real data)
+};
+
+/// Landed / flying state from the flight controller.
+struct FlightStateSample {
+  Timestamp t;
+  bool landed = false;
+};
+
+/// Ground-truth pose of I in G.
+struct PoseSample {
+  Timestamp t;
+  Eigen::Vector3d p_IinG = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_ItoG = Eigen::Quaterniond::Identity();
+};
+
+/// Estimated pose with covariance. Orientation error is local: R = R̂ · Exp(δθ), δθ in I.
+struct PoseEstimate {
+  Timestamp t;
+  Eigen::Vector3d p_IinG = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v_IinG = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_ItoG = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d bias_gyro_rad_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d bias_acc_m_s2 = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d cov_p_m2 = Eigen::Matrix3d::Zero();     ///< position covariance in G [m²]
+  Eigen::Matrix3d cov_v = Eigen::Matrix3d::Zero();         ///< velocity covariance in G [m²/s²]
+  Eigen::Matrix3d cov_theta_rad2 = Eigen::Matrix3d::Zero();///< orientation error covariance in I [rad²]
+};
+
+/// Estimated (or given) anchor position with covariance.
+struct AnchorEstimate {
+  Timestamp t;
+  SensorId id = 0;
+  Eigen::Vector3d p_AinG = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d cov_p_m2 = Eigen::Matrix3d::Zero();
+};
+
+/// Pairwise range bias model z = beta·d + gamma + noise (paper eq. z_kl), symmetric in (a, b).
+struct PairBias {
+  SensorId a = 0;
+  SensorId b = 0;
+  double gamma_m = 0.0;       ///< constant bias γ [m]
+  double beta = 1.0;          ///< distance-dependent scale β [-]
+  double sigma_m = 0.1;       ///< range noise σ for this pair [m]
+  double sigma_gamma_m = 0.0; ///< uncertainty of γ [m] (0: treated as exact)
+  double sigma_beta = 0.0;    ///< uncertainty of β [-] (0: treated as exact)
+};
+
+/// Key of an unordered pair (smaller id first).
+inline std::pair<SensorId, SensorId> pairKey(SensorId a, SensorId b) {
+  return a < b ? std::make_pair(a, b) : std::make_pair(b, a);
+}
+
+/// Result of an anchor calibration, handed to the estimator (ANCHOR_INIT; DESIGN §6 YAML).
+struct AnchorInit {
+  Timestamp t;                              ///< time of the calibration
+  SensorId id = 0;
+  Eigen::Vector3d p_AinG = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d cov_p_m2 = Eigen::Matrix3d::Identity();
+  std::vector<PairBias> biases;             ///< one per reference device (a = reference, b = id)
+  int n_inliers = 0;
+  int n_outliers = 0;
+};
+
+}  // namespace meshnav
