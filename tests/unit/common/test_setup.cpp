@@ -1,0 +1,95 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "common/setup.h"
+#include "test_util.h"
+
+using namespace meshnav;
+
+namespace {
+SystemSetup sample() {
+  SystemSetup s;
+  s.rel_tag_positions[100] = {-0.19, 0.105, -0.07};
+  s.rel_tag_positions[105] = {0.05, -0.105, -0.07};
+  s.abs_anchor_positions[101] = {-1.308, -4.140, 0.66};
+  s.abs_anchor_positions[102] = {1.742, -4.147, 1.881};
+  s.abs_anchor_sigmas_m[102] = 0.3;
+  s.pair_biases.push_back({100, 101, 0.12, 1.001, 0.1});
+  s.baro_p_IP = {0, 0, 0.05};
+  InitialPose ip;
+  ip.p_IinG = {1, 2, 0.1};
+  ip.yaw_deg = 30;
+  s.initial_pose = ip;
+  s.noise.sigma_range_m = 0.15;
+  return s;
+}
+}  // namespace
+
+TEST(Setup, RoundTrip) {
+  auto d = test::tempDir("setup");
+  const auto s = sample();
+  saveSetup(s, (d / "setup.yaml").string());
+  const auto r = loadSetup((d / "setup.yaml").string());
+  EXPECT_EQ(r.imu_id, 1);
+  EXPECT_EQ(r.rel_tag_positions.size(), 2u);
+  EXPECT_TRUE(r.rel_tag_positions.at(105).isApprox(s.rel_tag_positions.at(105)));
+  EXPECT_TRUE(r.abs_anchor_positions.at(102).isApprox(s.abs_anchor_positions.at(102)));
+  EXPECT_DOUBLE_EQ(r.abs_anchor_sigmas_m.at(102), 0.3);
+  ASSERT_TRUE(r.findPairBias(101, 100));
+  EXPECT_DOUBLE_EQ(r.findPairBias(101, 100)->gamma_m, 0.12);
+  EXPECT_FALSE(r.findPairBias(100, 102));
+  EXPECT_FALSE(r.baro_reference_pressure_pa);
+  ASSERT_TRUE(r.initial_pose);
+  EXPECT_DOUBLE_EQ(r.initial_pose->yaw_deg, 30);
+  EXPECT_DOUBLE_EQ(*r.noise.sigma_range_m, 0.15);
+  EXPECT_FALSE(r.noise.imu_acc_bias_rw);
+}
+
+TEST(Setup, ReadsThePublishedToolboxConfig) {
+  const std::string f = std::string(MESHNAV_SHARED_DIR) + "/data/real-t1-a3-loiter/config.yaml";
+  if (!std::filesystem::exists(f)) GTEST_SKIP() << "shared data not present: " << f;
+  const auto s = loadSetup(f);
+  ASSERT_EQ(s.rel_tag_positions.size(), 1u);
+  EXPECT_TRUE(s.rel_tag_positions.at(0).isApprox(Eigen::Vector3d(-0.09, 0.04, -0.045)));
+  ASSERT_EQ(s.abs_anchor_positions.size(), 3u);
+  EXPECT_TRUE(s.abs_anchor_positions.at(3).isApprox(Eigen::Vector3d(2.928, 2.47, 2.153)));
+}
+
+TEST(Setup, MalformedFilesNameFileAndKey) {
+  auto d = test::tempDir("setup");
+  auto expectError = [&](const std::string& text, const std::string& needle) {
+    auto f = test::writeFile(d / "bad.yaml", text);
+    try {
+      loadSetup(f);
+      ADD_FAILURE() << "expected an error for: " << text;
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("bad.yaml"), std::string::npos) << m;
+      EXPECT_NE(m.find(needle), std::string::npos) << m;
+    }
+  };
+  expectError("rel_tag_positions: {100: [1, 2]}\n", "rel_tag_positions.100");
+  expectError("abs_anchor_positions: {101: [1, 2, x]}\n", "abs_anchor_positions.101");
+  expectError("pair_biases: [{ids: [1]}]\n", "pair_biases[0].ids");
+  expectError("pair_biases: [{ids: [1, 1]}]\n", "same device");
+  expectError("initial_pose: {p_IinG: [0, 0, 0], yaw_deg: 0, sigma_p: 0.1}\n", "sigma_yaw_deg");
+  expectError("rel_tag_positions: {5: [0,0,0]}\nabs_anchor_positions: {5: [0,0,0]}\n", "both a tag and an anchor");
+  expectError("a: [1, 2\n", "YAML syntax error");
+  expectError("abs_anchor_sigmas: {7: 0.3}\n", "abs_anchor_sigmas.7");
+  EXPECT_THROW(loadSetup((d / "missing.yaml").string()), std::runtime_error);
+}
+
+TEST(Truth, RoundTrip) {
+  auto d = test::tempDir("truth");
+  Truth t;
+  t.anchor_positions[106] = {1, 2, 3};
+  t.pair_biases.push_back({100, 106, -0.2, 0.995, 0.1});
+  t.scalars["seed"] = 3;
+  saveTruth(t, (d / "truth.yaml").string());
+  const auto r = loadTruth((d / "truth.yaml").string());
+  EXPECT_TRUE(r.anchor_positions.at(106).isApprox(Eigen::Vector3d(1, 2, 3)));
+  ASSERT_EQ(r.pair_biases.size(), 1u);
+  EXPECT_DOUBLE_EQ(r.pair_biases[0].beta, 0.995);
+  EXPECT_DOUBLE_EQ(r.scalars.at("seed"), 3);
+}
