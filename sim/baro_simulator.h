@@ -1,0 +1,39 @@
+#pragma once
+/// @file baro_simulator.h
+/// @brief Barometer: static pressure at the sensor's height with white noise.
+///
+/// p_PinG = p_IinG + R_ItoG p_IP;  pressure = p_atm(h = z of p_PinG; p_ref) + n,  n ~ N(0, σ²),
+/// with the standard atmosphere of `common/atmosphere.h`; p_ref is the pressure at the hall floor
+/// level z = 0 (seeded around 97000 Pa, i.e. a site ~400 m above sea level).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/types.h"
+#include "sim/spiral_trajectory.h"
+
+namespace meshnav::sim {
+
+struct BaroOptions {
+  double rate_hz = 50.0;                                ///< sample rate [Hz]
+  double pressure_sigma_pa = 3.0;                       ///< white noise σ [Pa] (≈ 0.25 m)
+  Eigen::Vector3d p_IP = Eigen::Vector3d(0, 0, 0.05);   ///< sensor in the IMU frame [m]
+  double reference_pressure_pa = 97000.0;               ///< pressure at z = 0 [Pa]
+  std::string toString() const;
+};
+
+class BaroSimulator {
+ public:
+  BaroSimulator(const BaroOptions& options, uint64_t seed);
+  /// Noise-free pressure [Pa] for a state.
+  double idealPressure(const TrajectoryState& state) const;
+  /// Readings at t_k = k/rate for t_k ∈ [0, t_end_s].
+  std::vector<BaroSample> simulate(const SpiralTrajectory& trajectory, double t_end_s) const;
+
+ private:
+  BaroOptions options_;
+  uint64_t seed_;
+};
+
+}  // namespace meshnav::sim

@@ -1,0 +1,59 @@
+#pragma once
+/// @file imu_simulator.h
+/// @brief Flight-controller IMU: specific force and angular rate of the analytic trajectory with
+/// white noise and bias random walk.
+///
+/// Measurement at t_k = k·Δt (Δt = 1/rate):
+///   f_m = R_ItoGᵀ (a_G − g_G) + b_a + n_a,   ω_m = ω_I + b_g + n_g,   g_G = [0, 0, −9.81] m/s²
+/// with discrete white noise n ~ N(0, σ_d²), σ_d = σ_c / √Δt (σ_c: noise density), and biases that
+/// start at b(0) ~ N(0, σ_b0²) and random-walk b_{k+1} = b_k + σ_w √Δt · N(0, 1) (σ_w: bias rw density).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/types.h"
+#include "sim/spiral_trajectory.h"
+
+namespace meshnav::sim {
+
+struct ImuNoiseOptions {
+  double rate_hz = 200.0;                  ///< sample rate [Hz]
+  double acc_noise_density = 2e-3;         ///< σ_c accelerometer [m/s²/√Hz]
+  double gyro_noise_density = 2e-4;        ///< σ_c gyroscope [rad/s/√Hz]
+  double acc_bias_rw = 3e-3;               ///< σ_w accelerometer bias random walk [m/s³/√Hz]
+  double gyro_bias_rw = 2e-5;              ///< σ_w gyroscope bias random walk [rad/s²/√Hz]
+  double acc_bias_initial_sigma = 0.05;    ///< σ of b_a(0) [m/s²]
+  double gyro_bias_initial_sigma = 0.005;  ///< σ of b_g(0) [rad/s]
+
+  /// All noise and biases zero (ideal IMU).
+  static ImuNoiseOptions noiseless();
+  std::string toString() const;
+};
+
+/// Samples the IMU along a trajectory.
+class ImuSimulator {
+ public:
+  ImuSimulator(const ImuNoiseOptions& options, uint64_t seed);
+
+  /// The ideal (noise-free, bias-free) reading for one state: f_I = Rᵀ(a − g), ω_I.
+  static ImuSample ideal(const TrajectoryState& state);
+
+  /// Readings at t_k = k/rate for t_k ∈ [0, t_end_s].
+  std::vector<ImuSample> simulate(const SpiralTrajectory& trajectory, double t_end_s);
+
+  /// Bias at the first sample (after `simulate`) [m/s², rad/s].
+  const Eigen::Vector3d& initialAccBias() const { return bias_acc0_; }
+  const Eigen::Vector3d& initialGyroBias() const { return bias_gyro0_; }
+  /// Bias at the last sample (after `simulate`).
+  const Eigen::Vector3d& finalAccBias() const { return bias_acc_; }
+  const Eigen::Vector3d& finalGyroBias() const { return bias_gyro_; }
+
+ private:
+  ImuNoiseOptions options_;
+  uint64_t seed_;
+  Eigen::Vector3d bias_acc0_ = Eigen::Vector3d::Zero(), bias_gyro0_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d bias_acc_ = Eigen::Vector3d::Zero(), bias_gyro_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace meshnav::sim

@@ -1,0 +1,134 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "sim/imu_simulator.h"
+#include "sim/spiral_trajectory.h"
+
+using namespace meshnav::sim;
+
+namespace {
+
+/// Navigation state for the strapdown check.
+struct NavState {
+  Eigen::Vector3d p, v;
+  Eigen::Vector4d q;  ///< (w, x, y, z) of q_ItoG
+};
+
+Eigen::Quaterniond toQuat(const Eigen::Vector4d& q) { return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized(); }
+
+/// ṗ = v, v̇ = R(q) f + g, q̇ = ½ q ⊗ [0, ω].
+NavState derivative(const NavState& x, const Eigen::Vector3d& f, const Eigen::Vector3d& w) {
+  const Eigen::Vector3d g(0, 0, -SpiralTrajectory::kGravity_m_s2);
+  NavState d;
+  d.p = x.v;
+  d.v = toQuat(x.q) * f + g;
+  const Eigen::Quaterniond q(x.q[0], x.q[1], x.q[2], x.q[3]);
+  const Eigen::Quaterniond qw = q * Eigen::Quaterniond(0, w.x(), w.y(), w.z());
+  d.q = 0.5 * Eigen::Vector4d(qw.w(), qw.x(), qw.y(), qw.z());
+  return d;
+}
+
+NavState axpy(const NavState& x, double h, const NavState& d) {
+  return {x.p + h * d.p, x.v + h * d.v, x.q + h * d.q};
+}
+
+/// Integrates the IMU samples [k0, k1] with RK4 (inputs linearly interpolated at mid-steps).
+NavState integrate(const std::vector<meshnav::ImuSample>& imu, size_t k0, size_t k1, NavState x) {
+  for (size_t k = k0; k < k1; ++k) {
+    const double h = (imu[k + 1].t - imu[k].t).sec();
+    const Eigen::Vector3d f0 = imu[k].acc_m_s2, f1 = imu[k + 1].acc_m_s2, fm = 0.5 * (f0 + f1);
+    const Eigen::Vector3d w0 = imu[k].gyro_rad_s, w1 = imu[k + 1].gyro_rad_s, wm = 0.5 * (w0 + w1);
+    const NavState d1 = derivative(x, f0, w0);
+    const NavState d2 = derivative(axpy(x, h / 2, d1), fm, wm);
+    const NavState d3 = derivative(axpy(x, h / 2, d2), fm, wm);
+    const NavState d4 = derivative(axpy(x, h, d3), f1, w1);
+    x.p += h / 6 * (d1.p + 2 * d2.p + 2 * d3.p + d4.p);
+    x.v += h / 6 * (d1.v + 2 * d2.v + 2 * d3.v + d4.v);
+    x.q += h / 6 * (d1.q + 2 * d2.q + 2 * d3.q + d4.q);
+    x.q.normalize();
+  }
+  return x;
+}
+
+NavState trueState(const TrajectoryState& s) {
+  return {s.p_IinG, s.v_IinG, Eigen::Vector4d(s.q_ItoG.w(), s.q_ItoG.x(), s.q_ItoG.y(), s.q_ItoG.z())};
+}
+
+}  // namespace
+
+TEST(SimImuSimulator, NoiseFreeImuIntegratesBackToTheTrajectory) {
+  const SpiralTrajectory tr(TrajectoryOptions::randomized(2));
+  ImuSimulator sim(ImuNoiseOptions::noiseless(), 2);
+  const auto imu = sim.simulate(tr, tr.duration());
+  ASSERT_EQ(imu.size(), static_cast<size_t>(std::floor(tr.duration() * 200 + 1e-9)) + 1);
+  // Windows of 10 s: take-off (from the pad), spiral, spiral end + landing start.
+  for (double t0 : {2.0, 40.0, tr.options().spiral_end_s - 5.0, tr.touchdownTime() - 8.0}) {
+    const auto k0 = static_cast<size_t>(std::llround(t0 * 200));
+    const size_t k1 = k0 + 2000;
+    ASSERT_LT(k1, imu.size());
+    const NavState x = integrate(imu, k0, k1, trueState(tr.evaluate(imu[k0].t.sec())));
+    const auto truth = tr.evaluate(imu[k1].t.sec());
+    EXPECT_LT((x.p - truth.p_IinG).norm(), 0.01) << "window from " << t0;
+    EXPECT_LT((x.p - truth.p_IinG).norm(), 1e-4) << "window from " << t0;  // in fact far better than 1 cm
+    EXPECT_LT((x.v - truth.v_IinG).norm(), 1e-4) << "window from " << t0;
+    EXPECT_LT(toQuat(x.q).angularDistance(truth.q_ItoG), 1e-6) << "window from " << t0;
+  }
+}
+
+TEST(SimImuSimulator, IdealReadingIsSpecificForceInBodyFrame) {
+  const SpiralTrajectory tr(TrajectoryOptions::randomized(1));
+  // On the pad the accelerometer reads +g along body z and the gyro zero.
+  const auto pad = ImuSimulator::ideal(tr.evaluate(1.0));
+  EXPECT_LT((pad.acc_m_s2 - Eigen::Vector3d(0, 0, 9.81)).norm(), 1e-12);
+  EXPECT_LT(pad.gyro_rad_s.norm(), 1e-15);
+  // In flight: R f + g = a.
+  const auto s = tr.evaluate(50.0);
+  const auto m = ImuSimulator::ideal(s);
+  EXPECT_LT((s.R_ItoG * m.acc_m_s2 + Eigen::Vector3d(0, 0, -9.81) - s.a_IinG).norm(), 1e-12);
+  // Thrust is along body z only (a quadrotor): no lateral specific force.
+  EXPECT_LT(m.acc_m_s2.head<2>().norm(), 1e-12);
+}
+
+TEST(SimImuSimulator, NoiseAndBiasHaveTheConfiguredStatistics) {
+  const SpiralTrajectory tr(TrajectoryOptions::randomized(1));
+  ImuNoiseOptions opt;  // defaults: 2e-3 m/s²/√Hz, 2e-4 rad/s/√Hz at 200 Hz
+  ImuSimulator sim(opt, 9);
+  const auto imu = sim.simulate(tr, tr.duration());
+  const double dt = 1.0 / opt.rate_hz;
+  // Consecutive differences on the pad (first 4 s): variance 2σ_d² + σ_w² dt ≈ 2σ_d².
+  double s_acc = 0, s_gyro = 0;
+  int n = 0;
+  Eigen::Vector3d mean_acc_err = Eigen::Vector3d::Zero(), mean_gyro_err = Eigen::Vector3d::Zero();
+  for (size_t k = 1; imu[k].t.sec() < 4.0; ++k, ++n) {
+    s_acc += (imu[k].acc_m_s2 - imu[k - 1].acc_m_s2).squaredNorm();
+    s_gyro += (imu[k].gyro_rad_s - imu[k - 1].gyro_rad_s).squaredNorm();
+    const auto ideal = ImuSimulator::ideal(tr.evaluate(imu[k].t.sec()));
+    mean_acc_err += imu[k].acc_m_s2 - ideal.acc_m_s2;
+    mean_gyro_err += imu[k].gyro_rad_s - ideal.gyro_rad_s;
+  }
+  const double sigma_acc = std::sqrt(s_acc / (6.0 * n)), sigma_gyro = std::sqrt(s_gyro / (6.0 * n));
+  EXPECT_NEAR(sigma_acc, opt.acc_noise_density / std::sqrt(dt), 0.05 * opt.acc_noise_density / std::sqrt(dt));
+  EXPECT_NEAR(sigma_gyro, opt.gyro_noise_density / std::sqrt(dt), 0.05 * opt.gyro_noise_density / std::sqrt(dt));
+  // The mean error over the pad phase is the (slowly walking) initial bias.
+  EXPECT_LT((mean_acc_err / n - sim.initialAccBias()).norm(), 0.01);
+  EXPECT_LT((mean_gyro_err / n - sim.initialGyroBias()).norm(), 1e-3);
+  EXPECT_GT(sim.initialAccBias().norm(), 0.0);
+  // Bias random walk: after T seconds the change has σ = σ_w √T per axis (loose 4σ bound).
+  const double T = tr.duration();
+  EXPECT_LT((sim.finalAccBias() - sim.initialAccBias()).cwiseAbs().maxCoeff(), 4 * opt.acc_bias_rw * std::sqrt(T));
+  EXPECT_GT((sim.finalAccBias() - sim.initialAccBias()).norm(), 0.0);
+}
+
+TEST(SimImuSimulator, SameSeedSameSamples) {
+  const SpiralTrajectory tr(TrajectoryOptions::randomized(1, 0.2));
+  ImuSimulator a(ImuNoiseOptions{}, 5), b(ImuNoiseOptions{}, 5), c(ImuNoiseOptions{}, 6);
+  const auto sa = a.simulate(tr, 10.0), sb = b.simulate(tr, 10.0), sc = c.simulate(tr, 10.0);
+  ASSERT_EQ(sa.size(), sb.size());
+  for (size_t k = 0; k < sa.size(); ++k) {
+    EXPECT_EQ(sa[k].acc_m_s2, sb[k].acc_m_s2);
+    EXPECT_EQ(sa[k].gyro_rad_s, sb[k].gyro_rad_s);
+  }
+  EXPECT_NE(sa[10].acc_m_s2, sc[10].acc_m_s2);
+}

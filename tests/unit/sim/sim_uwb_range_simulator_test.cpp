@@ -1,0 +1,120 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sim/paper_scenario.h"
+#include "sim/uwb_hardware_biases.h"
+#include "sim/uwb_range_simulator.h"
+
+using namespace meshnav::sim;
+
+namespace {
+struct Fixture {
+  PaperScenario scenario = PaperScenario::paper();
+  SpiralTrajectory trajectory{TrajectoryOptions::randomized(4)};
+  TdmaSchedule schedule{scenario.uwbDeviceIds(), 0.01, 0.003};
+  UwbHardwareBiases biases{scenario.uwbDeviceIds()};
+};
+}  // namespace
+
+TEST(SimUwbHardwareBiases, SymmetricBoundedAndFixedByHardwareSeed) {
+  const PaperScenario sc = PaperScenario::paper();
+  const UwbHardwareBiases b(sc.uwbDeviceIds()), b2(sc.uwbDeviceIds());
+  const auto all = b.allTrue(0.1);
+  EXPECT_EQ(all.size(), 55u);  // 11 choose 2
+  double max_gamma = 0;
+  for (const auto& p : all) {
+    EXPECT_LT(p.a, p.b);
+    EXPECT_LE(std::abs(p.gamma_m), 0.4);
+    EXPECT_LE(std::abs(p.beta - 1.0), 0.01);
+    EXPECT_EQ(b.truth(p.a, p.b).gamma_m, b.truth(p.b, p.a).gamma_m);
+    EXPECT_EQ(b2.truth(p.a, p.b).gamma_m, p.gamma_m);  // same modules every time
+    max_gamma = std::max(max_gamma, std::abs(p.gamma_m));
+    // The a-priori calibration is close to but not equal to the truth.
+    const auto c = b.calibrated(p.a, p.b, 0.1);
+    EXPECT_NE(c.gamma_m, p.gamma_m);
+    EXPECT_LT(std::abs(c.gamma_m - p.gamma_m), 0.1);
+    EXPECT_EQ(c.sigma_m, 0.1);
+  }
+  EXPECT_GT(max_gamma, 0.2);  // biases are significant, as on real hardware
+  EXPECT_THROW(b.truth(100, 999), std::out_of_range);
+  // A different hardware seed gives different modules.
+  UwbHardwareOptions other;
+  other.hardware_seed = 7;
+  EXPECT_NE(UwbHardwareBiases(sc.uwbDeviceIds(), other).truth(100, 101).gamma_m, b.truth(100, 101).gamma_m);
+}
+
+TEST(SimUwbRangeSimulator, NoiseFreeRangesAreBetaTimesDistancePlusGamma) {
+  Fixture f;
+  UwbRangeOptions opt;
+  opt.sigma_range_m = 0.0;
+  opt.outlier_fraction = 0.0;
+  opt.drop_fraction = 0.0;
+  UwbRangeSimulator sim(f.scenario, f.biases, opt, 4);
+  const auto ranges = sim.simulate(f.trajectory, f.schedule, 30.0);
+  ASSERT_EQ(static_cast<int64_t>(ranges.size()), sim.slotCount());
+  for (const auto& r : ranges) {
+    const auto st = f.trajectory.evaluate(r.sample.t.sec());
+    const double d = (sim.devicePosition(r.sample.id_initiator, st) - sim.devicePosition(r.sample.id_responder, st)).norm();
+    const auto& b = f.biases.truth(r.sample.id_initiator, r.sample.id_responder);
+    EXPECT_NEAR(r.sample.range_m, b.beta * d + b.gamma_m, 1e-9);
+    EXPECT_FALSE(r.outlier);
+    EXPECT_EQ(r.sample.type_initiator == meshnav::UwbType::Tag, f.scenario.isTag(r.sample.id_initiator));
+    EXPECT_EQ(r.sample.type_responder == meshnav::UwbType::Tag, f.scenario.isTag(r.sample.id_responder));
+  }
+  // Anchor–anchor ranges are constant; the tag–tag range is the lever-arm distance.
+  for (const auto& r : ranges) {
+    if (r.sample.id_initiator == 100 && r.sample.id_responder == 105) {
+      const double d = (f.scenario.tags_p_TinI.at(100) - f.scenario.tags_p_TinI.at(105)).norm();
+      EXPECT_NEAR(r.true_distance_m, d, 1e-12);
+    }
+    if (r.sample.id_initiator == 101 && r.sample.id_responder == 102) {
+      const double d = (f.scenario.anchors_p_AinG.at(101) - f.scenario.anchors_p_AinG.at(102)).norm();
+      EXPECT_NEAR(r.true_distance_m, d, 1e-12);
+    }
+  }
+}
+
+TEST(SimUwbRangeSimulator, OutlierAndDropFractionsMatchTheTarget) {
+  Fixture f;
+  UwbRangeOptions opt;
+  opt.sigma_range_m = 0.1;
+  opt.outlier_fraction = 0.10;
+  opt.drop_fraction = 0.05;
+  UwbRangeSimulator sim(f.scenario, f.biases, opt, 8);
+  const auto ranges = sim.simulate(f.trajectory, f.schedule, f.trajectory.duration());
+  const double n = static_cast<double>(ranges.size());
+  ASSERT_GT(n, 10000);
+  EXPECT_NEAR(static_cast<double>(sim.droppedCount()) / sim.slotCount(), 0.05, 0.01);
+  EXPECT_NEAR(static_cast<double>(sim.outlierCount()) / n, 0.10, 0.01);
+  // Residuals: inliers ~ N(0, σ²), outliers positive in [0.5, 3] m (+ noise).
+  double s2 = 0;
+  int n_in = 0;
+  for (const auto& r : ranges) {
+    const auto& b = f.biases.truth(r.sample.id_initiator, r.sample.id_responder);
+    const double e = r.sample.range_m - (b.beta * r.true_distance_m + b.gamma_m);
+    if (r.outlier) {
+      EXPECT_GT(e, 0.5 - 0.6);
+      EXPECT_LT(e, 3.0 + 0.6);
+    } else {
+      s2 += e * e;
+      ++n_in;
+    }
+    EXPECT_NEAR(r.sample.R_m2, 0.01, 1e-15);
+    EXPECT_EQ(r.sample.range_corr_m, r.sample.range_m);
+  }
+  EXPECT_NEAR(std::sqrt(s2 / n_in), 0.1, 0.005);
+}
+
+TEST(SimUwbRangeSimulator, NoiseLevelDoesNotChangeWhichRangesAreOutliersOrDropped) {
+  Fixture f;
+  UwbRangeOptions noisy, quiet;
+  quiet.sigma_range_m = 0.0;
+  UwbRangeSimulator a(f.scenario, f.biases, noisy, 2), b(f.scenario, f.biases, quiet, 2);
+  const auto ra = a.simulate(f.trajectory, f.schedule, 40.0), rb = b.simulate(f.trajectory, f.schedule, 40.0);
+  ASSERT_EQ(ra.size(), rb.size());
+  for (size_t k = 0; k < ra.size(); ++k) {
+    EXPECT_EQ(ra[k].sample.t, rb[k].sample.t);
+    EXPECT_EQ(ra[k].outlier, rb[k].outlier);
+  }
+}
