@@ -1,0 +1,36 @@
+#pragma once
+/// @file calibration_io.h
+/// @brief Calibration results as YAML (DESIGN §6), one entry per anchor:
+/// @code
+/// anchors:
+///   - id: 106
+///     t: 80.000000                 # [s]
+///     p_AinG: [x, y, z]            # [m]
+///     p_AinG_cov: [9 values]       # 3×3 row-major [m²]
+///     ref_ids: [100, 101, ...]
+///     const_biases: [...]          # γ per reference [m]
+///     dist_biases: [...]           # β per reference [-]
+///     sigma_const_biases: [...]    # [m]
+///     sigma_dist_biases: [...]     # [-] (0: β fixed, not estimated)
+///     sigma_ranges: [...]          # residual σ of each pair [m] (extension)
+///     n_inliers: 700
+///     n_outliers: 15
+/// refused:
+///   - {id: 109, status: too_few_measurements, reason: "..."}
+/// @endcode
+
+#include <string>
+#include <vector>
+
+#include "calibrator/calibration_types.h"
+
+namespace meshnav::calib {
+
+/// Writes every result (refused ones under `refused:`). Throws std::runtime_error on I/O failure.
+void writeCalibrationYaml(const std::vector<CalibrationResult>& results, const std::string& path);
+
+/// Reads the `anchors:` entries back as estimator inits (PairBias a = reference, b = anchor).
+/// Throws std::runtime_error naming the file and the key on a malformed file.
+std::vector<AnchorInit> readAnchorInitsYaml(const std::string& path);
+
+}  // namespace meshnav::calib

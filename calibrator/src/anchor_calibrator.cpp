@@ -1,0 +1,177 @@
+#include "calibrator/anchor_calibrator.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "calibrator/calibration_problem.h"
+#include "calibrator/nonlinear_refiner.h"
+#include "calibrator/optimal_double_solver.h"
+#include "calibrator/range_model.h"
+#include "calibrator/ransac_solver.h"
+#include "calibrator/reference_geometry.h"
+
+namespace meshnav::calib {
+
+namespace {
+
+/// Final inlier test at x: |r_i|/σ_eff,i < k·max(1, s_robust), s_robust = 1.4826·median |r/σ_eff|
+/// over the candidate set (so an under-stated σ_d does not turn good ranges into outliers).
+std::vector<bool> classifyFinal(const CalibrationProblem& pb, const AnchorParams& x, const std::vector<bool>& candidates,
+                                double k) {
+  const auto n = pb.observations().size();
+  std::vector<double> w(n, 0.0), abs_cand;
+  for (int i = 0; i < static_cast<int>(n); ++i) {
+    if (pb.slotOf(i) < 0) continue;
+    w[static_cast<size_t>(i)] =
+        std::abs(pb.observations()[static_cast<size_t>(i)].z_m - predictRange(pb, x, i)) / effectiveSigma(pb, x, i);
+    if (candidates.empty() || candidates[static_cast<size_t>(i)]) abs_cand.push_back(w[static_cast<size_t>(i)]);
+  }
+  double s_rob = 1.0;
+  if (!abs_cand.empty()) {
+    auto mid = abs_cand.begin() + static_cast<long>(abs_cand.size() / 2);
+    std::nth_element(abs_cand.begin(), mid, abs_cand.end());
+    s_rob = std::max(1.0, 1.4826 * *mid);
+  }
+  std::vector<bool> in(n, false);
+  for (int i = 0; i < static_cast<int>(n); ++i)
+    in[static_cast<size_t>(i)] = pb.slotOf(i) >= 0 && w[static_cast<size_t>(i)] < k * s_rob;
+  return in;
+}
+
+}  // namespace
+
+const char* toString(CalibrationStatus s) {
+  switch (s) {
+    case CalibrationStatus::Ok: return "ok";
+    case CalibrationStatus::TooFewMeasurements: return "too_few_measurements";
+    case CalibrationStatus::TooFewReferencePositions: return "too_few_reference_positions";
+    case CalibrationStatus::DegenerateGeometry: return "degenerate_geometry";
+    case CalibrationStatus::IllConditioned: return "ill_conditioned";
+  }
+  return "?";
+}
+
+AnchorInit CalibrationResult::toAnchorInit() const {
+  AnchorInit a;
+  a.t = t;
+  a.id = anchor_id;
+  a.p_AinG = p_AinG;
+  a.cov_p_m2 = cov_p_m2;
+  a.n_inliers = n_inliers;
+  a.n_outliers = n_outliers;
+  for (const auto& r : references) {
+    PairBias b;
+    b.a = r.ref_id;
+    b.b = anchor_id;
+    b.gamma_m = r.gamma_m;
+    b.beta = r.beta;
+    b.sigma_m = r.sigma_range_m;
+    b.sigma_gamma_m = r.sigma_gamma_m;
+    b.sigma_beta = r.sigma_beta;
+    a.biases.push_back(b);
+  }
+  return a;
+}
+
+CalibrationResult AnchorCalibrator::calibrate(SensorId anchor_id, const std::vector<CalibObservation>& observations,
+                                              const std::map<SensorId, ReferencePrior>& priors, Timestamp t) const {
+  CalibrationResult res;
+  res.anchor_id = anchor_id;
+  res.t = t;
+  res.n_observations = static_cast<int>(observations.size());
+  const CalibrationProblem pb(anchor_id, observations, priors, options_);
+  auto refuse = [&](CalibrationStatus st, const std::string& why) {
+    res.status = st;
+    res.reason = why;
+    res.inliers.assign(observations.size(), false);
+    return res;
+  };
+
+  const GeometryReport geo = checkReferenceGeometry(pb, options_);
+  if (geo.status != CalibrationStatus::Ok) return refuse(geo.status, geo.reason);
+
+  // 1. Linear step, on RANSAC inliers or on everything.
+  std::vector<bool> use(pb.observations().size());
+  for (int i = 0; i < static_cast<int>(use.size()); ++i) use[static_cast<size_t>(i)] = pb.slotOf(i) >= 0;
+  LinearSolution lin;
+  if (options_.ransac) {
+    const RansacSolver ransac(options_);
+    RansacResult rr = ransac.run(pb, options_.ransac_seed);
+    res.ransac_iterations = rr.iterations;
+    if (!rr.ok) return refuse(CalibrationStatus::DegenerateGeometry, "RANSAC: " + rr.reason);
+    use = rr.inliers;
+    lin = rr.solution;
+  } else {
+    lin = OptimalDoubleSolver(options_).solve(pb);
+    if (!lin.ok) return refuse(CalibrationStatus::DegenerateGeometry, "linear step: " + lin.reason);
+  }
+  res.p_AinG_linear = lin.params.p_AinG;
+
+  // 2. Refinement; with RANSAC a second round on the inliers of the refined model.
+  const NonlinearRefiner refiner(options_);
+  RefineResult ref = refiner.refine(pb, lin.params, use);
+  if (!ref.converged) return refuse(CalibrationStatus::IllConditioned, "refinement failed: " + ref.message);
+  res.lm_iterations = ref.iterations;
+  std::vector<bool> inl = classifyFinal(pb, ref.params, {}, options_.outlier_threshold_sigmas);
+  if (options_.ransac && inl != use) {
+    RefineResult ref2 = refiner.refine(pb, ref.params, inl);
+    if (ref2.converged) {
+      ref = ref2;
+      res.lm_iterations += ref2.iterations;
+      inl = classifyFinal(pb, ref.params, {}, options_.outlier_threshold_sigmas);
+    }
+  }
+  const AnchorParams& x = ref.params;
+
+  // 3. Covariance on the final inliers.
+  const CovarianceEstimate cov = estimateCovariance(pb, x, inl, options_.scale_covariance_by_residuals);
+  if (!cov.ok) return refuse(CalibrationStatus::IllConditioned, "information matrix is singular");
+  const Eigen::Matrix3d Pp = cov.P.block<3, 3>(0, 0);
+  const double sig_max = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Pp).eigenvalues()(2)));
+  if (!(sig_max <= options_.max_position_sigma_m)) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "position sigma %.2f m exceeds %.2f m", sig_max, options_.max_position_sigma_m);
+    return refuse(CalibrationStatus::IllConditioned, buf);
+  }
+
+  res.status = CalibrationStatus::Ok;
+  res.p_AinG = x.p_AinG;
+  res.cov_p_m2 = 0.5 * (Pp + Pp.transpose());
+  res.residual_variance_factor = cov.s2;
+  // Map inliers back to the caller's order: the problem sorted by time (stable), so match by sort.
+  std::vector<size_t> order(observations.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return observations[a].t < observations[b].t; });
+  res.inliers.assign(observations.size(), false);
+  for (size_t k = 0; k < order.size(); ++k) res.inliers[order[k]] = inl[k];
+
+  for (int s = 0; s < static_cast<int>(pb.slots().size()); ++s) {
+    const auto& slot = pb.slots()[static_cast<size_t>(s)];
+    ReferenceBiasEstimate r;
+    r.ref_id = slot.id;
+    r.moving = slot.moving;
+    r.beta_estimated = pb.betaIndex(s) >= 0;
+    r.gamma_m = x.gamma_m[static_cast<size_t>(s)];
+    r.sigma_gamma_m = std::sqrt(cov.P(pb.gammaIndex(s), pb.gammaIndex(s)));
+    r.beta = x.beta[static_cast<size_t>(s)];
+    r.sigma_beta = r.beta_estimated ? std::sqrt(cov.P(pb.betaIndex(s), pb.betaIndex(s))) : 0.0;
+    double sq = 0.0;
+    for (int i : slot.obs) {
+      if (inl[static_cast<size_t>(i)]) {
+        sq += std::pow(pb.observations()[static_cast<size_t>(i)].z_m - predictRange(pb, x, i), 2);
+        ++r.n_inliers;
+      } else {
+        ++r.n_outliers;
+      }
+    }
+    r.sigma_range_m = r.n_inliers > 0 ? std::sqrt(sq / r.n_inliers) : options_.sigma_range_m;
+    res.n_inliers += r.n_inliers;
+    res.n_outliers += r.n_outliers;
+    res.references.push_back(r);
+  }
+  return res;
+}
+
+}  // namespace meshnav::calib

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Sequences 1..12 of the paper scenario: simulate, run the pipeline, evaluate, print the table.
+# Called by `./meshnav paper-table` after the build. Options:
+#   --seeds A-B            seed range (default 1-12)
+#   --strategy S           centralized | dp | dah (default centralized)
+#   --out DIR              output root (default out/paper-<strategy>)
+#   --mission FILE         mission file for meshnav_run (fly-by calibration)
+#   --config FILE          estimator options
+#   --sim-args "..."       extra meshnav_sim options (e.g. "--outlier-fraction 0.1")
+#   --table-md FILE        also write the table as Markdown
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BIN="${MESHNAV_BUILD_DIR:-$ROOT/build}/bin"
+seeds="1-12"; strategy="centralized"; out=""; mission=""; config=""; sim_args=""; table_md=""
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --seeds) seeds="$2"; shift 2 ;;
+    --strategy) strategy="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    --mission) mission="$2"; shift 2 ;;
+    --config) config="$2"; shift 2 ;;
+    --sim-args) sim_args="$2"; shift 2 ;;
+    --table-md) table_md="$2"; shift 2 ;;
+    -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "paper_table: unknown option $1" >&2; exit 2 ;;
+  esac
+done
+out="${out:-$ROOT/out/paper-$strategy}"
+first="${seeds%-*}"; last="${seeds#*-}"
+mkdir -p "$out"
+for ((s = first; s <= last; s++)); do
+  d="$out/$(printf 'seed%02d' "$s")"
+  mkdir -p "$d"
+  echo "[paper-table] seed $s: simulate, run ($strategy), evaluate -> $d" >&2
+  # shellcheck disable=SC2086
+  "$BIN/meshnav_sim" --seed "$s" --out "$d/dataset" $sim_args > "$d/sim.log" 2>&1 || { cat "$d/sim.log"; exit 1; }
+  run_args=(--dataset "$d/dataset" --out "$d/run" --strategy "$strategy")
+  [[ -n "$mission" ]] && run_args+=(--mission "$mission")
+  [[ -n "$config" ]] && run_args+=(--config "$config")
+  "$BIN/meshnav_run" "${run_args[@]}" > "$d/run.log" 2>&1 || { cat "$d/run.log"; exit 1; }
+  "$BIN/meshnav_eval" --dataset "$d/dataset" --run "$d/run" --no-plots --only-flying > "$d/eval.log" 2>&1 \
+    || { cat "$d/eval.log"; exit 1; }
+done
+batch=(--batch "$out")
+[[ -n "$table_md" ]] && batch+=(--table-md "$table_md")
+"$BIN/meshnav_eval" "${batch[@]}"

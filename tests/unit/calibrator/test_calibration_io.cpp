@@ -1,0 +1,144 @@
+// Calibration YAML round trip, options YAML, and building observations from ranges + poses.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "calibrator/anchor_calibrator.h"
+#include "calibrator/calibration_io.h"
+#include "calibrator/observation_builder.h"
+#include "calibrator/synthetic_scene.h"
+
+using namespace meshnav;
+using namespace meshnav::calib;
+
+namespace {
+std::string tmpFile(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("meshnav_calib_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return (dir / name).string();
+}
+}  // namespace
+
+TEST(CalibrationIo, YamlRoundTripIntoAnchorInit) {
+  SyntheticSceneConfig cfg;
+  const auto sc = makeSyntheticScene(cfg);
+  CalibrationResult ok = AnchorCalibrator({}).calibrate(106, sc.observations, {}, Timestamp::fromSec(80.0));
+  ASSERT_TRUE(ok.ok());
+  CalibrationResult refused = AnchorCalibrator({}).calibrate(109, {}, {}, Timestamp::fromSec(80.0));
+  const std::string path = tmpFile("calib.yaml");
+  writeCalibrationYaml({ok, refused}, path);
+  const auto inits = readAnchorInitsYaml(path);
+  ASSERT_EQ(inits.size(), 1u);
+  const AnchorInit& a = inits[0];
+  EXPECT_EQ(a.id, 106);
+  EXPECT_NEAR(a.t.sec(), 80.0, 1e-9);
+  EXPECT_LT((a.p_AinG - ok.p_AinG).norm(), 1e-8);
+  EXPECT_LT((a.cov_p_m2 - ok.cov_p_m2).norm(), 1e-12);
+  EXPECT_EQ(a.n_inliers, ok.n_inliers);
+  EXPECT_EQ(a.n_outliers, ok.n_outliers);
+  ASSERT_EQ(a.biases.size(), ok.references.size());
+  for (size_t k = 0; k < a.biases.size(); ++k) {
+    EXPECT_EQ(a.biases[k].a, ok.references[k].ref_id);
+    EXPECT_EQ(a.biases[k].b, 106);
+    EXPECT_NEAR(a.biases[k].gamma_m, ok.references[k].gamma_m, 1e-8);
+    EXPECT_NEAR(a.biases[k].beta, ok.references[k].beta, 1e-8);
+    EXPECT_NEAR(a.biases[k].sigma_gamma_m, ok.references[k].sigma_gamma_m, 1e-8);
+  }
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const char* key : {"p_AinG_cov", "ref_ids", "const_biases", "dist_biases", "sigma_const_biases",
+                          "sigma_dist_biases", "n_inliers", "n_outliers", "refused", "too_few_measurements"})
+    EXPECT_NE(text.find(key), std::string::npos) << key;
+}
+
+TEST(CalibrationIo, MalformedYamlNamesFileAndKey) {
+  const std::string path = tmpFile("bad.yaml");
+  {
+    std::ofstream(path) << "anchors:\n  - id: 106\n    p_AinG: [1, 2]\n";
+  }
+  try {
+    readAnchorInitsYaml(path);
+    FAIL() << "no throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("anchors[0].p_AinG"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(readAnchorInitsYaml(tmpFile("missing.yaml")), std::runtime_error);
+}
+
+TEST(CalibrationIo, OptionsFromYaml) {
+  const std::string path = tmpFile("opts.yaml");
+  {
+    std::ofstream(path) << "calibrator:\n  sigma_range: 0.2\n  robust_loss: huber\n  ransac: false\n";
+  }
+  const auto o = CalibratorOptions::load(path);
+  EXPECT_DOUBLE_EQ(o.sigma_range_m, 0.2);
+  EXPECT_EQ(o.robust_loss, RobustLoss::Huber);
+  EXPECT_FALSE(o.ransac);
+  EXPECT_NE(o.toString().find("robust_loss: huber"), std::string::npos);
+  {
+    std::ofstream(path) << "calibrator:\n  sigma_rnage: 0.2\n";
+  }
+  try {
+    CalibratorOptions::load(path);
+    FAIL() << "no throw";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("sigma_rnage"), std::string::npos);
+  }
+  {
+    std::ofstream(path) << "calibrator:\n  sigma_range: -1\n";
+  }
+  EXPECT_THROW(CalibratorOptions::load(path), std::runtime_error);
+}
+
+TEST(ObservationBuilder, TagsAtLeverArmKnownAnchorsAndDiagnostics) {
+  SystemSetup setup;
+  setup.rel_tag_positions[100] = Eigen::Vector3d(0.2, 0.0, -0.1);
+  setup.abs_anchor_positions[101] = Eigen::Vector3d(1, 2, 3);
+  setup.abs_anchor_positions[106] = Eigen::Vector3d(9, 9, 9);  // known, but calibrated as unknown
+  setup.abs_anchor_sigmas_m[101] = 0.05;
+  setup.pair_biases.push_back(PairBias{101, 106, 0.3, 1.0, 0.1, 0.02, 0.0});
+  CalibratorOptions o;
+  o.max_pose_gap_s = 2.0;
+  ObservationBuilder b(setup, o);
+  std::vector<PoseEstimate> poses(2);
+  poses[0].t = Timestamp::fromSec(0.0);
+  poses[1].t = Timestamp::fromSec(1.0);
+  poses[1].p_IinG = Eigen::Vector3d(2, 0, 0);
+  for (auto& p : poses) {
+    p.q_ItoG = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+    p.cov_p_m2 = 0.01 * Eigen::Matrix3d::Identity();
+    p.cov_theta_rad2 = 0.0 * Eigen::Matrix3d::Identity();
+  }
+  b.setPoses(poses);
+  auto mk = [](double t, SensorId a, SensorId c, double z) {
+    RangeSample r;
+    r.t = Timestamp::fromSec(t);
+    r.id_initiator = a;
+    r.id_responder = c;
+    r.range_m = z;
+    return r;
+  };
+  const std::vector<RangeSample> ranges = {mk(0.5, 100, 106, 3.0), mk(0.5, 106, 101, 4.0), mk(5.0, 100, 106, 3.0),
+                                           mk(0.6, 107, 106, 2.0), mk(0.7, 100, 101, 2.0),
+                                           mk(0.8, 106, 100, std::nan(""))};
+  Diagnostics diag;
+  const auto obs = b.collect(106, ranges, diag);
+  ASSERT_EQ(obs.size(), 2u);
+  EXPECT_EQ(obs[0].ref_id, 100);
+  EXPECT_LT((obs[0].p_RinG - Eigen::Vector3d(1.0, 0.2, -0.1)).norm(), 1e-12);  // p + R_z(90°)·l
+  EXPECT_NEAR(obs[0].cov_p_RinG_m2(0, 0), 0.01, 1e-12);
+  EXPECT_EQ(obs[1].ref_id, 101);
+  EXPECT_EQ(obs[1].p_RinG, Eigen::Vector3d(1, 2, 3));
+  EXPECT_NEAR(obs[1].cov_p_RinG_m2(2, 2), 0.0025, 1e-12);
+  EXPECT_EQ(diag.get("calibrator:range_without_pose"), 1);
+  EXPECT_EQ(diag.get("calibrator:range_to_unknown_device"), 1);
+  EXPECT_EQ(diag.get("calibrator:bad_range"), 1);
+  const auto pri = b.priors(106);
+  ASSERT_EQ(pri.count(101), 1u);
+  EXPECT_DOUBLE_EQ(pri.at(101).gamma_m, 0.3);
+  EXPECT_DOUBLE_EQ(pri.at(101).sigma_gamma_m, 0.02);
+  // Time window.
+  EXPECT_EQ(b.collect(106, ranges, diag, Timestamp::fromSec(0.55), std::nullopt).size(), 0u);
+}
