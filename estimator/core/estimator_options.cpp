@@ -1,0 +1,201 @@
+#include "estimator/core/estimator_options.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace meshnav::estimator {
+namespace {
+
+/// Visits every option as (dotted key, field, unit/comment). The single list used for loading,
+/// printing and the shipped YAML, so they cannot drift apart.
+template <typename Opt, typename Visitor>
+void forEachField(Opt& o, Visitor&& v) {
+  v("strategy", o.strategy, "centralized | dp | dah");
+  v("gravity_m_s2", o.gravity_m_s2, "|g| [m/s^2]");
+  v("window_s", o.window_s, "out-of-sequence window [s]");
+  v("pose_output_rate_hz", o.pose_output_rate_hz, "POSE rate, 0 = every IMU step [Hz]");
+  v("anchors_output_rate_hz", o.anchors_output_rate_hz, "ANCHORS rate (data time) [Hz]");
+  v("status_rate_hz", o.status_rate_hz, "ESTIMATOR_STATUS rate (data time) [Hz]");
+  v("joseph_form", o.joseph_form, "Joseph covariance update (false: P - K S K^T, symmetrized)");
+  v("imu.acc_noise_density", o.imu.acc_noise_density, "[m/s^2/sqrt(Hz)]");
+  v("imu.gyro_noise_density", o.imu.gyro_noise_density, "[rad/s/sqrt(Hz)]");
+  v("imu.acc_bias_rw", o.imu.acc_bias_rw, "[m/s^3/sqrt(Hz)]");
+  v("imu.gyro_bias_rw", o.imu.gyro_bias_rw, "[rad/s^2/sqrt(Hz)]");
+  v("imu.max_dt_s", o.imu.max_dt_s, "longer IMU gaps are counted as imu_gap [s]");
+  v("init.duration_s", o.init.duration_s, "landed data before initializing [s]");
+  v("init.min_ranges", o.init.min_ranges, "tag-anchor ranges needed without initial_pose [-]");
+  v("init.assume_landed_without_flight_state", o.init.assume_landed_without_flight_state,
+    "no FLIGHT_STATE received yet: treat as landed");
+  v("init.sigma_v_m_s", o.init.sigma_v_m_s, "[m/s]");
+  v("init.sigma_roll_pitch_deg", o.init.sigma_roll_pitch_deg, "[deg]");
+  v("init.sigma_bias_gyro_rad_s", o.init.sigma_bias_gyro_rad_s, "[rad/s]");
+  v("init.sigma_bias_acc_m_s2", o.init.sigma_bias_acc_m_s2, "[m/s^2]");
+  v("init.range_init_min_sigma_p_m", o.init.range_init_min_sigma_p_m, "floor of position sigma from ranges [m]");
+  v("init.range_init_sigma_yaw_deg", o.init.range_init_sigma_yaw_deg, "yaw sigma when initialized from ranges [deg]");
+  v("init.range_init_outlier_m", o.init.range_init_outlier_m, "init range residual treated as outlier [m]");
+  v("baro.enabled", o.baro.enabled, "");
+  v("baro.pressure_sigma_pa", o.baro.pressure_sigma_pa, "[Pa]");
+  v("baro.bias_rw_m_per_sqrt_s", o.baro.bias_rw_m_per_sqrt_s, "height bias random walk [m/sqrt(s)]");
+  v("baro.init_bias_sigma_m", o.baro.init_bias_sigma_m, "bias sigma with a given reference pressure [m]");
+  v("baro.gate_probability", o.baro.gate_probability, "chi^2 gate, 0 = off [-]");
+  v("uwb.enabled", o.uwb.enabled, "");
+  v("uwb.sigma_range_m", o.uwb.sigma_range_m, "fallback range sigma [m]");
+  v("uwb.gate_probability", o.uwb.gate_probability, "chi^2 gate, 0 = off [-]");
+  v("uwb.use_corrected_range", o.uwb.use_corrected_range, "fuse range_corr instead of range_raw");
+  v("uwb.max_range_m", o.uwb.max_range_m, "longer ranges are bad input [m]");
+  v("zupt.enabled", o.zupt.enabled, "");
+  v("zupt.rate_hz", o.zupt.rate_hz, "pseudo-measurement rate while landed [Hz]");
+  v("zupt.sigma_acc_m_s2", o.zupt.sigma_acc_m_s2, "sigma of a = 0 [m/s^2]");
+  v("zupt.sigma_gyro_rad_s", o.zupt.sigma_gyro_rad_s, "sigma of omega = 0 [rad/s]");
+  v("zupt.sigma_vel_m_s", o.zupt.sigma_vel_m_s, "sigma of v = 0 [m/s]");
+}
+
+std::vector<std::string> splitKey(const std::string& key) {
+  std::vector<std::string> parts;
+  std::stringstream ss(key);
+  std::string p;
+  while (std::getline(ss, p, '.')) parts.push_back(p);
+  return parts;
+}
+
+std::string formatValue(const std::string& v) { return v; }
+std::string formatValue(bool v) { return v ? "true" : "false"; }
+std::string formatValue(int v) { return std::to_string(v); }
+std::string formatValue(double v) {
+  std::ostringstream os;
+  os.precision(10);
+  os << v;
+  std::string s = os.str();
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+/// Regularized lower incomplete gamma P(a, x) (series / continued fraction, Numerical Recipes style).
+double gammaP(double a, double x) {
+  if (x <= 0.0) return 0.0;
+  const double gln = std::lgamma(a);
+  if (x < a + 1.0) {
+    double ap = a, sum = 1.0 / a, del = sum;
+    for (int n = 0; n < 500; ++n) {
+      ap += 1.0;
+      del *= x / ap;
+      sum += del;
+      if (std::abs(del) < std::abs(sum) * 1e-15) break;
+    }
+    return sum * std::exp(-x + a * std::log(x) - gln);
+  }
+  double b = x + 1.0 - a, c = 1.0 / 1e-300, d = 1.0 / b, h = d;
+  for (int i = 1; i < 500; ++i) {
+    const double an = -i * (i - a);
+    b += 2.0;
+    d = an * d + b;
+    if (std::abs(d) < 1e-300) d = 1e-300;
+    c = b + an / c;
+    if (std::abs(c) < 1e-300) c = 1e-300;
+    d = 1.0 / d;
+    const double del = d * c;
+    h *= del;
+    if (std::abs(del - 1.0) < 1e-15) break;
+  }
+  return 1.0 - std::exp(-x + a * std::log(x) - gln) * h;
+}
+
+}  // namespace
+
+double chi2Quantile(int dof, double p) {
+  if (dof <= 0 || !(p > 0.0 && p < 1.0)) throw std::invalid_argument("chi2Quantile: need dof > 0 and 0 < p < 1");
+  double lo = 0.0, hi = std::max(10.0, 10.0 * dof);
+  while (gammaP(0.5 * dof, 0.5 * hi) < p) hi *= 2.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (gammaP(0.5 * dof, 0.5 * mid) < p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+EstimatorOptions EstimatorOptions::fromYaml(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": cannot read estimator options: " + e.what());
+  }
+  EstimatorOptions o;
+  forEachField(o, [&](const std::string& key, auto& field, const char*) {
+    YAML::Node node;
+    node.reset(root);  // (Node::operator= would overwrite the content of root)
+    for (const auto& part : splitKey(key)) {
+      const YAML::Node child = node.IsMap() ? node[part] : YAML::Node();
+      if (!child) throw std::runtime_error(path + ": missing key '" + key + "'");
+      node.reset(child);
+    }
+    try {
+      field = node.as<std::remove_reference_t<decltype(field)>>();
+    } catch (const std::exception& e) {
+      throw std::runtime_error(path + ": key '" + key + "' has a malformed value: " + e.what());
+    }
+  });
+  try {
+    o.validate();
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  return o;
+}
+
+void EstimatorOptions::validate() const {
+  auto need = [](bool ok, const std::string& what) {
+    if (!ok) throw std::invalid_argument("invalid option: " + what);
+  };
+  need(strategy == "centralized" || strategy == "dp" || strategy == "dah", "strategy must be centralized, dp or dah");
+  need(gravity_m_s2 > 0.0, "gravity_m_s2 > 0");
+  need(window_s >= 0.0, "window_s >= 0");
+  need(pose_output_rate_hz >= 0.0 && anchors_output_rate_hz > 0.0 && status_rate_hz > 0.0, "output rates");
+  need(imu.acc_noise_density > 0 && imu.gyro_noise_density > 0 && imu.acc_bias_rw >= 0 && imu.gyro_bias_rw >= 0,
+       "imu noise densities > 0");
+  need(imu.max_dt_s > 0.0, "imu.max_dt_s > 0");
+  need(init.duration_s >= 0.0 && init.min_ranges >= 4, "init.duration_s >= 0, init.min_ranges >= 4");
+  need(init.sigma_v_m_s > 0 && init.sigma_roll_pitch_deg > 0 && init.sigma_bias_gyro_rad_s > 0 &&
+           init.sigma_bias_acc_m_s2 > 0 && init.range_init_min_sigma_p_m > 0 && init.range_init_sigma_yaw_deg > 0 &&
+           init.range_init_outlier_m > 0,
+       "init sigmas > 0");
+  need(baro.pressure_sigma_pa > 0 && baro.bias_rw_m_per_sqrt_s >= 0 && baro.init_bias_sigma_m > 0, "baro sigmas");
+  need(baro.gate_probability >= 0 && baro.gate_probability < 1, "baro.gate_probability in [0, 1)");
+  need(uwb.sigma_range_m > 0 && uwb.max_range_m > 0, "uwb.sigma_range_m > 0, uwb.max_range_m > 0");
+  need(uwb.gate_probability >= 0 && uwb.gate_probability < 1, "uwb.gate_probability in [0, 1)");
+  need(zupt.rate_hz > 0 && zupt.sigma_acc_m_s2 > 0 && zupt.sigma_gyro_rad_s > 0 && zupt.sigma_vel_m_s > 0,
+       "zupt rate and sigmas > 0");
+}
+
+void EstimatorOptions::applySetupNoise(const NoiseFigures& n) {
+  if (n.imu_acc_noise_density) imu.acc_noise_density = *n.imu_acc_noise_density;
+  if (n.imu_gyro_noise_density) imu.gyro_noise_density = *n.imu_gyro_noise_density;
+  if (n.imu_acc_bias_rw) imu.acc_bias_rw = *n.imu_acc_bias_rw;
+  if (n.imu_gyro_bias_rw) imu.gyro_bias_rw = *n.imu_gyro_bias_rw;
+  if (n.baro_pressure_sigma_pa) baro.pressure_sigma_pa = *n.baro_pressure_sigma_pa;
+}
+
+std::string EstimatorOptions::toString() const {
+  std::ostringstream os;
+  std::vector<std::string> open;  // currently open YAML sections
+  forEachField(*this, [&](const std::string& key, const auto& field, const char* unit) {
+    auto parts = splitKey(key);
+    const std::string section = parts.size() > 1 ? parts[0] : "";
+    if (parts.size() > 1 && (open.empty() || open.back() != section)) {
+      os << section << ":\n";
+      open = {section};
+    } else if (parts.size() == 1) {
+      open.clear();
+    }
+    os << (parts.size() > 1 ? "  " : "") << parts.back() << ": " << formatValue(field);
+    if (unit && *unit) os << "  # " << unit;
+    os << "\n";
+  });
+  return os.str();
+}
+
+}  // namespace meshnav::estimator

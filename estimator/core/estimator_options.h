@@ -1,0 +1,88 @@
+#pragma once
+/// @file estimator_options.h
+/// @brief Tuning of the estimator (config/estimator.yaml). Every key is required when loading
+/// from YAML; the defaults here equal the shipped file. Setup noise figures (setup.yaml `noise:`)
+/// override the matching defaults at construction of the node (see `applySetupNoise`).
+
+#include <string>
+
+#include "common/setup.h"
+
+namespace meshnav::estimator {
+
+/// IMU noise model (continuous-time densities).
+struct ImuNoiseOptions {
+  double acc_noise_density = 0.02;    ///< σ_a [m/s²/√Hz]
+  double gyro_noise_density = 0.002;  ///< σ_ω [rad/s/√Hz]
+  double acc_bias_rw = 0.002;         ///< σ_ba [m/s³/√Hz]
+  double gyro_bias_rw = 0.0002;       ///< σ_bω [rad/s²/√Hz]
+  double max_dt_s = 0.1;              ///< a longer IMU gap is propagated but counted ("imu_gap") [s]
+};
+
+/// Static initialization while landed.
+struct InitOptions {
+  double duration_s = 1.0;              ///< landed data needed before initializing [s]
+  int min_ranges = 12;                  ///< tag–known-anchor ranges needed without initial_pose
+  bool assume_landed_without_flight_state = true;  ///< no FLIGHT_STATE yet: treat as landed
+  double sigma_v_m_s = 0.05;            ///< initial velocity σ [m/s]
+  double sigma_roll_pitch_deg = 2.0;    ///< initial roll/pitch σ [deg]
+  double sigma_bias_gyro_rad_s = 0.005; ///< initial gyro bias σ [rad/s]
+  double sigma_bias_acc_m_s2 = 0.2;     ///< initial accelerometer bias σ [m/s²]
+  double range_init_min_sigma_p_m = 0.2;   ///< floor of the position σ from range least squares [m]
+  double range_init_sigma_yaw_deg = 30.0;  ///< yaw σ when initialized from ranges (large) [deg]
+  double range_init_outlier_m = 0.6;       ///< residual beyond which an init range is dropped [m]
+};
+
+struct BaroOptions {
+  bool enabled = true;
+  double pressure_sigma_pa = 3.0;        ///< pressure noise σ [Pa]
+  double bias_rw_m_per_sqrt_s = 0.02;    ///< height bias random walk [m/√s]
+  double init_bias_sigma_m = 1.0;        ///< bias σ when the reference pressure is given [m]
+  double gate_probability = 0.999;       ///< χ² gate (0: no gating) [-]
+};
+
+struct UwbOptions {
+  bool enabled = true;
+  double sigma_range_m = 0.15;           ///< fallback range σ [m]
+  double gate_probability = 0.997;       ///< χ² gate (0: no gating) [-]
+  bool use_corrected_range = false;      ///< fuse range_corr instead of range_raw
+  double max_range_m = 100.0;            ///< longer ranges are bad input [m]
+};
+
+struct ZuptOptions {
+  bool enabled = true;
+  double rate_hz = 10.0;                 ///< pseudo-measurement rate while landed [Hz]
+  double sigma_acc_m_s2 = 0.2;           ///< σ of a = 0 [m/s²]
+  double sigma_gyro_rad_s = 0.01;        ///< σ of ω = 0 [rad/s]
+  double sigma_vel_m_s = 0.02;           ///< σ of v = 0 [m/s]
+};
+
+struct EstimatorOptions {
+  std::string strategy = "centralized";  ///< centralized | dp | dah
+  double gravity_m_s2 = 9.81;            ///< |g|, gravity is −g along z of G [m/s²]
+  double window_s = 1.0;                 ///< out-of-sequence window [s]
+  double pose_output_rate_hz = 0.0;      ///< POSE rate; 0: every IMU step [Hz]
+  double anchors_output_rate_hz = 1.0;   ///< ANCHORS rate (data time) [Hz]
+  double status_rate_hz = 1.0;           ///< ESTIMATOR_STATUS rate (data time) [Hz]
+  bool joseph_form = true;               ///< Joseph covariance update (else P − K S Kᵀ, symmetrized)
+  ImuNoiseOptions imu;
+  InitOptions init;
+  BaroOptions baro;
+  UwbOptions uwb;
+  ZuptOptions zupt;
+
+  /// Loads every key from `path`; throws std::runtime_error("<path>: missing key 'a.b'") etc.
+  static EstimatorOptions fromYaml(const std::string& path);
+  /// Throws std::invalid_argument naming the first out-of-range value.
+  void validate() const;
+  /// Setup noise figures override the IMU and baro defaults (setup.yaml `noise:`). The range σ is
+  /// resolved per range by `UwbNetwork` (pair σ, then setup σ, then the range's R, then this file).
+  void applySetupNoise(const NoiseFigures& noise);
+  /// Multi-line "key: value  # unit" listing.
+  std::string toString() const;
+};
+
+/// χ² quantile: x with P(χ²_dof ≤ x) = p (0 < p < 1).
+double chi2Quantile(int dof, double p);
+
+}  // namespace meshnav::estimator

@@ -1,0 +1,36 @@
+#pragma once
+/// @file instance_kind.h
+/// @brief Kinds of sensor instances (paper §III-A): each has a unique id and a state block size.
+
+#include <string>
+
+namespace meshnav::estimator {
+
+/// Type of a sensor instance. Only instances with an error state appear in the filter's layout:
+/// the IMU (15), a barometer (its bias, 1) and estimated anchors (position, 3). Tags and exactly
+/// known anchors are instances without state.
+enum class InstanceKind { Imu, Baro, Tag, Anchor };
+
+/// Error-state dimension of an instance kind with state (Tag: 0).
+constexpr int errorDim(InstanceKind k) {
+  switch (k) {
+    case InstanceKind::Imu: return 15;
+    case InstanceKind::Baro: return 1;
+    case InstanceKind::Anchor: return 3;
+    case InstanceKind::Tag: return 0;
+  }
+  return 0;
+}
+
+/// "imu", "baro", "tag", "anchor" (as in EstimatorStatus).
+inline std::string kindName(InstanceKind k) {
+  switch (k) {
+    case InstanceKind::Imu: return "imu";
+    case InstanceKind::Baro: return "baro";
+    case InstanceKind::Tag: return "tag";
+    case InstanceKind::Anchor: return "anchor";
+  }
+  return "?";
+}
+
+}  // namespace meshnav::estimator

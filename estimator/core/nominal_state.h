@@ -1,0 +1,35 @@
+#pragma once
+/// @file nominal_state.h
+/// @brief Nominal (mean) values of every instance with state, addressed by instance id.
+
+#include <Eigen/Core>
+#include <map>
+
+#include "common/time.h"
+#include "common/types.h"
+#include "estimator/core/imu_state.h"
+#include "estimator/core/state_layout.h"
+
+namespace meshnav::estimator {
+
+struct NominalState {
+  Timestamp t;                                       ///< time the state is valid at
+  SensorId imu_id = 1;
+  ImuState imu;
+  std::map<SensorId, double> baro_bias_m;            ///< barometer height bias b_P [m]
+  std::map<SensorId, Eigen::Vector3d> anchor_p_AinG; ///< estimated anchors' positions [m]
+
+  /// Applies a stacked error-state correction laid out as `layout`.
+  void boxplus(const StateLayout& layout, const Eigen::VectorXd& dx) {
+    for (const StateBlock& b : layout.blocks()) {
+      switch (b.kind) {
+        case InstanceKind::Imu: imu.boxplus(dx.segment<ImuErr::kDim>(b.offset)); break;
+        case InstanceKind::Baro: baro_bias_m.at(b.id) += dx(b.offset); break;
+        case InstanceKind::Anchor: anchor_p_AinG.at(b.id) += dx.segment<3>(b.offset); break;
+        case InstanceKind::Tag: break;
+      }
+    }
+  }
+};
+
+}  // namespace meshnav::estimator

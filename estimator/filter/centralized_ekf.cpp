@@ -1,0 +1,132 @@
+#include "estimator/filter/centralized_ekf.h"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <stdexcept>
+
+namespace meshnav::estimator {
+
+CentralizedEkf::CentralizedEkf(const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s, bool joseph_form)
+    : propagator_(propagator), baro_bias_rw_(baro_bias_rw_m_per_sqrt_s), joseph_form_(joseph_form) {}
+
+void CentralizedEkf::reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) {
+  x_ = NominalState{};
+  x_.t = t;
+  x_.imu_id = imu_id;
+  x_.imu = x;
+  layout_ = StateLayout{};
+  P_.resize(0, 0);
+  appendBlock(imu_id, InstanceKind::Imu, cov);
+}
+
+void CentralizedEkf::appendBlock(SensorId id, InstanceKind kind, const Eigen::MatrixXd& cov) {
+  const int n = layout_.dim();
+  const StateBlock& b = layout_.add(id, kind);
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(layout_.dim(), layout_.dim());
+  P.topLeftCorner(n, n) = P_;
+  P.block(b.offset, b.offset, b.dim, b.dim) = 0.5 * (cov + cov.transpose());
+  P_ = std::move(P);
+}
+
+void CentralizedEkf::addBaro(SensorId id, double bias_m, double var_m2) {
+  if (layout_.find(id)) removeInstance(id);
+  x_.baro_bias_m[id] = bias_m;
+  appendBlock(id, InstanceKind::Baro, Eigen::MatrixXd::Constant(1, 1, var_m2));
+}
+
+void CentralizedEkf::addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) {
+  if (layout_.find(id)) removeInstance(id);
+  x_.anchor_p_AinG[id] = p_AinG;
+  appendBlock(id, InstanceKind::Anchor, cov);
+}
+
+bool CentralizedEkf::removeInstance(SensorId id) {
+  const StateBlock* blk = layout_.find(id);
+  if (!blk || blk->kind == InstanceKind::Imu) return false;
+  const int off = blk->offset, d = blk->dim, n = layout_.dim(), tail = n - off - d;
+  Eigen::MatrixXd P(n - d, n - d);
+  P.topLeftCorner(off, off) = P_.topLeftCorner(off, off);
+  P.topRightCorner(off, tail) = P_.topRightCorner(off, tail);
+  P.bottomLeftCorner(tail, off) = P_.bottomLeftCorner(tail, off);
+  P.bottomRightCorner(tail, tail) = P_.bottomRightCorner(tail, tail);
+  P_ = std::move(P);
+  layout_.remove(id);
+  x_.baro_bias_m.erase(id);
+  x_.anchor_p_AinG.erase(id);
+  return true;
+}
+
+void CentralizedEkf::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) {
+  const double dt = (t_to - x_.t).sec();
+  if (dt <= 0.0) return;
+  ImuMatrix Phi, Q;
+  propagator_.propagate(x_.imu, acc_m_s2, gyro_rad_s, dt, &Phi, &Q);
+  x_.t = t_to;
+  constexpr int kI = ImuErr::kDim;  // the IMU block is always first
+  const int n = layout_.dim();
+  // P ← Φ_full P Φ_fullᵀ with Φ_full = diag(Φ, I): rows, then columns.
+  P_.topRows<kI>() = (Phi * P_.topRows<kI>()).eval();
+  P_.leftCols<kI>() = (P_.leftCols<kI>() * Phi.transpose()).eval();
+  P_.topLeftCorner<kI, kI>() += Q;
+  // Keep the touched rows/columns exactly symmetric.
+  const ImuMatrix Pii = P_.topLeftCorner<kI, kI>();
+  P_.topLeftCorner<kI, kI>() = 0.5 * (Pii + Pii.transpose());
+  if (n > kI) P_.bottomLeftCorner(n - kI, kI) = P_.topRightCorner(kI, n - kI).transpose();
+  for (const StateBlock& b : layout_.blocks())
+    if (b.kind == InstanceKind::Baro) P_(b.offset, b.offset) += baro_bias_rw_ * baro_bias_rw_ * dt;
+  checkInvariants("propagate");
+}
+
+UpdateResult CentralizedEkf::update(const Linearization& lin, double nis_gate) {
+  const int n = layout_.dim(), m = lin.dim();
+  // U = P Hᵀ and S = H P Hᵀ + R from the named blocks (H is zero elsewhere).
+  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n, m);
+  for (const JacobianBlock& jb : lin.blocks) {
+    const StateBlock& b = layout_.at(jb.id);
+    if (jb.H.rows() != m || jb.H.cols() != b.dim)
+      throw std::logic_error("CentralizedEkf::update: Jacobian block of " + std::to_string(jb.id) + " has wrong size");
+    U.noalias() += P_.middleCols(b.offset, b.dim) * jb.H.transpose();
+  }
+  Eigen::MatrixXd S = lin.R;
+  for (const JacobianBlock& jb : lin.blocks) {
+    const StateBlock& b = layout_.at(jb.id);
+    S.noalias() += jb.H * U.middleRows(b.offset, b.dim);
+  }
+  S = 0.5 * (S + S.transpose()).eval();
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
+  UpdateResult res;
+  res.nis = lin.residual.dot(ldlt.solve(lin.residual));
+  if (!std::isfinite(res.nis) || (nis_gate > 0.0 && res.nis > nis_gate)) return res;
+  const Eigen::MatrixXd K = ldlt.solve(U.transpose()).transpose();  // n × m
+  const Eigen::VectorXd dx = K * lin.residual;
+  if (joseph_form_) {
+    const Eigen::MatrixXd KU = K * U.transpose();
+    P_ += -KU - KU.transpose() + K * S * K.transpose();
+  } else {
+    P_.noalias() -= K * U.transpose();
+  }
+  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  x_.boxplus(layout_, dx);
+  res.accepted = true;
+  checkInvariants("update");
+  return res;
+}
+
+Eigen::MatrixXd CentralizedEkf::covariance(SensorId a, SensorId b) const {
+  const StateBlock& ba = layout_.at(a);
+  const StateBlock& bb = layout_.at(b);
+  return P_.block(ba.offset, bb.offset, ba.dim, bb.dim);
+}
+
+void CentralizedEkf::checkInvariants(const char* where) const {
+#ifdef MESHNAV_CHECK_INVARIANTS
+  if (!(P_ - P_.transpose()).isZero(1e-9 * (1.0 + P_.norm())))
+    throw std::logic_error(std::string("CentralizedEkf: covariance not symmetric after ") + where);
+  if (Eigen::LLT<Eigen::MatrixXd>(P_).info() != Eigen::Success)
+    throw std::logic_error(std::string("CentralizedEkf: covariance not positive definite after ") + where);
+#else
+  (void)where;
+#endif
+}
+
+}  // namespace meshnav::estimator

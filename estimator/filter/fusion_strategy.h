@@ -1,0 +1,52 @@
+#pragma once
+/// @file fusion_strategy.h
+/// @brief The interface behind which the fusion strategies live (DESIGN §4): `centralized` (a
+/// plain full-covariance error-state EKF, the reference), and in the next issue `dp` and `dah`
+/// over isolated instances. The node (instance handler) only talks to this interface.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+#include "estimator/core/linearization.h"
+#include "estimator/core/nominal_state.h"
+#include "estimator/core/state_layout.h"
+
+namespace meshnav::estimator {
+
+/// Outcome of one update.
+struct UpdateResult {
+  bool accepted = false;
+  double nis = 0.0;  ///< normalized innovation squared rᵀ S⁻¹ r
+};
+
+class FusionStrategy {
+ public:
+  virtual ~FusionStrategy() = default;
+  virtual std::string name() const = 0;
+  /// Deep copy (state snapshot for out-of-sequence rewinds).
+  virtual std::unique_ptr<FusionStrategy> clone() const = 0;
+
+  /// (Re)starts the filter with only the IMU instance.
+  virtual void reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) = 0;
+  /// Adds a barometer bias instance (uncorrelated with the rest).
+  virtual void addBaro(SensorId id, double bias_m, double var_m2) = 0;
+  /// Adds an anchor position instance (uncorrelated with the rest). Replaces it if present.
+  virtual void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) = 0;
+  /// Removes an instance with state (not the IMU). False if absent.
+  virtual bool removeInstance(SensorId id) = 0;
+
+  /// Propagates to `t_to` with IMU readings held constant since the state's time.
+  virtual void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) = 0;
+  /// EKF update with a linearized measurement; gated when `nis_gate` > 0 and NIS > `nis_gate`.
+  virtual UpdateResult update(const Linearization& lin, double nis_gate) = 0;
+
+  virtual const NominalState& state() const = 0;
+  virtual const StateLayout& layout() const = 0;
+  /// Σ_ab between two instances with state.
+  virtual Eigen::MatrixXd covariance(SensorId a, SensorId b) const = 0;
+  /// The stacked covariance in `layout()` order.
+  virtual Eigen::MatrixXd fullCovariance() const = 0;
+};
+
+}  // namespace meshnav::estimator

@@ -1,0 +1,20 @@
+#include "estimator/filter/strategy_factory.h"
+
+#include <stdexcept>
+
+#include "estimator/filter/centralized_ekf.h"
+
+namespace meshnav::estimator {
+
+bool strategyImplemented(const std::string& name) { return name == "centralized"; }
+
+std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& o) {
+  if (o.strategy == "centralized")
+    return std::make_unique<CentralizedEkf>(ImuPropagator(o.gravity_m_s2, o.imu), o.baro.bias_rw_m_per_sqrt_s,
+                                            o.joseph_form);
+  if (o.strategy == "dp" || o.strategy == "dah")
+    throw std::invalid_argument("strategy '" + o.strategy + "' is not implemented yet (next issue)");
+  throw std::invalid_argument("unknown strategy '" + o.strategy + "'");
+}
+
+}  // namespace meshnav::estimator

@@ -1,0 +1,17 @@
+#pragma once
+/// @file strategy_factory.h
+/// @brief Creates the fusion strategy named in the options.
+
+#include <memory>
+
+#include "estimator/core/estimator_options.h"
+#include "estimator/filter/fusion_strategy.h"
+
+namespace meshnav::estimator {
+
+/// True for strategies this build implements ("centralized").
+bool strategyImplemented(const std::string& name);
+/// Throws std::invalid_argument for unknown or not yet implemented strategies.
+std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& options);
+
+}  // namespace meshnav::estimator

@@ -1,0 +1,460 @@
+#include "estimator/node/estimator_node.h"
+
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "common/atmosphere.h"
+#include "estimator/filter/strategy_factory.h"
+#include "estimator/uwb/range_model.h"
+
+namespace meshnav::estimator {
+
+namespace {
+
+std::string where(const char* channel, Timestamp t) { return std::string(channel) + " t=" + formatSeconds(t); }
+
+}  // namespace
+
+std::vector<EstimatorInput> mergeInTimeOrder(const Dataset& ds) {
+  std::vector<EstimatorInput> all;
+  all.reserve(ds.imu.size() + ds.baro.size() + ds.ranges.size() + ds.flight_states.size());
+  for (const auto& s : ds.flight_states) all.emplace_back(s);
+  for (const auto& s : ds.imu) all.emplace_back(s);
+  for (const auto& s : ds.baro) all.emplace_back(s);
+  for (const auto& s : ds.ranges) all.emplace_back(s);
+  std::stable_sort(all.begin(), all.end(),
+                   [](const EstimatorInput& a, const EstimatorInput& b) { return inputOrder(a) < inputOrder(b); });
+  return all;
+}
+
+EstimatorNode::Snapshot EstimatorNode::Snapshot::copy() const {
+  Snapshot s;
+  s.filter = filter ? filter->clone() : nullptr;
+  s.network = network;
+  s.last_imu = last_imu;
+  s.landed = landed;
+  s.last_zupt = last_zupt;
+  return s;
+}
+
+EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup& setup, EstimatorSinks sinks)
+    : options_(options),
+      setup_(setup),
+      sinks_(std::move(sinks)),
+      baro_model_(setup.baro_p_IP),
+      zupt_model_(Eigen::Vector3d(0.0, 0.0, -options.gravity_m_s2)) {
+  options_.applySetupNoise(setup.noise);
+  options_.validate();
+  if (!strategyImplemented(options_.strategy))
+    throw std::invalid_argument("strategy '" + options_.strategy + "' is not implemented yet (next issue)");
+  if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
+  if (options_.baro.gate_probability > 0) baro_gate_ = chi2Quantile(1, options_.baro.gate_probability);
+  resetAll();
+}
+
+EstimatorNode::~EstimatorNode() = default;
+
+void EstimatorNode::resetAll() {
+  initializer_ = std::make_unique<StaticInitializer>(options_, setup_);
+  cur_ = Snapshot{};
+  cur_.network = std::make_shared<const UwbNetwork>(setup_, options_.uwb.sigma_range_m);
+  history_.clear();
+  baro_reference_pa_.reset();
+  instance_stats_.clear();
+  last_pose_pub_.reset();
+}
+
+void EstimatorNode::event(bool first, const std::string& kind, const std::string& message) {
+  if (!first) return;
+  if (message.empty())
+    diag_.count(kind);
+  else
+    diag_.report(kind, message);
+}
+
+bool EstimatorNode::validate(const EstimatorInput& in) {
+  std::string bad;
+  Timestamp t = inputTime(in);
+  if (const auto* s = std::get_if<ImuSample>(&in)) {
+    if (!s->acc_m_s2.allFinite() || !s->gyro_rad_s.allFinite() || s->acc_m_s2.norm() > 2000.0 ||
+        s->gyro_rad_s.norm() > 100.0)
+      bad = where("IMU", t) + ": non-finite or absurd reading";
+  } else if (const auto* s = std::get_if<BaroSample>(&in)) {
+    if (!std::isfinite(s->pressure_pa) || s->pressure_pa < 1000.0 || s->pressure_pa > 200000.0)
+      bad = where("BARO", t) + ": non-finite or absurd pressure " + std::to_string(s->pressure_pa);
+  } else if (const auto* s = std::get_if<RangeSample>(&in)) {
+    const double z = options_.uwb.use_corrected_range ? s->range_corr_m : s->range_m;
+    if (!std::isfinite(z) || z < -0.5 || z > options_.uwb.max_range_m || !std::isfinite(s->R_m2) || s->R_m2 < 0)
+      bad = where("RANGE", t) + ": bad range " + std::to_string(z) + " m between " + std::to_string(s->id_initiator) +
+            " and " + std::to_string(s->id_responder);
+    else if (s->id_initiator == s->id_responder || s->id_initiator <= 0 || s->id_responder <= 0)
+      bad = where("RANGE", t) + ": invalid ids " + std::to_string(s->id_initiator) + ", " +
+            std::to_string(s->id_responder);
+  } else if (const auto* a = std::get_if<AnchorInit>(&in)) {
+    if (a->id <= 0 || !a->p_AinG.allFinite() || !a->cov_p_m2.allFinite() ||
+        Eigen::LLT<Eigen::Matrix3d>(0.5 * (a->cov_p_m2 + a->cov_p_m2.transpose())).info() != Eigen::Success)
+      bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) + " with invalid position or covariance";
+    for (const auto& b : a->biases)
+      if (!std::isfinite(b.gamma_m) || !std::isfinite(b.beta) || b.beta <= 0.0 || !std::isfinite(b.sigma_m))
+        bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) + " with invalid pair bias";
+  }
+  if (!bad.empty()) {
+    diag_.report("bad_input", bad);
+    return false;
+  }
+  return true;
+}
+
+void EstimatorNode::onInput(const EstimatorInput& in_raw) {
+  if (!validate(in_raw)) return;
+  EstimatorInput in = in_raw;
+  // Commands are not measurements: they apply now (at the newest time) unless they are newer.
+  if (newest_ && (std::holds_alternative<AnchorInit>(in) || std::holds_alternative<EstimatorCommand>(in))) {
+    if (auto* a = std::get_if<AnchorInit>(&in)) a->t = std::max(a->t, *newest_);
+    if (auto* c = std::get_if<EstimatorCommand>(&in)) c->t = std::max(c->t, *newest_);
+  }
+  if (const auto* c = std::get_if<EstimatorCommand>(&in); c && c->action == EstimatorCommand::Action::Reset) {
+    spdlog::info("estimator: reset by command at t={}", formatSeconds(c->t));
+    diag_.count("reset");
+    resetAll();
+    return;
+  }
+  const Timestamp t = inputTime(in);
+  if (!initialized()) {
+    newest_ = newest_ ? std::max(*newest_, t) : t;
+    feedInitializer(in);
+    publishPeriodic();
+    return;
+  }
+  if (t < init_time_) {
+    diag_.count("before_init");
+    return;
+  }
+  if (t < *newest_ - Duration::fromSec(options_.window_s)) {
+    diag_.report("rejected_too_old", where("input", t) + " is older than the newest " + formatSeconds(*newest_) +
+                                         " minus the window " + std::to_string(options_.window_s) + " s");
+    return;
+  }
+  Entry e{inputOrder(in), in, nullptr};
+  auto pos = std::upper_bound(history_.begin(), history_.end(), e.key,
+                              [](const InputOrder& k, const Entry& x) { return k < x.key; });
+  if (pos == history_.end()) {
+    e.before = std::make_shared<const Snapshot>(cur_.copy());
+    history_.push_back(std::move(e));
+    process(history_.back().input, true);
+  } else {
+    // Out of sequence: rewind to the snapshot before its place, re-process in order.
+    diag_.count("out_of_sequence");
+    cur_ = pos->before->copy();
+    e.before = pos->before;
+    auto it = history_.insert(pos, std::move(e));
+    process(it->input, true);
+    for (++it; it != history_.end(); ++it) {
+      it->before = std::make_shared<const Snapshot>(cur_.copy());
+      process(it->input, false);
+    }
+  }
+  newest_ = std::max(*newest_, t);
+  const Timestamp oldest_kept = *newest_ - Duration::fromSec(options_.window_s);
+  while (!history_.empty() && history_.front().key.t_us < oldest_kept.us) history_.pop_front();
+  publishPeriodic();
+}
+
+void EstimatorNode::feedInitializer(const EstimatorInput& in) {
+  std::visit(
+      [&](const auto& m) {
+        using T = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<T, ImuSample>) initializer_->addImu(m);
+        if constexpr (std::is_same_v<T, BaroSample>) initializer_->addBaro(m);
+        if constexpr (std::is_same_v<T, RangeSample>) initializer_->addRange(m);
+        if constexpr (std::is_same_v<T, FlightStateSample>) initializer_->addFlightState(m);
+        if constexpr (std::is_same_v<T, AnchorInit>) pending_anchor_inits_.push_back(m);
+        if constexpr (std::is_same_v<T, EstimatorCommand>)
+          if (m.action == EstimatorCommand::Action::AddAnchor) pending_anchor_inits_.push_back(m.anchor);
+      },
+      in);
+  if (!std::holds_alternative<ImuSample>(in)) return;
+  if (auto belief = initializer_->tryInitialize()) initialize(*belief);
+}
+
+void EstimatorNode::initialize(const InitialBelief& b) {
+  auto filter = makeStrategy(options_);
+  filter->reset(setup_.imu_id, b.imu, b.cov, b.t);
+  if (options_.baro.enabled && b.baro_reference_pa) {
+    baro_reference_pa_ = b.baro_reference_pa;
+    filter->addBaro(setup_.baro_id, b.baro_bias_m, b.baro_bias_var_m2);
+  }
+  for (const auto& [id, p] : setup_.abs_anchor_positions) {
+    auto sig = setup_.abs_anchor_sigmas_m.find(id);
+    if (sig != setup_.abs_anchor_sigmas_m.end())
+      filter->addAnchor(id, p, Eigen::Matrix3d::Identity() * sig->second * sig->second);
+  }
+  cur_.filter = std::move(filter);
+  cur_.last_imu = b.last_imu;
+  cur_.landed = b.landed;
+  cur_.last_zupt = b.t;
+  init_time_ = b.t;
+  newest_ = newest_ ? std::max(*newest_, b.t) : b.t;
+  const Eigen::Matrix3d R0 = b.imu.q_ItoG.toRotationMatrix();
+  const double yaw_deg = std::atan2(R0(1, 0), R0(0, 0)) * 180.0 / M_PI;
+  spdlog::info(
+      "estimator: initialized at t={} from {} p_IinG=[{:.3f}, {:.3f}, {:.3f}] m, yaw {:.1f} deg (σ_p {:.2f} m, "
+      "σ_yaw {:.1f} deg){}",
+      formatSeconds(b.t), b.from_ranges ? "ranges" : "initial_pose", b.imu.p_IinG.x(), b.imu.p_IinG.y(),
+      b.imu.p_IinG.z(), yaw_deg, std::sqrt(b.cov(ImuErr::kP, ImuErr::kP)),
+      std::sqrt(b.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta).trace() -
+                2.0 * std::pow(options_.init.sigma_roll_pitch_deg * M_PI / 180.0, 2)) * 180.0 / M_PI,
+      b.from_ranges ? fmt::format(", {} ranges, rms {:.3f} m", b.n_ranges_used, b.range_fit_rms_m) : "");
+  if (!baro_reference_pa_ && options_.baro.enabled)
+    spdlog::warn("estimator: no baro reference pressure (none in setup, no landed baro data): baro unused");
+  const auto pending = std::move(pending_anchor_inits_);
+  pending_anchor_inits_.clear();
+  for (auto a : pending) {
+    a.t = b.t;
+    onInput(a);
+  }
+}
+
+void EstimatorNode::process(const EstimatorInput& in, bool first) {
+  std::visit(
+      [&](const auto& m) {
+        using T = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<T, ImuSample>) processImu(m, first);
+        if constexpr (std::is_same_v<T, BaroSample>) processBaro(m, first);
+        if constexpr (std::is_same_v<T, RangeSample>) processRange(m, first);
+        if constexpr (std::is_same_v<T, FlightStateSample>) cur_.landed = m.landed;
+        if constexpr (std::is_same_v<T, AnchorInit>) applyAnchorInit(m, first);
+        if constexpr (std::is_same_v<T, EstimatorCommand>) applyCommand(m, first);
+      },
+      in);
+}
+
+void EstimatorNode::propagateTo(Timestamp t) {
+  if (!cur_.last_imu || t <= cur_.filter->state().t) return;
+  ScopedStepTimer timer(timings_, "propagate");
+  cur_.filter->propagate(cur_.last_imu->acc_m_s2, cur_.last_imu->gyro_rad_s, t);
+}
+
+void EstimatorNode::processImu(const ImuSample& s, bool first) {
+  FusionStrategy& f = *cur_.filter;
+  const Timestamp t0 = f.state().t;
+  if (s.t > t0) {
+    if ((s.t - t0).sec() > options_.imu.max_dt_s)
+      event(first, "imu_gap", where("IMU", s.t) + ": gap of " + std::to_string((s.t - t0).sec()) + " s");
+    // Readings interpolated to the middle of [t0, s.t] (held when no earlier reading).
+    Eigen::Vector3d acc = s.acc_m_s2, gyro = s.gyro_rad_s;
+    if (cur_.last_imu && s.t > cur_.last_imu->t) {
+      const double alpha = 0.5 * ((t0 - cur_.last_imu->t).sec() + (s.t - cur_.last_imu->t).sec()) /
+                           (s.t - cur_.last_imu->t).sec();
+      acc = (1.0 - alpha) * cur_.last_imu->acc_m_s2 + alpha * s.acc_m_s2;
+      gyro = (1.0 - alpha) * cur_.last_imu->gyro_rad_s + alpha * s.gyro_rad_s;
+    }
+    ScopedStepTimer timer(timings_, "propagate");
+    f.propagate(acc, gyro, s.t);
+  }
+  cur_.last_imu = s;
+  if (options_.zupt.enabled && cur_.landed && (s.t - cur_.last_zupt).sec() >= 1.0 / options_.zupt.rate_hz - 1e-9) {
+    ScopedStepTimer timer(timings_, "zupt");
+    ZuptMeasurement z;
+    z.t = s.t;
+    z.acc_m_s2 = s.acc_m_s2;
+    z.gyro_rad_s = s.gyro_rad_s;
+    z.sigma_acc_m_s2 = options_.zupt.sigma_acc_m_s2;
+    z.sigma_gyro_rad_s = options_.zupt.sigma_gyro_rad_s;
+    z.sigma_vel_m_s = options_.zupt.sigma_vel_m_s;
+    f.update(zupt_model_.linearize(z, f.state()), 0.0);
+    cur_.last_zupt = s.t;
+    if (first) ++instance_stats_[setup_.imu_id].n_updates;
+  }
+  if (first && sinks_.pose) {
+    const bool due = options_.pose_output_rate_hz <= 0.0 || !last_pose_pub_ ||
+                     (s.t - *last_pose_pub_).sec() >= 1.0 / options_.pose_output_rate_hz - 1e-6;
+    if (due) {
+      last_pose_pub_ = s.t;
+      sinks_.pose(makePose());
+    }
+  }
+}
+
+void EstimatorNode::processBaro(const BaroSample& s, bool first) {
+  if (!options_.baro.enabled) return;
+  if (!baro_reference_pa_) {
+    event(first, "baro_no_reference");
+    return;
+  }
+  propagateTo(s.t);
+  ScopedStepTimer timer(timings_, "baro_update");
+  BaroMeasurement z;
+  z.t = s.t;
+  z.baro_id = setup_.baro_id;
+  z.height_m = atmosphere::heightFromPressure(s.pressure_pa, *baro_reference_pa_);
+  z.sigma_m = std::abs(atmosphere::dHeightDPressure(s.pressure_pa, *baro_reference_pa_)) * options_.baro.pressure_sigma_pa;
+  const UpdateResult r = cur_.filter->update(baro_model_.linearize(z, cur_.filter->state()), baro_gate_);
+  if (!first) return;
+  InstanceStatus& st = instance_stats_[setup_.baro_id];
+  if (r.accepted) {
+    ++st.n_updates;
+  } else {
+    ++st.n_rejected;
+    diag_.count("gated_baro");
+  }
+}
+
+void EstimatorNode::processRange(const RangeSample& s, bool first) {
+  if (!options_.uwb.enabled) return;
+  RangeMeasurement z;
+  z.t = s.t;
+  z.a = s.id_initiator;
+  z.b = s.id_responder;
+  z.z_m = options_.uwb.use_corrected_range ? s.range_corr_m : s.range_m;
+  z.R_m2 = s.R_m2;
+  const RangeModel::Status status = RangeModel::classify(z, cur_.filter->state(), *cur_.network);
+  if (status != RangeModel::Status::Ok) {
+    if (status == RangeModel::Status::UnknownId)
+      event(first, "unknown_id",
+            where("RANGE", s.t) + ": unknown device in range " + std::to_string(z.a) + "–" + std::to_string(z.b));
+    else
+      event(first, RangeModel::statusName(status));
+    return;
+  }
+  propagateTo(s.t);
+  ScopedStepTimer timer(timings_, "range_update");
+  Linearization lin;
+  const RangeModel::Status st = RangeModel::linearize(z, cur_.filter->state(), *cur_.network, &lin);
+  if (st != RangeModel::Status::Ok) {
+    event(first, RangeModel::statusName(st));
+    return;
+  }
+  const UpdateResult r = cur_.filter->update(lin, range_gate_);
+  if (!first) return;
+  if (!r.accepted) diag_.count("gated_range");
+  for (SensorId id : {z.a, z.b}) {
+    InstanceStatus& is = instance_stats_[id];
+    ++(r.accepted ? is.n_updates : is.n_rejected);
+  }
+}
+
+void EstimatorNode::applyAnchorInit(const AnchorInit& a, bool first) {
+  auto net = std::make_shared<UwbNetwork>(*cur_.network);
+  if (net->isTag(a.id)) {
+    event(first, "bad_command", where("ANCHOR_INIT", a.t) + ": id " + std::to_string(a.id) + " is a tag");
+    return;
+  }
+  net->removeDevice(a.id);  // an exactly known anchor becomes an estimated one
+  for (PairBias b : a.biases) {
+    if (b.a != a.id && b.b != a.id) b.b = a.id;
+    net->setPairBias(b);
+  }
+  cur_.network = std::move(net);
+  cur_.filter->addAnchor(a.id, a.p_AinG, 0.5 * (a.cov_p_m2 + a.cov_p_m2.transpose()));
+  if (first) {
+    diag_.count("anchor_init");
+    spdlog::info("estimator: anchor {} added at t={} p_AinG=[{:.3f}, {:.3f}, {:.3f}] with {} pair biases", a.id,
+                 formatSeconds(a.t), a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z(), a.biases.size());
+  }
+}
+
+void EstimatorNode::applyCommand(const EstimatorCommand& c, bool first) {
+  switch (c.action) {
+    case EstimatorCommand::Action::AddAnchor: {
+      AnchorInit a = c.anchor;
+      a.id = c.id ? c.id : a.id;
+      a.t = c.t;
+      applyAnchorInit(a, first);
+      break;
+    }
+    case EstimatorCommand::Action::RemoveInstance: {
+      if (c.id == setup_.imu_id || c.id == setup_.baro_id) {
+        event(first, "bad_command", "ESTIMATOR_CMD: cannot remove the IMU or baro instance " + std::to_string(c.id));
+        break;
+      }
+      bool removed = cur_.filter->removeInstance(c.id);
+      if (cur_.network->isTag(c.id) || cur_.network->exactAnchor(c.id)) {
+        auto net = std::make_shared<UwbNetwork>(*cur_.network);
+        removed = net->removeDevice(c.id) || removed;
+        cur_.network = std::move(net);
+      }
+      if (!removed) event(first, "bad_command", "ESTIMATOR_CMD: no instance " + std::to_string(c.id) + " to remove");
+      break;
+    }
+    case EstimatorCommand::Action::Reset: break;  // handled in onInput
+  }
+}
+
+PoseEstimate EstimatorNode::makePose() const {
+  const FusionStrategy& f = *cur_.filter;
+  const NominalState& x = f.state();
+  const Eigen::MatrixXd P = f.covariance(x.imu_id, x.imu_id);
+  PoseEstimate e;
+  e.t = x.t;
+  e.p_IinG = x.imu.p_IinG;
+  e.v_IinG = x.imu.v_IinG;
+  e.q_ItoG = x.imu.q_ItoG;
+  e.bias_gyro_rad_s = x.imu.bias_gyro_rad_s;
+  e.bias_acc_m_s2 = x.imu.bias_acc_m_s2;
+  e.cov_p_m2 = P.block<3, 3>(ImuErr::kP, ImuErr::kP);
+  e.cov_v = P.block<3, 3>(ImuErr::kV, ImuErr::kV);
+  e.cov_theta_rad2 = P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta);
+  return e;
+}
+
+std::optional<PoseEstimate> EstimatorNode::pose() const {
+  if (!initialized()) return std::nullopt;
+  return makePose();
+}
+
+std::vector<AnchorEstimate> EstimatorNode::anchors() const {
+  std::vector<AnchorEstimate> out;
+  if (!initialized()) return out;
+  const NominalState& x = cur_.filter->state();
+  for (const auto& [id, p] : cur_.network->exactAnchors()) out.push_back({x.t, id, p, Eigen::Matrix3d::Zero()});
+  for (const auto& [id, p] : x.anchor_p_AinG) out.push_back({x.t, id, p, cur_.filter->covariance(id, id)});
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+  return out;
+}
+
+EstimatorStatus EstimatorNode::status() const {
+  EstimatorStatus s;
+  s.t = newest_.value_or(Timestamp{});
+  s.wall_utime = std::chrono::duration_cast<std::chrono::microseconds>(
+                     std::chrono::system_clock::now().time_since_epoch())
+                     .count();
+  s.initialized = initialized();
+  s.strategy = options_.strategy;
+  auto add = [&](SensorId id, const std::string& type) {
+    InstanceStatus is;
+    auto it = instance_stats_.find(id);
+    if (it != instance_stats_.end()) is = it->second;
+    is.id = id;
+    is.type = type;
+    s.instances.push_back(is);
+  };
+  if (initialized()) {
+    for (const StateBlock& b : cur_.filter->layout().blocks()) add(b.id, kindName(b.kind));
+    for (const auto& [id, p] : cur_.network->tags()) add(id, "tag");
+    for (const auto& [id, p] : cur_.network->exactAnchors()) add(id, "anchor");
+  }
+  s.counters = diag_.snapshot();
+  s.mean_step_us = timings_.means();
+  return s;
+}
+
+void EstimatorNode::publishPeriodic() {
+  if (!newest_) return;
+  const Timestamp now = *newest_;
+  auto due = [&](std::optional<Timestamp>& next, double rate_hz) {
+    if (next && now < *next) return false;
+    const Duration period = Duration::fromSec(1.0 / rate_hz);
+    next = (next && now - *next < period) ? *next + period : now + period;
+    return true;
+  };
+  if (initialized() && sinks_.anchors && due(next_anchor_pub_, options_.anchors_output_rate_hz))
+    sinks_.anchors(anchors());
+  if (sinks_.status && due(next_status_pub_, options_.status_rate_hz)) sinks_.status(status());
+}
+
+}  // namespace meshnav::estimator

@@ -1,0 +1,130 @@
+#pragma once
+/// @file estimator_node.h
+/// @brief The estimator node (instance handler, DESIGN §4), free of LCM: consumes IMU, baro,
+/// range, flight state, ANCHOR_INIT and ESTIMATOR_CMD inputs, publishes POSE, ANCHORS and
+/// ESTIMATOR_STATUS through callbacks.
+///
+/// - Before initialization, inputs feed the `StaticInitializer` (no propagation).
+/// - Afterwards every input is kept in a time-sorted history over a sliding window with the
+///   filter snapshot before it. An input older than the newest processed one rewinds to the
+///   snapshot before its place and re-processes the rest in the canonical order
+///   (estimator_input.h), so the result equals in-order processing. Older than the window:
+///   rejected ("rejected_too_old"). Bad values: "bad_input". Unknown range ids: "unknown_id".
+/// - IMU samples propagate (inputs interpolated to the middle of the step); baro and range
+///   updates propagate to their own time with the latest reading held. While landed a
+///   zero-velocity update runs at `zupt.rate_hz` with the latest IMU reading.
+/// - ANCHOR_INIT and ESTIMATOR_CMD apply at max(their time, newest time).
+/// Poses are published per in-order IMU step (decimated to `pose_output_rate_hz`), anchors
+/// and status at their rates in data time. Not thread-safe: call from one thread.
+
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "common/diagnostics.h"
+#include "common/messages.h"
+#include "common/setup.h"
+#include "common/types.h"
+#include "estimator/baro/baro_model.h"
+#include "estimator/core/estimator_options.h"
+#include "estimator/filter/fusion_strategy.h"
+#include "estimator/node/estimator_input.h"
+#include "estimator/node/static_initializer.h"
+#include "estimator/node/step_timings.h"
+#include "estimator/uwb/uwb_network.h"
+#include "estimator/zupt/zupt_model.h"
+
+namespace meshnav::estimator {
+
+struct EstimatorSinks {
+  std::function<void(const PoseEstimate&)> pose;
+  std::function<void(const std::vector<AnchorEstimate>&)> anchors;
+  std::function<void(const EstimatorStatus&)> status;
+};
+
+class EstimatorNode {
+ public:
+  /// Throws std::invalid_argument for invalid options or a strategy not implemented yet.
+  EstimatorNode(const EstimatorOptions& options, const SystemSetup& setup, EstimatorSinks sinks = {});
+  ~EstimatorNode();
+  EstimatorNode(const EstimatorNode&) = delete;
+  EstimatorNode& operator=(const EstimatorNode&) = delete;
+
+  void onImu(const ImuSample& s) { onInput(s); }
+  void onBaro(const BaroSample& s) { onInput(s); }
+  void onRange(const RangeSample& s) { onInput(s); }
+  void onFlightState(const FlightStateSample& s) { onInput(s); }
+  void onAnchorInit(const AnchorInit& a) { onInput(a); }
+  void onCommand(const EstimatorCommand& c) { onInput(c); }
+  void onInput(const EstimatorInput& in);
+
+  bool initialized() const { return filter() != nullptr; }
+  /// The current estimate (at the newest processed input), when initialized.
+  std::optional<PoseEstimate> pose() const;
+  /// Every anchor the node knows: estimated ones with covariance, exact ones with zero covariance.
+  std::vector<AnchorEstimate> anchors() const;
+  EstimatorStatus status() const;
+  const Diagnostics& diagnostics() const { return diag_; }
+  const StepTimings& timings() const { return timings_; }
+  const EstimatorOptions& options() const { return options_; }
+  /// The filter (null before initialization).
+  const FusionStrategy* filter() const { return cur_.filter.get(); }
+  /// Inputs currently held for out-of-sequence handling.
+  size_t historySize() const { return history_.size(); }
+
+ private:
+  /// Everything a rewind restores.
+  struct Snapshot {
+    std::unique_ptr<FusionStrategy> filter;
+    std::shared_ptr<const UwbNetwork> network;
+    std::optional<ImuSample> last_imu;
+    bool landed = true;
+    Timestamp last_zupt;
+    Snapshot copy() const;
+  };
+  struct Entry {
+    InputOrder key;
+    EstimatorInput input;
+    std::shared_ptr<const Snapshot> before;
+  };
+
+  bool validate(const EstimatorInput& in);
+  void feedInitializer(const EstimatorInput& in);
+  void initialize(const InitialBelief& b);
+  /// Processes one input on `cur_`; `first` = first time (count events, publish).
+  void process(const EstimatorInput& in, bool first);
+  void processImu(const ImuSample& s, bool first);
+  void processBaro(const BaroSample& s, bool first);
+  void processRange(const RangeSample& s, bool first);
+  void applyAnchorInit(const AnchorInit& a, bool first);
+  void applyCommand(const EstimatorCommand& c, bool first);
+  void propagateTo(Timestamp t);
+  void event(bool first, const std::string& kind, const std::string& message = "");
+  void publishPeriodic();
+  void resetAll();
+  PoseEstimate makePose() const;
+
+  EstimatorOptions options_;
+  SystemSetup setup_;
+  EstimatorSinks sinks_;
+  Diagnostics diag_;
+  StepTimings timings_;
+  std::unique_ptr<StaticInitializer> initializer_;
+  std::vector<AnchorInit> pending_anchor_inits_;
+  BaroModel baro_model_;
+  ZuptModel zupt_model_;
+  double range_gate_ = 0.0, baro_gate_ = 0.0;
+
+  Snapshot cur_;
+  std::deque<Entry> history_;
+  std::optional<Timestamp> newest_;   ///< newest input time seen (also before init)
+  Timestamp init_time_;
+  std::optional<double> baro_reference_pa_;
+  std::map<SensorId, InstanceStatus> instance_stats_;
+  std::optional<Timestamp> last_pose_pub_, next_anchor_pub_, next_status_pub_;
+};
+
+}  // namespace meshnav::estimator

@@ -1,0 +1,242 @@
+#include "estimator/node/static_initializer.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "common/atmosphere.h"
+
+namespace meshnav::estimator {
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+
+Eigen::Matrix3d rotZ(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+}  // namespace
+
+StaticInitializer::StaticInitializer(const EstimatorOptions& options, const SystemSetup& setup)
+    : options_(options), setup_(setup), network_(setup, options.uwb.sigma_range_m) {}
+
+bool StaticInitializer::isStatic() const {
+  return landed_.value_or(options_.init.assume_landed_without_flight_state);
+}
+
+void StaticInitializer::restart() {
+  static_since_.reset();
+  n_imu_ = 0;
+  sum_acc_.setZero();
+  sum_gyro_.setZero();
+  n_baro_ = 0;
+  sum_pressure_ = 0.0;
+  ranges_.clear();
+}
+
+void StaticInitializer::addFlightState(const FlightStateSample& s) {
+  const bool was_static = isStatic();
+  landed_ = s.landed;
+  if (was_static && !s.landed) took_off_ = true;
+  if (!was_static && s.landed) restart();
+}
+
+void StaticInitializer::addImu(const ImuSample& s) {
+  if (!isStatic()) return;
+  if (!static_since_) static_since_ = s.t;
+  last_imu_ = s;
+  ++n_imu_;
+  sum_acc_ += s.acc_m_s2;
+  sum_gyro_ += s.gyro_rad_s;
+}
+
+void StaticInitializer::addBaro(const BaroSample& s) {
+  if (!isStatic()) return;
+  ++n_baro_;
+  sum_pressure_ += s.pressure_pa;
+}
+
+void StaticInitializer::addRange(const RangeSample& s) {
+  if (!isStatic()) return;
+  SensorId tag = s.id_initiator, anchor = s.id_responder;
+  if (!setup_.isTag(tag)) std::swap(tag, anchor);
+  if (!setup_.isTag(tag) || !setup_.isKnownAnchor(anchor)) return;
+  const PairBias pb = network_.pairBias(tag, anchor);
+  const double z = options_.uwb.use_corrected_range ? s.range_corr_m : s.range_m;
+  InitRange r;
+  r.tag = tag;
+  r.anchor = anchor;
+  r.d_m = (z - pb.gamma_m) / pb.beta;
+  r.sigma_m = network_.rangeSigma(tag, anchor, s.R_m2);
+  ranges_.push_back(r);
+}
+
+std::optional<InitialBelief> StaticInitializer::tryInitialize() {
+  if (!last_imu_ || n_imu_ == 0 || !static_since_) {
+    waiting_for_ = "landed IMU data";
+    return std::nullopt;
+  }
+  const double collected_s = (last_imu_->t - *static_since_).sec();
+  // After take-off initialize with what was collected (if anything useful), else wait.
+  const bool enough_time = collected_s >= options_.init.duration_s || (took_off_ && collected_s > 0.1);
+  if (!enough_time) {
+    waiting_for_ = "landed data (" + std::to_string(collected_s) + " s of " + std::to_string(options_.init.duration_s) + " s)";
+    return std::nullopt;
+  }
+  const Eigen::Vector3d f = sum_acc_ / n_imu_;
+  const double roll = std::atan2(f.y(), f.z());
+  const double pitch = std::atan2(-f.x(), std::hypot(f.y(), f.z()));
+  const Eigen::Matrix3d R_rp = (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                                Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX())).toRotationMatrix();
+  auto belief = build(R_rp);
+  if (!belief && took_off_) restart();  // flying: the landed data is stale
+  return belief;
+}
+
+std::optional<InitialBelief> StaticInitializer::build(const Eigen::Matrix3d& R_rp) {
+  InitialBelief b;
+  b.t = last_imu_->t;
+  b.last_imu = *last_imu_;
+  b.landed = isStatic();
+  Eigen::Vector3d p;
+  double yaw = 0.0, sigma_p = 0.0, sigma_yaw = 0.0;
+  if (setup_.initial_pose) {
+    p = setup_.initial_pose->p_IinG;
+    yaw = setup_.initial_pose->yaw_deg * kDeg;
+    sigma_p = setup_.initial_pose->sigma_p_m;
+    sigma_yaw = setup_.initial_pose->sigma_yaw_deg * kDeg;
+  } else {
+    if (static_cast<int>(ranges_.size()) < options_.init.min_ranges) {
+      waiting_for_ =
+          "tag ranges to known anchors (" + std::to_string(ranges_.size()) + " of " +
+          std::to_string(options_.init.min_ranges) + ")";
+      return std::nullopt;
+    }
+    Eigen::Matrix4d cov;
+    if (!fitPoseToRanges(R_rp, p, yaw, cov, b.range_fit_rms_m, b.n_ranges_used)) {
+      waiting_for_ = "a converging range fit";
+      return std::nullopt;
+    }
+    b.from_ranges = true;
+    sigma_p = std::max(options_.init.range_init_min_sigma_p_m, std::sqrt(cov.topLeftCorner<3, 3>().diagonal().maxCoeff()));
+    sigma_yaw = std::max(options_.init.range_init_sigma_yaw_deg * kDeg, std::sqrt(cov(3, 3)));
+  }
+  const Eigen::Matrix3d R = rotZ(yaw) * R_rp;
+  b.imu.p_IinG = p;
+  b.imu.v_IinG.setZero();
+  b.imu.q_ItoG = Eigen::Quaterniond(R).normalized();
+  b.imu.bias_gyro_rad_s = sum_gyro_ / n_imu_;
+  b.imu.bias_acc_m_s2.setZero();
+
+  const Eigen::Vector3d n = R.transpose() * Eigen::Vector3d::UnitZ();
+  const double s_rp = options_.init.sigma_roll_pitch_deg * kDeg;
+  const Eigen::Matrix3d I3 = Eigen::Matrix3d::Identity();
+  b.cov.setZero();
+  b.cov.block<3, 3>(ImuErr::kP, ImuErr::kP) = I3 * sigma_p * sigma_p;
+  b.cov.block<3, 3>(ImuErr::kV, ImuErr::kV) = I3 * std::pow(options_.init.sigma_v_m_s, 2);
+  b.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) =
+      s_rp * s_rp * (I3 - n * n.transpose()) + sigma_yaw * sigma_yaw * n * n.transpose();
+  b.cov.block<3, 3>(ImuErr::kBg, ImuErr::kBg) = I3 * std::pow(options_.init.sigma_bias_gyro_rad_s, 2);
+  b.cov.block<3, 3>(ImuErr::kBa, ImuErr::kBa) = I3 * std::pow(options_.init.sigma_bias_acc_m_s2, 2);
+
+  // Barometer: reference and bias.
+  const double baro_z = (p + R * setup_.baro_p_IP).z();
+  if (setup_.baro_reference_pressure_pa) {
+    b.baro_reference_pa = *setup_.baro_reference_pressure_pa;
+    b.baro_bias_m = 0.0;
+    b.baro_bias_var_m2 = std::pow(options_.baro.init_bias_sigma_m, 2);
+  } else if (n_baro_ > 0) {
+    const double p_ref = sum_pressure_ / n_baro_;
+    const double sigma_h = std::abs(atmosphere::dHeightDPressure(p_ref, p_ref)) * options_.baro.pressure_sigma_pa;
+    b.baro_reference_pa = p_ref;
+    b.baro_bias_m = -baro_z;  // mean measured height is 0 at the reference
+    b.baro_bias_var_m2 = sigma_p * sigma_p + sigma_h * sigma_h / n_baro_ + 0.01;
+  }
+  return b;
+}
+
+bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p_out, double& yaw_out,
+                                        Eigen::Matrix4d& cov_out, double& rms_out, int& n_used) const {
+  std::set<SensorId> anchors;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& r : ranges_) anchors.insert(r.anchor);
+  if (anchors.size() < 3) return false;
+  for (SensorId a : anchors) centroid += setup_.abs_anchor_positions.at(a);
+  centroid /= static_cast<double>(anchors.size());
+
+  std::vector<bool> use(ranges_.size(), true);
+  // Gauss–Newton on [p, yaw]; returns the weighted cost.
+  auto solve = [&](Eigen::Vector3d& p, double& yaw, Eigen::Matrix4d* cov) {
+    double cost = 0.0;
+    for (int it = 0; it < 30; ++it) {
+      Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+      Eigen::Vector4d g = Eigen::Vector4d::Zero();
+      cost = 0.0;
+      const Eigen::Matrix3d R = rotZ(yaw) * R_rp;
+      for (size_t i = 0; i < ranges_.size(); ++i) {
+        if (!use[i]) continue;
+        const InitRange& r = ranges_[i];
+        const Eigen::Vector3d lever = R * setup_.rel_tag_positions.at(r.tag);
+        const Eigen::Vector3d delta = setup_.abs_anchor_positions.at(r.anchor) - p - lever;
+        const double d = std::max(delta.norm(), 1e-6);
+        const Eigen::Vector3d u = delta / d;
+        const double res = r.d_m - d;
+        Eigen::Vector4d J;  // ∂res/∂[p, yaw]
+        J.head<3>() = u;
+        J(3) = u.dot(Eigen::Vector3d::UnitZ().cross(lever));
+        const double w = 1.0 / (r.sigma_m * r.sigma_m);
+        A += w * J * J.transpose();
+        g += w * J * res;
+        cost += w * res * res;
+      }
+      A.diagonal().array() += 1e-9;
+      const Eigen::Vector4d step = -A.ldlt().solve(g);
+      p += step.head<3>();
+      yaw = std::remainder(yaw + step(3), 2.0 * M_PI);
+      if (cov) *cov = A.inverse();
+      if (step.norm() < 1e-9) break;
+    }
+    return cost;
+  };
+
+  double best_cost = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d best_p = centroid;
+  double best_yaw = 0.0;
+  for (int sx = -1; sx <= 1; ++sx)
+    for (int sy = -1; sy <= 1; ++sy)
+      for (int k = 0; k < 4; ++k) {
+        Eigen::Vector3d p = centroid + Eigen::Vector3d(2.0 * sx, 2.0 * sy, 0.0);
+        p.z() = 0.5;
+        double yaw = k * 0.5 * M_PI;
+        const double c = solve(p, yaw, nullptr);
+        if (std::isfinite(c) && c < best_cost) {
+          best_cost = c;
+          best_p = p;
+          best_yaw = yaw;
+        }
+      }
+  if (!std::isfinite(best_cost)) return false;
+  // Drop outliers and refine.
+  const Eigen::Matrix3d R = rotZ(best_yaw) * R_rp;
+  n_used = 0;
+  for (size_t i = 0; i < ranges_.size(); ++i) {
+    const InitRange& r = ranges_[i];
+    const double d = (setup_.abs_anchor_positions.at(r.anchor) - best_p - R * setup_.rel_tag_positions.at(r.tag)).norm();
+    use[i] = std::abs(r.d_m - d) <= options_.init.range_init_outlier_m;
+    n_used += use[i] ? 1 : 0;
+  }
+  if (n_used < 4) return false;
+  solve(best_p, best_yaw, &cov_out);
+  double sq = 0.0;
+  const Eigen::Matrix3d R2 = rotZ(best_yaw) * R_rp;
+  for (size_t i = 0; i < ranges_.size(); ++i) {
+    if (!use[i]) continue;
+    const InitRange& r = ranges_[i];
+    const double d = (setup_.abs_anchor_positions.at(r.anchor) - best_p - R2 * setup_.rel_tag_positions.at(r.tag)).norm();
+    sq += (r.d_m - d) * (r.d_m - d);
+  }
+  rms_out = std::sqrt(sq / n_used);
+  p_out = best_p;
+  yaw_out = best_yaw;
+  return best_p.allFinite() && std::isfinite(best_yaw);
+}
+
+}  // namespace meshnav::estimator

@@ -1,0 +1,85 @@
+#pragma once
+/// @file static_initializer.h
+/// @brief Initial belief from data collected while landed (before the filter runs).
+///
+///  - roll, pitch from the mean specific force f̄ (at rest f = Rᵀ[0, 0, |g|]):
+///    roll = atan2(f̄_y, f̄_z), pitch = atan2(−f̄_x, √(f̄_y² + f̄_z²)); gyro bias = mean ω;
+///  - position and yaw from setup.initial_pose (σ_p, σ_yaw) when given, otherwise from a
+///    least-squares fit of [p_IinG, yaw] to the bias-corrected tag ranges to known anchors
+///    ((z − γ)/β = ‖p_A − p_IinG − R(yaw) p_TinI‖, Gauss–Newton from several seeds, residuals
+///    beyond `range_init_outlier_m` dropped) with a large yaw σ;
+///  - baro reference pressure from setup or the mean landed pressure; bias so that the mean
+///    height matches the initial baro height.
+/// The orientation covariance is local (I): Σ_θ = σ_rp² (I − n nᵀ) + σ_yaw² n nᵀ, n = R̂ᵀ e_z.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/setup.h"
+#include "common/types.h"
+#include "estimator/core/estimator_options.h"
+#include "estimator/core/imu_state.h"
+#include "estimator/uwb/uwb_network.h"
+
+namespace meshnav::estimator {
+
+struct InitialBelief {
+  Timestamp t;
+  ImuState imu;
+  ImuMatrix cov = ImuMatrix::Identity();
+  bool from_ranges = false;
+  double range_fit_rms_m = 0.0;      ///< RMS residual of the range fit [m]
+  int n_ranges_used = 0;
+  std::optional<double> baro_reference_pa;  ///< none: no baro data and none in setup
+  double baro_bias_m = 0.0;
+  double baro_bias_var_m2 = 1.0;
+  ImuSample last_imu;                ///< the IMU reading the belief is valid at
+  bool landed = true;                ///< flight state at initialization
+};
+
+class StaticInitializer {
+ public:
+  StaticInitializer(const EstimatorOptions& options, const SystemSetup& setup);
+
+  void addFlightState(const FlightStateSample& s);
+  void addImu(const ImuSample& s);
+  void addBaro(const BaroSample& s);
+  /// Ranges between a tag and a known anchor (from setup) are kept; others are ignored.
+  void addRange(const RangeSample& s);
+
+  /// The initial belief at the latest IMU sample's time, once enough landed data is there.
+  std::optional<InitialBelief> tryInitialize();
+  /// What the initializer still waits for (for logs).
+  std::string waitingFor() const { return waiting_for_; }
+
+ private:
+  struct InitRange {
+    SensorId tag = 0;
+    SensorId anchor = 0;
+    double d_m = 0.0;      // bias-corrected distance
+    double sigma_m = 0.1;
+  };
+  bool isStatic() const;
+  void restart();
+  std::optional<InitialBelief> build(const Eigen::Matrix3d& R_rp);
+  /// Least-squares [p, yaw]; returns false when it does not converge.
+  bool fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p, double& yaw, Eigen::Matrix4d& cov,
+                       double& rms, int& n_used) const;
+
+  EstimatorOptions options_;
+  SystemSetup setup_;
+  UwbNetwork network_;
+  std::optional<bool> landed_;
+  bool took_off_ = false;
+  std::optional<Timestamp> static_since_;
+  std::optional<ImuSample> last_imu_;
+  int n_imu_ = 0;
+  Eigen::Vector3d sum_acc_ = Eigen::Vector3d::Zero(), sum_gyro_ = Eigen::Vector3d::Zero();
+  int n_baro_ = 0;
+  double sum_pressure_ = 0.0;
+  std::vector<InitRange> ranges_;
+  std::string waiting_for_ = "landed IMU data";
+};
+
+}  // namespace meshnav::estimator

@@ -1,0 +1,18 @@
+#pragma once
+/// @file range_measurement.h
+/// @brief A two-way range between UWB devices a and b as fused by the filter.
+
+#include "common/time.h"
+#include "common/types.h"
+
+namespace meshnav::estimator {
+
+struct RangeMeasurement {
+  Timestamp t;
+  SensorId a = 0;       ///< initiator
+  SensorId b = 0;       ///< responder
+  double z_m = 0.0;     ///< measured range [m]
+  double R_m2 = 0.0;    ///< variance from the source [m²], 0 = unknown
+};
+
+}  // namespace meshnav::estimator

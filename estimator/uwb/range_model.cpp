@@ -1,0 +1,104 @@
+#include "estimator/uwb/range_model.h"
+
+namespace meshnav::estimator {
+namespace {
+
+/// One end of a range: where it is and how it depends on the state.
+struct End {
+  enum class Kind { Tag, StateAnchor, ExactAnchor } kind = Kind::ExactAnchor;
+  SensorId id = 0;
+  Eigen::Vector3d p_inG = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d* p_TinI = nullptr;  // tags only
+};
+
+std::optional<End> resolve(SensorId id, const NominalState& x, const UwbNetwork& net) {
+  End e;
+  e.id = id;
+  if (const Eigen::Vector3d* lever = net.tagLeverArm(id)) {
+    e.kind = End::Kind::Tag;
+    e.p_TinI = lever;
+    e.p_inG = x.imu.p_IinG + x.imu.q_ItoG * (*lever);
+    return e;
+  }
+  if (auto it = x.anchor_p_AinG.find(id); it != x.anchor_p_AinG.end()) {
+    e.kind = End::Kind::StateAnchor;
+    e.p_inG = it->second;
+    return e;
+  }
+  if (const Eigen::Vector3d* p = net.exactAnchor(id)) {
+    e.kind = End::Kind::ExactAnchor;
+    e.p_inG = *p;
+    return e;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+RangeModel::Status RangeModel::classify(const RangeMeasurement& z, const NominalState& x, const UwbNetwork& net) {
+  auto kindOf = [&](SensorId id) -> std::optional<End::Kind> {
+    if (net.isTag(id)) return End::Kind::Tag;
+    if (x.anchor_p_AinG.count(id)) return End::Kind::StateAnchor;
+    if (net.exactAnchor(id)) return End::Kind::ExactAnchor;
+    return std::nullopt;
+  };
+  const auto a = kindOf(z.a), b = kindOf(z.b);
+  if (!a || !b) return Status::UnknownId;
+  if (*a == End::Kind::Tag && *b == End::Kind::Tag) return Status::TagTag;
+  if (*a == End::Kind::ExactAnchor && *b == End::Kind::ExactAnchor) return Status::NoState;
+  return Status::Ok;
+}
+
+std::optional<std::pair<double, double>> RangeModel::predict(const RangeMeasurement& z, const NominalState& x,
+                                                             const UwbNetwork& net) {
+  const auto a = resolve(z.a, x, net), b = resolve(z.b, x, net);
+  if (!a || !b) return std::nullopt;
+  const PairBias pb = net.pairBias(z.a, z.b);
+  const double d = (b->p_inG - a->p_inG).norm();
+  return std::make_pair(pb.beta * d + pb.gamma_m, d);
+}
+
+RangeModel::Status RangeModel::linearize(const RangeMeasurement& z, const NominalState& x, const UwbNetwork& net,
+                                         Linearization* out) {
+  auto a = resolve(z.a, x, net), b = resolve(z.b, x, net);
+  if (!a || !b) return Status::UnknownId;
+  if (a->kind == End::Kind::Tag && b->kind == End::Kind::Tag) return Status::TagTag;
+  if (a->kind == End::Kind::ExactAnchor && b->kind == End::Kind::ExactAnchor) return Status::NoState;
+  // Order the ends so that a tag, if any, is the near end.
+  if (b->kind == End::Kind::Tag) std::swap(a, b);
+  const Eigen::Vector3d delta = b->p_inG - a->p_inG;
+  const double d = delta.norm();
+  if (d < 1e-6) return Status::Degenerate;
+  const Eigen::RowVector3d u = (delta / d).transpose();
+  const PairBias pb = net.pairBias(z.a, z.b);
+  const double sigma = net.rangeSigma(z.a, z.b, z.R_m2);
+
+  Linearization& lin = *out;
+  lin.blocks.clear();
+  lin.residual = Eigen::VectorXd::Constant(1, z.z_m - (pb.beta * d + pb.gamma_m));
+  lin.R = Eigen::MatrixXd::Constant(
+      1, 1, sigma * sigma + pb.sigma_gamma_m * pb.sigma_gamma_m + d * d * pb.sigma_beta * pb.sigma_beta);
+  if (a->kind == End::Kind::Tag) {
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, ImuErr::kDim);
+    H.block<1, 3>(0, ImuErr::kP) = -pb.beta * u;
+    H.block<1, 3>(0, ImuErr::kTheta) = pb.beta * u * x.imu.q_ItoG.toRotationMatrix() * so3::skew(*a->p_TinI);
+    lin.blocks.push_back({x.imu_id, std::move(H)});
+  } else if (a->kind == End::Kind::StateAnchor) {
+    lin.blocks.push_back({a->id, Eigen::MatrixXd(-pb.beta * u)});
+  }
+  if (b->kind == End::Kind::StateAnchor) lin.blocks.push_back({b->id, Eigen::MatrixXd(pb.beta * u)});
+  return Status::Ok;
+}
+
+const char* RangeModel::statusName(Status s) {
+  switch (s) {
+    case Status::Ok: return "ok";
+    case Status::UnknownId: return "unknown_id";
+    case Status::NoState: return "range_no_state";
+    case Status::TagTag: return "range_tag_tag";
+    case Status::Degenerate: return "range_degenerate";
+  }
+  return "?";
+}
+
+}  // namespace meshnav::estimator

@@ -1,0 +1,40 @@
+#pragma once
+/// @file range_model.h
+/// @brief Range model (paper eq. UWB-meas-range): z = β_ab d_ab + γ_ab + ν, with
+///   tag T on the IMU: p_TinG = p_IinG + R_ItoG p_TinI,  d = ‖p_A − p_TinG‖,
+///   anchor–anchor:    d = ‖p_Ab − p_Aa‖.
+/// Jacobians with u = (p_far − p_near)/d (unit vector from the tag / first anchor):
+///   ∂z/∂δp_IinG = −β uᵀ,  ∂z/∂δθ = β uᵀ R̂ [p_TinI]×,  ∂z/∂δp_A = β uᵀ (estimated anchor),
+///   anchor–anchor: ∂z/∂δp_Aa = −β uᵀ, ∂z/∂δp_Ab = β uᵀ.
+/// Noise variance R = σ² + σ_γ² + (d σ_β)² (pair uncertainties inflate the noise).
+
+#include <Eigen/Core>
+
+#include "estimator/core/linearization.h"
+#include "estimator/core/nominal_state.h"
+#include "estimator/uwb/range_measurement.h"
+#include "estimator/uwb/uwb_network.h"
+
+namespace meshnav::estimator {
+
+class RangeModel {
+ public:
+  enum class Status {
+    Ok,
+    UnknownId,    ///< an end is neither a tag nor a known/estimated anchor
+    NoState,      ///< both ends exactly known anchors: nothing to estimate
+    TagTag,       ///< both ends on the vehicle: constant distance, no information
+    Degenerate,   ///< predicted distance ~0
+  };
+  /// Predicted range β d + γ and the distance d, when both ends are known.
+  static std::optional<std::pair<double, double>> predict(const RangeMeasurement& z, const NominalState& x,
+                                                          const UwbNetwork& net);
+  /// Whether the range can be fused (cheap: no distance computed; Degenerate is not detected).
+  static Status classify(const RangeMeasurement& z, const NominalState& x, const UwbNetwork& net);
+  /// Linearizes into `out` (blocks per instance with state) when Status::Ok.
+  static Status linearize(const RangeMeasurement& z, const NominalState& x, const UwbNetwork& net,
+                          Linearization* out);
+  static const char* statusName(Status s);
+};
+
+}  // namespace meshnav::estimator

@@ -1,0 +1,28 @@
+#pragma once
+/// @file node_test_helpers.h
+/// @brief Running an EstimatorNode over synthetic data and comparing filter states.
+
+#include <gtest/gtest.h>
+
+#include "estimator/node/estimator_node.h"
+#include "estimator/testing/synthetic_scenario.h"
+
+namespace meshnav::estimator::test {
+
+/// Max absolute difference of the nominal states and covariances of two filters.
+inline double stateDifference(const FusionStrategy& a, const FusionStrategy& b) {
+  const NominalState &x = a.state(), &y = b.state();
+  if (x.t != y.t || a.layout().dim() != b.layout().dim()) return 1e300;
+  double d = x.imu.boxminus(y.imu).cwiseAbs().maxCoeff();
+  for (const auto& [id, v] : x.baro_bias_m) d = std::max(d, std::abs(v - y.baro_bias_m.at(id)));
+  for (const auto& [id, p] : x.anchor_p_AinG) d = std::max(d, (p - y.anchor_p_AinG.at(id)).cwiseAbs().maxCoeff());
+  return std::max(d, (a.fullCovariance() - b.fullCovariance()).cwiseAbs().maxCoeff());
+}
+
+inline EstimatorOptions testOptions() {
+  EstimatorOptions o;
+  o.window_s = 1.0;
+  return o;
+}
+
+}  // namespace meshnav::estimator::test

@@ -1,0 +1,231 @@
+/// EstimatorNode: initialization, estimation on synthetic data, bad input, outputs, run-time instances.
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+#include "node_test_helpers.h"
+
+using namespace meshnav;
+using namespace meshnav::estimator;
+
+namespace {
+
+double orientationErrorDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
+  return so3::logMap(a.conjugate() * b).norm() * 180.0 / M_PI;
+}
+
+}  // namespace
+
+TEST(EstimatorNode, NoPropagationOrOutputBeforeInitialization) {
+  synthetic::SyntheticOptions o;
+  o.duration_s = 5.0;
+  const Dataset ds = synthetic::makeSyntheticDataset(o);
+  int poses = 0;
+  EstimatorSinks sinks;
+  sinks.pose = [&](const PoseEstimate&) { ++poses; };
+  EstimatorNode node(test::testOptions(), ds.setup, sinks);
+  for (const auto& s : ds.imu) {
+    if (s.t.sec() >= 0.5) break;  // less than init.duration_s of landed data
+    node.onImu(s);
+  }
+  EXPECT_FALSE(node.initialized());
+  EXPECT_FALSE(node.pose().has_value());
+  EXPECT_EQ(poses, 0);
+}
+
+TEST(EstimatorNode, NoiseFreeRunTracksTruth) {
+  synthetic::SyntheticOptions o;
+  o.duration_s = 20.0;
+  const Dataset ds = synthetic::makeSyntheticDataset(o);
+  std::vector<PoseEstimate> poses;
+  EstimatorSinks sinks;
+  sinks.pose = [&](const PoseEstimate& e) { poses.push_back(e); };
+  EstimatorNode node(test::testOptions(), ds.setup, sinks);
+  for (const auto& in : mergeInTimeOrder(ds)) node.onInput(in);
+  ASSERT_TRUE(node.initialized());
+  ASSERT_GT(poses.size(), 3000u);
+  // Compare at the ground-truth samples (same rate as the IMU).
+  double max_p = 0.0, max_q = 0.0;
+  size_t j = 0;
+  for (const auto& e : poses) {
+    while (j < ds.ground_truth.size() && ds.ground_truth[j].t < e.t) ++j;
+    ASSERT_LT(j, ds.ground_truth.size());
+    ASSERT_EQ(ds.ground_truth[j].t, e.t);
+    max_p = std::max(max_p, (e.p_IinG - ds.ground_truth[j].p_IinG).norm());
+    max_q = std::max(max_q, orientationErrorDeg(e.q_ItoG, ds.ground_truth[j].q_ItoG));
+  }
+  EXPECT_LT(max_p, 0.05);
+  EXPECT_LT(max_q, 1.0);
+  EXPECT_EQ(node.diagnostics().get("gated_range"), 0);
+}
+
+TEST(EstimatorNode, NoisyRunIsAccurateAndCovarianceStaysSymmetricPositiveDefinite) {
+  synthetic::SyntheticOptions o;
+  o.duration_s = 30.0;
+  o.noise = true;
+  o.n_estimated_anchors = 3;
+  o.bias_acc_m_s2 = Eigen::Vector3d(0.05, -0.03, 0.04);
+  o.bias_gyro_rad_s = Eigen::Vector3d(0.003, -0.002, 0.001);
+  const Dataset ds = synthetic::makeSyntheticDataset(o);
+  EstimatorNode node(test::testOptions(), ds.setup);
+  const auto inputs = mergeInTimeOrder(ds);
+  double sq = 0.0;
+  int n = 0;
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    node.onInput(inputs[i]);
+    if (!node.initialized() || i % 25 != 0) continue;
+    const Eigen::MatrixXd P = node.filter()->fullCovariance();
+    ASSERT_EQ(P, P.transpose()) << "at input " << i;
+    ASSERT_EQ(Eigen::LLT<Eigen::MatrixXd>(P).info(), Eigen::Success) << "at input " << i;
+    const auto t = node.filter()->state().t;
+    const auto& gt = ds.ground_truth[static_cast<size_t>(std::llround(t.sec() * o.imu_rate_hz))];
+    if (gt.t == t) {
+      sq += (node.filter()->state().imu.p_IinG - gt.p_IinG).squaredNorm();
+      ++n;
+    }
+  }
+  ASSERT_GT(n, 100);
+  EXPECT_LT(std::sqrt(sq / n), 0.15);
+  EXPECT_LT((node.filter()->state().imu.bias_gyro_rad_s - o.bias_gyro_rad_s).norm(), 0.001);
+}
+
+TEST(EstimatorNode, InitializesFromRangesWithoutInitialPose) {
+  synthetic::SyntheticOptions o;
+  o.duration_s = 6.0;
+  o.with_initial_pose = false;
+  o.noise = true;
+  o.pair_rate_hz = 4.0;
+  const Dataset ds = synthetic::makeSyntheticDataset(o);
+  EstimatorNode node(test::testOptions(), ds.setup);
+  for (const auto& in : mergeInTimeOrder(ds)) {
+    node.onInput(in);
+    if (node.initialized()) break;
+  }
+  ASSERT_TRUE(node.initialized());
+  const auto t = node.filter()->state().t;
+  EXPECT_LE(t.sec(), o.landed_s);
+  const PoseSample& gt = ds.ground_truth[static_cast<size_t>(std::llround(t.sec() * o.imu_rate_hz))];
+  EXPECT_LT((node.pose()->p_IinG - gt.p_IinG).norm(), 0.3);
+  // Yaw is uncertain (large σ) but roll/pitch come from the accelerometer.
+  EXPECT_GT(node.pose()->cov_theta_rad2.trace(), std::pow(20.0 * M_PI / 180.0, 2));
+}
+
+TEST(EstimatorNode, BadInputIsCountedAndDoesNotChangeTheEstimate) {
+  synthetic::SyntheticOptions o;
+  o.duration_s = 8.0;
+  o.noise = true;
+  const Dataset ds = synthetic::makeSyntheticDataset(o);
+  const auto inputs = mergeInTimeOrder(ds);
+  EstimatorNode clean(test::testOptions(), ds.setup), dirty(test::testOptions(), ds.setup);
+  int n_bad = 0;
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    clean.onInput(inputs[i]);
+    dirty.onInput(inputs[i]);
+    if (i % 97 != 0 || !dirty.initialized()) continue;
+    const Timestamp t = inputTime(inputs[i]);
+    RangeSample nan_range{t, 100, 101, UwbType::Tag, UwbType::Anchor, std::nan(""), 0.0, 0.0, true};
+    dirty.onRange(nan_range);
+    RangeSample unknown{t, 100, 999, UwbType::Tag, UwbType::Anchor, 3.0, 3.0, 0.01, true};
+    dirty.onRange(unknown);
+    RangeSample absurd{t, 100, 101, UwbType::Tag, UwbType::Anchor, -7.0, -7.0, 0.01, true};
+    dirty.onRange(absurd);
+    ImuSample nan_imu{t, Eigen::Vector3d(std::nan(""), 0, 9.8), Eigen::Vector3d::Zero()};
+    dirty.onImu(nan_imu);
+    dirty.onBaro({t, -5.0});
+    ++n_bad;
+  }
+  ASSERT_GT(n_bad, 10);
+  EXPECT_EQ(dirty.diagnostics().get("bad_input"), 4 * n_bad);
+  EXPECT_EQ(dirty.diagnostics().get("unknown_id"), n_bad);
+  EXPECT_EQ(test::stateDifference(*clean.filter(), *dirty.filter()), 0.0);
+}
+
+TEST(EstimatorNode, OutputsAtTheirRates) {
+  synthetic::SyntheticOptions o;
+  o.duration_s = 10.0;
+  const Dataset ds = synthetic::makeSyntheticDataset(o);
+  EstimatorOptions opt = test::testOptions();
+  opt.pose_output_rate_hz = 50.0;
+  int poses = 0, anchor_msgs = 0, status_msgs = 0;
+  EstimatorStatus last_status;
+  EstimatorSinks sinks;
+  sinks.pose = [&](const PoseEstimate&) { ++poses; };
+  sinks.anchors = [&](const std::vector<AnchorEstimate>& a) {
+    ++anchor_msgs;
+    EXPECT_EQ(a.size(), 4u);
+  };
+  sinks.status = [&](const EstimatorStatus& s) {
+    ++status_msgs;
+    last_status = s;
+  };
+  EstimatorNode node(opt, ds.setup, sinks);
+  for (const auto& in : mergeInTimeOrder(ds)) node.onInput(in);
+  const double run_s = 10.0 - node.options().init.duration_s;
+  EXPECT_NEAR(poses, 50.0 * run_s, 3.0);
+  EXPECT_NEAR(anchor_msgs, run_s, 1.5);
+  EXPECT_NEAR(status_msgs, 10.0, 1.5);  // also before initialization (heartbeat)
+  EXPECT_TRUE(last_status.initialized);
+  EXPECT_EQ(last_status.strategy, "centralized");
+  EXPECT_GT(last_status.mean_step_us.count("propagate"), 0u);
+  EXPECT_GT(last_status.mean_step_us.count("range_update"), 0u);
+  EXPECT_GT(last_status.mean_step_us.count("zupt"), 0u);
+  bool has_tag = false, has_imu = false;
+  for (const auto& i : last_status.instances) {
+    has_tag |= i.type == "tag" && i.n_updates > 0;
+    has_imu |= i.type == "imu";
+  }
+  EXPECT_TRUE(has_tag);
+  EXPECT_TRUE(has_imu);
+}
+
+TEST(EstimatorNode, AnchorInitAddsAnEstimatedAnchorThatIsRefined) {
+  synthetic::SyntheticOptions o;
+  o.duration_s = 20.0;
+  o.noise = true;
+  o.n_estimated_anchors = 1;  // anchor 106 is in the data …
+  Dataset ds = synthetic::makeSyntheticDataset(o);
+  const Eigen::Vector3d p_true = ds.setup.abs_anchor_positions.at(106);
+  ds.setup.abs_anchor_positions.erase(106);  // … but unknown to the estimator
+  ds.setup.abs_anchor_sigmas_m.erase(106);
+  EstimatorNode node(test::testOptions(), ds.setup);
+  const auto inputs = mergeInTimeOrder(ds);
+  bool sent = false;
+  for (const auto& in : inputs) {
+    if (!sent && inputTime(in).sec() >= 6.0) {
+      EXPECT_GT(node.diagnostics().get("unknown_id"), 0);
+      AnchorInit init;
+      init.t = inputTime(in);
+      init.id = 106;
+      init.p_AinG = p_true + Eigen::Vector3d(0.25, -0.2, 0.15);
+      init.cov_p_m2 = Eigen::Matrix3d::Identity() * 0.3 * 0.3;
+      node.onAnchorInit(init);
+      sent = true;
+    }
+    node.onInput(in);
+  }
+  const auto anchors = node.anchors();
+  auto it = std::find_if(anchors.begin(), anchors.end(), [](const auto& a) { return a.id == 106; });
+  ASSERT_NE(it, anchors.end());
+  EXPECT_LT((it->p_AinG - p_true).norm(), 0.15);
+  EXPECT_LT(it->cov_p_m2.trace(), 3 * 0.3 * 0.3);
+  EXPECT_EQ(node.diagnostics().get("anchor_init"), 1);
+
+  // Removing it at run time: its ranges become unknown again.
+  const int64_t unknown_before = node.diagnostics().get("unknown_id");
+  EstimatorCommand rm;
+  rm.t = node.filter()->state().t;
+  rm.action = EstimatorCommand::Action::RemoveInstance;
+  rm.id = 106;
+  node.onCommand(rm);
+  EXPECT_EQ(node.filter()->state().anchor_p_AinG.count(106), 0u);
+  RangeSample r{node.filter()->state().t + Duration::fromMs(1), 100, 106, UwbType::Tag, UwbType::Anchor, 4.0, 4.0, 0.01, true};
+  node.onRange(r);
+  EXPECT_EQ(node.diagnostics().get("unknown_id"), unknown_before + 1);
+}
+
+TEST(EstimatorNode, UnimplementedStrategyIsRefused) {
+  EstimatorOptions o;
+  o.strategy = "dah";
+  EXPECT_THROW(EstimatorNode(o, synthetic::syntheticSetup({})), std::invalid_argument);
+}
