@@ -7,11 +7,12 @@
 namespace meshnav::estimator {
 
 /// Type of a sensor instance. Only instances with an error state appear in the filter's layout:
-/// the IMU (15), a barometer (its bias, 1) and estimated anchors (position, 3). Tags and exactly
-/// known anchors are instances without state.
+/// the IMU (15), a barometer (its bias, 1), estimated anchors (position, 3) and tags whose constant
+/// biases γ towards exactly known anchors are estimated (one state per such pair; the dimension is
+/// given when the block is added). Exactly known anchors are instances without state.
 enum class InstanceKind { Imu, Baro, Tag, Anchor };
 
-/// Error-state dimension of an instance kind with state (Tag: 0).
+/// Default error-state dimension of an instance kind (Tag: variable, given at insertion).
 constexpr int errorDim(InstanceKind k) {
   switch (k) {
     case InstanceKind::Imu: return 15;

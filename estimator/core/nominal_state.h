@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <map>
+#include <vector>
 
 #include "common/time.h"
 #include "common/types.h"
@@ -12,12 +13,26 @@
 
 namespace meshnav::estimator {
 
+/// Estimated constant range biases γ of one tag towards exactly known anchors (z = βd + γ + ν):
+/// state i is γ(tag, peers[i]) [m].
+struct TagBiasState {
+  std::vector<SensorId> peers;
+  Eigen::VectorXd gamma_m;
+  /// Index of `peer` in the state, or −1.
+  int index(SensorId peer) const {
+    for (size_t i = 0; i < peers.size(); ++i)
+      if (peers[i] == peer) return static_cast<int>(i);
+    return -1;
+  }
+};
+
 struct NominalState {
   Timestamp t;                                       ///< time the state is valid at
   SensorId imu_id = 1;
   ImuState imu;
   std::map<SensorId, double> baro_bias_m;            ///< barometer height bias b_P [m]
   std::map<SensorId, Eigen::Vector3d> anchor_p_AinG; ///< estimated anchors' positions [m]
+  std::map<SensorId, TagBiasState> tag_biases;        ///< estimated tag–anchor biases γ [m]
 
   /// Applies a stacked error-state correction laid out as `layout`.
   void boxplus(const StateLayout& layout, const Eigen::VectorXd& dx) {
@@ -26,7 +41,7 @@ struct NominalState {
         case InstanceKind::Imu: imu.boxplus(dx.segment<ImuErr::kDim>(b.offset)); break;
         case InstanceKind::Baro: baro_bias_m.at(b.id) += dx(b.offset); break;
         case InstanceKind::Anchor: anchor_p_AinG.at(b.id) += dx.segment<3>(b.offset); break;
-        case InstanceKind::Tag: break;
+        case InstanceKind::Tag: tag_biases.at(b.id).gamma_m += dx.segment(b.offset, b.dim); break;
       }
     }
   }

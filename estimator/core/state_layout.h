@@ -24,11 +24,13 @@ struct StateBlock {
 /// Ordered list of state blocks. Adding appends; removing closes the gap.
 class StateLayout {
  public:
-  /// Appends a block for `id` (throws if `id` already has a block).
-  const StateBlock& add(SensorId id, InstanceKind kind) {
+  /// Appends a block for `id` of dimension `dim` (negative: the kind's default; throws if `id`
+  /// already has a block).
+  const StateBlock& add(SensorId id, InstanceKind kind, int dim = -1) {
     if (find(id)) throw std::logic_error("StateLayout: instance " + std::to_string(id) + " already has a block");
-    blocks_.push_back({id, kind, dim_, errorDim(kind)});
-    dim_ += errorDim(kind);
+    const int d = dim < 0 ? errorDim(kind) : dim;
+    blocks_.push_back({id, kind, dim_, d});
+    dim_ += d;
     return blocks_.back();
   }
   /// Removes the block of `id` and shifts the following ones; returns the removed block.

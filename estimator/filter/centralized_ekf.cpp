@@ -21,7 +21,7 @@ void CentralizedEkf::reset(SensorId imu_id, const ImuState& x, const ImuMatrix& 
 
 void CentralizedEkf::appendBlock(SensorId id, InstanceKind kind, const Eigen::MatrixXd& cov) {
   const int n = layout_.dim();
-  const StateBlock& b = layout_.add(id, kind);
+  const StateBlock& b = layout_.add(id, kind, static_cast<int>(cov.rows()));
   Eigen::MatrixXd P = Eigen::MatrixXd::Zero(layout_.dim(), layout_.dim());
   P.topLeftCorner(n, n) = P_;
   P.block(b.offset, b.offset, b.dim, b.dim) = 0.5 * (cov + cov.transpose());
@@ -40,6 +40,13 @@ void CentralizedEkf::addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const
   appendBlock(id, InstanceKind::Anchor, cov);
 }
 
+void CentralizedEkf::addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
+                                  const Eigen::VectorXd& var_m2) {
+  if (layout_.find(tag_id)) removeInstance(tag_id);
+  x_.tag_biases[tag_id] = TagBiasState{peers, gamma_m};
+  appendBlock(tag_id, InstanceKind::Tag, var_m2.asDiagonal().toDenseMatrix());
+}
+
 bool CentralizedEkf::removeInstance(SensorId id) {
   const StateBlock* blk = layout_.find(id);
   if (!blk || blk->kind == InstanceKind::Imu) return false;
@@ -53,6 +60,7 @@ bool CentralizedEkf::removeInstance(SensorId id) {
   layout_.remove(id);
   x_.baro_bias_m.erase(id);
   x_.anchor_p_AinG.erase(id);
+  x_.tag_biases.erase(id);
   return true;
 }
 

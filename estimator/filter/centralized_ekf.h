@@ -23,6 +23,8 @@ class CentralizedEkf final : public FusionStrategy {
   void reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) override;
   void addBaro(SensorId id, double bias_m, double var_m2) override;
   void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) override;
+  void addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
+                    const Eigen::VectorXd& var_m2) override;
   bool removeInstance(SensorId id) override;
 
   void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) override;
@@ -35,7 +37,7 @@ class CentralizedEkf final : public FusionStrategy {
 
  private:
   /// Appends a block with covariance `cov`, uncorrelated with the others.
-  void appendBlock(SensorId id, InstanceKind kind, const Eigen::MatrixXd& cov);
+  void appendBlock(SensorId id, InstanceKind kind, const Eigen::MatrixXd& cov);  // dim = cov.rows()
   void checkInvariants(const char* where) const;
 
   ImuPropagator propagator_;

@@ -33,6 +33,10 @@ class FusionStrategy {
   virtual void addBaro(SensorId id, double bias_m, double var_m2) = 0;
   /// Adds an anchor position instance (uncorrelated with the rest). Replaces it if present.
   virtual void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) = 0;
+  /// Adds a tag instance whose constant biases γ(tag, peer) towards exactly known anchors are
+  /// estimated (prior mean `gamma_m`, variances `var_m2`, uncorrelated). Replaces it if present.
+  virtual void addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
+                            const Eigen::VectorXd& var_m2) = 0;
   /// Removes an instance with state (not the IMU). False if absent.
   virtual bool removeInstance(SensorId id) = 0;
 

@@ -193,6 +193,24 @@ void EstimatorNode::initialize(const InitialBelief& b) {
     if (sig != setup_.abs_anchor_sigmas_m.end())
       filter->addAnchor(id, p, Eigen::Matrix3d::Identity() * sig->second * sig->second);
   }
+  if (options_.uwb.estimate_tag_biases) {
+    // Tag instances with state: γ towards exactly known anchors whose a-priori bias is uncertain.
+    for (const auto& [tag, lever] : setup_.rel_tag_positions) {
+      std::vector<SensorId> peers;
+      std::vector<double> gamma, var;
+      for (const auto& [anchor, p] : setup_.abs_anchor_positions) {
+        if (setup_.abs_anchor_sigmas_m.count(anchor)) continue;
+        const auto pb = setup_.findPairBias(tag, anchor);
+        if (!pb || pb->sigma_gamma_m <= 0.0) continue;
+        peers.push_back(anchor);
+        gamma.push_back(pb->gamma_m);
+        var.push_back(pb->sigma_gamma_m * pb->sigma_gamma_m);
+      }
+      if (!peers.empty())
+        filter->addTagBiases(tag, peers, Eigen::Map<Eigen::VectorXd>(gamma.data(), static_cast<long>(gamma.size())),
+                             Eigen::Map<Eigen::VectorXd>(var.data(), static_cast<long>(var.size())));
+    }
+  }
   cur_.filter = std::move(filter);
   cur_.last_imu = b.last_imu;
   cur_.landed = b.landed;

@@ -33,6 +33,23 @@ std::optional<End> resolve(SensorId id, const NominalState& x, const UwbNetwork&
   return std::nullopt;
 }
 
+/// The estimated γ of the pair (a, b) when one end is a tag with a bias state towards the other:
+/// (tag id, index in the tag's state).
+std::optional<std::pair<SensorId, int>> gammaState(SensorId a, SensorId b, const NominalState& x) {
+  for (auto [tag, peer] : {std::make_pair(a, b), std::make_pair(b, a)}) {
+    auto it = x.tag_biases.find(tag);
+    if (it == x.tag_biases.end()) continue;
+    const int i = it->second.index(peer);
+    if (i >= 0) return std::make_pair(tag, i);
+  }
+  return std::nullopt;
+}
+
+/// γ of the pair: the estimated one if it is a state, else the dictionary's.
+double pairGamma(const PairBias& pb, const std::optional<std::pair<SensorId, int>>& gs, const NominalState& x) {
+  return gs ? x.tag_biases.at(gs->first).gamma_m(gs->second) : pb.gamma_m;
+}
+
 }  // namespace
 
 RangeModel::Status RangeModel::classify(const RangeMeasurement& z, const NominalState& x, const UwbNetwork& net) {
@@ -55,7 +72,7 @@ std::optional<std::pair<double, double>> RangeModel::predict(const RangeMeasurem
   if (!a || !b) return std::nullopt;
   const PairBias pb = net.pairBias(z.a, z.b);
   const double d = (b->p_inG - a->p_inG).norm();
-  return std::make_pair(pb.beta * d + pb.gamma_m, d);
+  return std::make_pair(pb.beta * d + pairGamma(pb, gammaState(z.a, z.b, x), x), d);
 }
 
 RangeModel::Status RangeModel::linearize(const RangeMeasurement& z, const NominalState& x, const UwbNetwork& net,
@@ -72,12 +89,14 @@ RangeModel::Status RangeModel::linearize(const RangeMeasurement& z, const Nomina
   const Eigen::RowVector3d u = (delta / d).transpose();
   const PairBias pb = net.pairBias(z.a, z.b);
   const double sigma = net.rangeSigma(z.a, z.b, z.R_m2);
+  const auto gs = gammaState(z.a, z.b, x);
+  // An estimated γ carries its uncertainty in the state; a dictionary γ inflates the noise.
+  const double var_gamma = gs ? 0.0 : pb.sigma_gamma_m * pb.sigma_gamma_m;
 
   Linearization& lin = *out;
   lin.blocks.clear();
-  lin.residual = Eigen::VectorXd::Constant(1, z.z_m - (pb.beta * d + pb.gamma_m));
-  lin.R = Eigen::MatrixXd::Constant(
-      1, 1, sigma * sigma + pb.sigma_gamma_m * pb.sigma_gamma_m + d * d * pb.sigma_beta * pb.sigma_beta);
+  lin.residual = Eigen::VectorXd::Constant(1, z.z_m - (pb.beta * d + pairGamma(pb, gs, x)));
+  lin.R = Eigen::MatrixXd::Constant(1, 1, sigma * sigma + var_gamma + d * d * pb.sigma_beta * pb.sigma_beta);
   if (a->kind == End::Kind::Tag) {
     Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, ImuErr::kDim);
     H.block<1, 3>(0, ImuErr::kP) = -pb.beta * u;
@@ -87,6 +106,11 @@ RangeModel::Status RangeModel::linearize(const RangeMeasurement& z, const Nomina
     lin.blocks.push_back({a->id, Eigen::MatrixXd(-pb.beta * u)});
   }
   if (b->kind == End::Kind::StateAnchor) lin.blocks.push_back({b->id, Eigen::MatrixXd(pb.beta * u)});
+  if (gs) {  // ∂z/∂δγ = 1
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, x.tag_biases.at(gs->first).gamma_m.size());
+    H(0, gs->second) = 1.0;
+    lin.blocks.push_back({gs->first, std::move(H)});
+  }
   return Status::Ok;
 }
 

@@ -6,7 +6,8 @@
 /// Jacobians with u = (p_far − p_near)/d (unit vector from the tag / first anchor):
 ///   ∂z/∂δp_IinG = −β uᵀ,  ∂z/∂δθ = β uᵀ R̂ [p_TinI]×,  ∂z/∂δp_A = β uᵀ (estimated anchor),
 ///   anchor–anchor: ∂z/∂δp_Aa = −β uᵀ, ∂z/∂δp_Ab = β uᵀ.
-/// Noise variance R = σ² + σ_γ² + (d σ_β)² (pair uncertainties inflate the noise).
+/// Noise variance R = σ² + σ_γ² + (d σ_β)² (pair uncertainties inflate the noise), except when γ
+/// of a tag–anchor pair is a state of the tag instance: then ∂z/∂δγ = 1 and σ_γ is not added.
 
 #include <Eigen/Core>
 
