@@ -1,0 +1,515 @@
+#include "calibrator/node/calibrator_node.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "calibrator/calibration_problem.h"
+#include "calibrator/reference_geometry.h"
+#include "common/pose_interpolation.h"
+
+namespace meshnav::calib {
+
+namespace {
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+/// Range sanity limits [m] (as the dataset reader's RangeLimits).
+constexpr double kMinRangeM = -0.5;
+constexpr double kMaxRangeM = 500.0;
+
+/// Extra slack before the pose history is trimmed, so that trimming is amortised [s].
+constexpr double kPruneSlackS = 10.0;
+
+std::string describe(const RangeSample& r) {
+  return "range at t=" + formatSeconds(r.t) + " between " + std::to_string(r.id_initiator) + " and " +
+         std::to_string(r.id_responder);
+}
+
+int64_t wallUtime() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+const char* CalibratorNode::toString(State s) {
+  switch (s) {
+    case State::Idle: return "idle";
+    case State::Collecting: return "collecting";
+    case State::Calibrated: return "calibrated";
+    case State::Refused: return "refused";
+  }
+  return "?";
+}
+
+CalibratorNode::CalibratorNode(const CalibratorOptions& options, const SystemSetup& setup, CalibratorSinks sinks,
+                               const CalibratorNodeOptions& node_options)
+    : node_options_(node_options),
+      setup_(setup),
+      sinks_(std::move(sinks)),
+      calibrator_(options),
+      prior_source_(setup, options),
+      collect_new_anchors_(node_options.collect_from_start) {
+  node_options_.validate();
+  if (!(options.sigma_range_m > 0.0)) throw std::invalid_argument("calibrator option sigma_range must be > 0");
+}
+
+// --------------------------------------------------------------------------------------------
+// Inputs
+// --------------------------------------------------------------------------------------------
+
+bool CalibratorNode::isUnknownAnchor(SensorId id, UwbType type) const {
+  return id > 0 && !setup_.isTag(id) && !setup_.isKnownAnchor(id) && id != setup_.imu_id && id != setup_.baro_id &&
+         type == UwbType::Anchor;
+}
+
+bool CalibratorNode::isReference(SensorId id) const {
+  if (setup_.isTag(id) || setup_.isKnownAnchor(id)) return true;
+  const auto it = tracks_.find(id);
+  return it != tracks_.end() && it->second.state == State::Calibrated;
+}
+
+CalibratorNode::Track& CalibratorNode::track(SensorId x) {
+  auto it = tracks_.find(x);
+  if (it == tracks_.end()) {
+    it = tracks_.emplace(x, Track{}).first;
+    it->second.state = collect_new_anchors_ ? State::Collecting : State::Idle;
+    if (newest_) it->second.next_auto_check = *newest_;
+    spdlog::info("calibrator: new unknown anchor {} ({})", x, toString(it->second.state));
+  }
+  return it->second;
+}
+
+void CalibratorNode::onRange(const RangeSample& r) {
+  diag_.count("ranges_received");
+  if (!std::isfinite(r.range_m) || r.range_m < kMinRangeM || r.range_m > kMaxRangeM) {
+    diag_.report("bad_range", describe(r) + ": range " + std::to_string(r.range_m) + " m is not finite or absurd");
+    return;
+  }
+  if (r.id_initiator == r.id_responder || r.id_initiator <= 0 || r.id_responder <= 0) {
+    diag_.report("bad_range", describe(r) + ": invalid device ids");
+    return;
+  }
+  // Every end must be a device we can place now or later: a setup tag, a known anchor, or an
+  // anchor of unknown position. Anything else (a tag not in the setup, the IMU/baro id) is unknown.
+  for (const auto& [id, type] : {std::make_pair(r.id_initiator, r.type_initiator),
+                                 std::make_pair(r.id_responder, r.type_responder)}) {
+    if (!setup_.isTag(id) && !setup_.isKnownAnchor(id) && !isUnknownAnchor(id, type)) {
+      diag_.report("unknown_device", describe(r) + ": device " + std::to_string(id) + " (type '" +
+                                         static_cast<char>(type) + "') is neither a tag of the setup nor an anchor");
+      return;
+    }
+  }
+  advance(r.t);
+  bool kept = false, idle = false;
+  for (const auto& [x, type] : {std::make_pair(r.id_initiator, r.type_initiator),
+                                std::make_pair(r.id_responder, r.type_responder)}) {
+    if (!isUnknownAnchor(x, type)) continue;
+    Track& tr = track(x);
+    if (tr.state == State::Collecting || tr.state == State::Refused) {
+      addRange(x, tr, r);
+      kept = true;
+    } else if (tr.state == State::Idle) {
+      idle = true;
+    }
+  }
+  if (kept) {
+    diag_.count("ranges_kept");
+  } else {
+    diag_.count(idle ? "ranges_not_collecting" : "ranges_not_needed");
+  }
+  runPeriodic();
+}
+
+void CalibratorNode::addRange(SensorId x, Track& track, const RangeSample& r) {
+  track.ranges.push_back(r);
+  ++track.ranges_by_device[r.id_initiator == x ? r.id_responder : r.id_initiator];
+  if (static_cast<int64_t>(track.ranges.size()) > node_options_.max_ranges_per_anchor) {
+    const RangeSample& old = track.ranges.front();
+    auto it = track.ranges_by_device.find(old.id_initiator == x ? old.id_responder : old.id_initiator);
+    if (it != track.ranges_by_device.end() && --it->second <= 0) track.ranges_by_device.erase(it);
+    track.ranges.pop_front();
+    diag_.count("ranges_evicted");
+  }
+}
+
+void CalibratorNode::onPose(const PoseEstimate& p_in) {
+  PoseEstimate p = p_in;
+  const double qn = p.q_ItoG.norm();
+  if (!p.p_IinG.allFinite() || !p.q_ItoG.coeffs().allFinite() || !(qn > 0.5 && qn < 2.0) ||
+      !p.cov_p_m2.allFinite() || !p.cov_theta_rad2.allFinite()) {
+    diag_.report("bad_pose", "pose at t=" + formatSeconds(p.t) + " has a non-finite value or a bad quaternion");
+    return;
+  }
+  p.q_ItoG.normalize();
+  const Duration window = Duration::fromSec(node_options_.history_window_s);
+  if (!poses_.empty() && p.t < poses_.back().t - window) {
+    diag_.report("pose_too_old", "pose at t=" + formatSeconds(p.t) + " is older than the history window (newest " +
+                                     formatSeconds(poses_.back().t) + ")");
+    return;
+  }
+  if (poses_.empty() || p.t > poses_.back().t) {
+    poses_.push_back(p);
+  } else {
+    auto it = std::lower_bound(poses_.begin(), poses_.end(), p.t,
+                               [](const PoseEstimate& a, Timestamp t) { return a.t < t; });
+    if (it != poses_.end() && it->t == p.t) {
+      *it = p;  // same instant: the newer message wins
+    } else {
+      poses_.insert(it, p);
+      diag_.count("poses_out_of_order");
+    }
+  }
+  // Trim the history (amortised: only when the slack is exceeded).
+  const Timestamp cutoff = poses_.back().t - window;
+  if (poses_.front().t < cutoff - Duration::fromSec(kPruneSlackS)) {
+    auto it = std::lower_bound(poses_.begin(), poses_.end(), cutoff,
+                               [](const PoseEstimate& a, Timestamp t) { return a.t < t; });
+    poses_.erase(poses_.begin(), it);
+  }
+  advance(p.t);
+  runPeriodic();
+}
+
+void CalibratorNode::onAnchors(const std::vector<AnchorEstimate>& anchors) {
+  std::map<SensorId, AnchorEstimate> beliefs;
+  for (const auto& a : anchors) {
+    if (a.id <= 0 || !a.p_AinG.allFinite() || !a.cov_p_m2.allFinite()) {
+      diag_.report("bad_anchor_estimate", "anchor estimate of " + std::to_string(a.id) + " at t=" + formatSeconds(a.t) +
+                                              " is invalid (id or non-finite value)");
+      continue;
+    }
+    beliefs[a.id] = a;
+  }
+  beliefs_ = std::move(beliefs);  // the message holds every anchor the estimator knows
+}
+
+void CalibratorNode::onCommand(const CalibCommand& c) {
+  std::vector<SensorId> ids;
+  for (SensorId id : c.anchors) {
+    if (id <= 0 || setup_.isTag(id) || setup_.isKnownAnchor(id) || id == setup_.imu_id || id == setup_.baro_id) {
+      diag_.report("bad_command", "command names " + std::to_string(id) +
+                                      ", which is not an anchor of unknown position; ignored for it");
+      continue;
+    }
+    ids.push_back(id);
+  }
+  const bool all = c.anchors.empty();
+  if (!all && ids.empty()) return;
+  switch (c.action) {
+    case CalibCommand::Action::Collect:
+      if (all) {
+        collect_new_anchors_ = true;
+        for (auto& [x, tr] : tracks_)
+          if (tr.state == State::Idle) startCollecting(x, tr);
+      } else {
+        for (SensorId x : ids) startCollecting(x, track(x));
+      }
+      break;
+    case CalibCommand::Action::Calibrate: {
+      if (all)
+        for (const auto& [x, tr] : tracks_)
+          if (tr.state == State::Collecting || tr.state == State::Refused) ids.push_back(x);
+      for (SensorId x : ids) {
+        Track& tr = track(x);
+        if (tr.state == State::Calibrated) {
+          spdlog::info("calibrator: anchor {} is already calibrated; Calibrate ignored (Collect it to re-calibrate)", x);
+          diag_.count("calibrate_already_calibrated");
+        } else if (tr.state == State::Idle) {
+          tr.reason = "not collecting (aborted, or no Collect yet)";
+          diag_.report("calibrate_not_collecting", "Calibrate for anchor " + std::to_string(x) + ": " + tr.reason);
+        } else {
+          calibrateAnchor(x, tr, buildObservations(x, tr), false);
+        }
+      }
+      publishStatus();
+      break;
+    }
+    case CalibCommand::Action::Abort:
+      if (all) {
+        collect_new_anchors_ = false;
+        for (auto& [x, tr] : tracks_)
+          if (tr.state != State::Calibrated) stopCollecting(tr);
+      } else {
+        for (SensorId x : ids) {
+          Track& tr = track(x);
+          if (tr.state != State::Calibrated) stopCollecting(tr);
+        }
+      }
+      break;
+    default:
+      diag_.report("bad_command", "unknown command action " + std::to_string(static_cast<int>(c.action)));
+      break;
+  }
+}
+
+void CalibratorNode::tick(Timestamp now) {
+  if (newest_ && now <= *newest_) {
+    runPeriodic();
+    return;
+  }
+  advance(now);
+  runPeriodic();
+}
+
+// --------------------------------------------------------------------------------------------
+// Collection state
+// --------------------------------------------------------------------------------------------
+
+void CalibratorNode::startCollecting(SensorId x, Track& tr) {
+  if (tr.state == State::Calibrated)
+    spdlog::info("calibrator: anchor {} collects anew; its calibration is forgotten (no longer a reference)", x);
+  tr.state = State::Collecting;
+  tr.ranges.clear();
+  tr.ranges_by_device.clear();
+  tr.reason.clear();
+  tr.result.reset();
+  tr.next_auto_check = newest_.value_or(Timestamp{});
+}
+
+void CalibratorNode::stopCollecting(Track& tr) {
+  tr.state = State::Idle;
+  tr.ranges.clear();
+  tr.ranges_by_device.clear();
+  tr.reason.clear();
+}
+
+void CalibratorNode::advance(Timestamp t) {
+  if (!newest_ || t > *newest_) newest_ = t;
+}
+
+// --------------------------------------------------------------------------------------------
+// Observations
+// --------------------------------------------------------------------------------------------
+
+std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> CalibratorNode::tagPosition(SensorId tag,
+                                                                                      Timestamp t) const {
+  const auto lever = setup_.rel_tag_positions.find(tag);
+  if (lever == setup_.rel_tag_positions.end()) return std::nullopt;
+  const auto& opt = calibrator_.options();
+  const auto pose = interpolateEstimate(poses_, t, Duration::fromSec(opt.max_pose_gap_s));
+  if (!pose) return std::nullopt;
+  // p_TinG = p_IinG + R_ItoG p_TinI;  Σ_T = Σ_p + (R[p_TinI]ₓ) Σ_θ (R[p_TinI]ₓ)ᵀ (local orientation error).
+  const Eigen::Matrix3d R = pose->q_ItoG.toRotationMatrix();
+  const Eigen::Matrix3d J = R * skew(lever->second);
+  Eigen::Matrix3d cov = pose->cov_p_m2 + J * pose->cov_theta_rad2 * J.transpose();
+  cov += opt.min_tag_position_sigma_m * opt.min_tag_position_sigma_m * Eigen::Matrix3d::Identity();
+  return std::make_pair(Eigen::Vector3d(pose->p_IinG + R * lever->second), cov);
+}
+
+std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> CalibratorNode::anchorReference(SensorId id) const {
+  if (const auto k = setup_.abs_anchor_positions.find(id); k != setup_.abs_anchor_positions.end()) {
+    const auto sig = setup_.abs_anchor_sigmas_m.find(id);
+    const double s = sig == setup_.abs_anchor_sigmas_m.end() ? 0.0 : sig->second;
+    return std::make_pair(k->second, Eigen::Matrix3d(s * s * Eigen::Matrix3d::Identity()));
+  }
+  const auto it = tracks_.find(id);
+  if (it == tracks_.end() || it->second.state != State::Calibrated || !it->second.result) return std::nullopt;
+  if (const auto b = beliefs_.find(id); b != beliefs_.end()) return std::make_pair(b->second.p_AinG, b->second.cov_p_m2);
+  return std::make_pair(it->second.result->p_AinG, it->second.result->cov_p_m2);
+}
+
+CalibratorNode::Built CalibratorNode::buildObservations(SensorId x, Track& tr) {
+  Built b;
+  const auto& opt = calibrator_.options();
+  std::deque<RangeSample> kept;
+  for (const RangeSample& r : tr.ranges) {
+    const SensorId ref = r.id_initiator == x ? r.id_responder : r.id_initiator;
+    CalibObservation o;
+    o.t = r.t;
+    o.ref_id = ref;
+    o.z_m = r.range_m;
+    o.sigma_d_m = (opt.use_range_variance && r.R_m2 > 0) ? std::sqrt(r.R_m2) : opt.sigma_range_m;
+    if (setup_.isTag(ref)) {
+      if (const auto tp = tagPosition(ref, r.t)) {
+        o.p_RinG = tp->first;
+        o.cov_p_RinG_m2 = tp->second;
+        b.obs.push_back(o);
+      } else if (poses_.empty() || r.t > poses_.back().t) {
+        ++b.waiting_for_pose;  // the pose may still come
+      } else {
+        ++b.dropped_no_pose;   // a gap in (or before) the pose history: never usable
+        auto it = tr.ranges_by_device.find(ref);
+        if (it != tr.ranges_by_device.end() && --it->second <= 0) tr.ranges_by_device.erase(it);
+        continue;
+      }
+    } else if (const auto ar = anchorReference(ref)) {
+      o.p_RinG = ar->first;
+      o.cov_p_RinG_m2 = ar->second;
+      b.obs.push_back(o);
+    } else {
+      ++b.waiting_for_reference;  // the other anchor is not calibrated (yet)
+    }
+    kept.push_back(r);
+  }
+  tr.ranges.swap(kept);
+  if (b.dropped_no_pose > 0) diag_.count("ranges_dropped_no_pose", b.dropped_no_pose);
+  return b;
+}
+
+// --------------------------------------------------------------------------------------------
+// Calibration
+// --------------------------------------------------------------------------------------------
+
+void CalibratorNode::calibrateAnchor(SensorId x, Track& tr, Built built, bool automatic) {
+  last_waiting_for_pose_ = built.waiting_for_pose;
+  last_waiting_for_reference_ = built.waiting_for_reference;
+  const Timestamp stamp = newest_.value_or(Timestamp{});
+  CalibrationResult res = calibrator_.calibrate(x, built.obs, prior_source_.priors(x), stamp);
+  const char* how = automatic ? "automatic" : "commanded";
+  if (res.ok()) {
+    std::string refs;
+    for (const auto& r : res.references) refs += (refs.empty() ? "" : ",") + std::to_string(r.ref_id);
+    spdlog::info("calibrator: anchor {} calibrated ({}, t={} s): p_AinG [{:.3f} {:.3f} {:.3f}] m, sigma [{:.3f} "
+                 "{:.3f} {:.3f}] m, {} inliers, {} outliers, refs {}",
+                 x, how, formatSeconds(stamp), res.p_AinG.x(), res.p_AinG.y(), res.p_AinG.z(),
+                 std::sqrt(res.cov_p_m2(0, 0)), std::sqrt(res.cov_p_m2(1, 1)), std::sqrt(res.cov_p_m2(2, 2)),
+                 res.n_inliers, res.n_outliers, refs);
+    tr.state = State::Calibrated;
+    tr.reason.clear();
+    tr.ranges.clear();
+    tr.ranges_by_device.clear();
+    diag_.count("calibrations_ok");
+    res.inliers.clear();  // per-observation flags are not needed after the fact
+    tr.result = res;
+    keepResult(res);
+    if (sinks_.anchor_init) sinks_.anchor_init(res.toAnchorInit());
+  } else {
+    tr.state = State::Refused;
+    tr.reason = std::string(calib::toString(res.status)) + ": " + res.reason;
+    if (built.waiting_for_pose > 0 || built.waiting_for_reference > 0)
+      tr.reason += " (" + std::to_string(built.waiting_for_pose) + " ranges wait for a tag pose, " +
+                   std::to_string(built.waiting_for_reference) + " for a reference anchor)";
+    tr.next_auto_check = stamp + Duration::fromSec(node_options_.auto_retry_period_s);
+    spdlog::warn("calibrator: anchor {} refused ({}, t={} s): {}", x, how, formatSeconds(stamp), tr.reason);
+    diag_.count("calibrations_refused");
+    res.inliers.clear();
+    keepResult(std::move(res));
+  }
+}
+
+void CalibratorNode::keepResult(CalibrationResult res) {
+  results_.push_back(std::move(res));
+  if (results_.size() > kMaxResults) results_.erase(results_.begin());
+}
+
+void CalibratorNode::checkAuto(SensorId x, Track& tr) {
+  if (!newest_ || *newest_ < tr.next_auto_check) return;
+  tr.next_auto_check = *newest_ + Duration::fromSec(node_options_.auto_check_period_s);
+  Built built = buildObservations(x, tr);
+  const auto& opt = calibrator_.options();
+  // 1. enough usable ranges.
+  if (static_cast<int>(built.obs.size()) < node_options_.auto_min_ranges) return;
+  // 2. enough reference devices with enough ranges each.
+  std::map<SensorId, int> per_ref;
+  for (const auto& o : built.obs) ++per_ref[o.ref_id];
+  int n_refs = 0;
+  for (const auto& [id, n] : per_ref) n_refs += n >= opt.min_measurements_per_reference ? 1 : 0;
+  if (n_refs < node_options_.auto_min_references) return;
+  // 3. the library's refusal checks with the stricter spreads: the tags span a volume.
+  CalibratorOptions strict = opt;
+  strict.min_plane_spread_m = std::max(opt.min_plane_spread_m, node_options_.auto_min_plane_spread_m);
+  strict.min_line_spread_m = std::max(opt.min_line_spread_m, node_options_.auto_min_line_spread_m);
+  const CalibrationProblem pb(x, built.obs, prior_source_.priors(x), strict);
+  const GeometryReport geo = checkReferenceGeometry(pb, strict);
+  if (geo.status != CalibrationStatus::Ok) {
+    spdlog::debug("calibrator: anchor {} not ready for automatic calibration: {}", x, geo.reason);
+    return;
+  }
+  calibrateAnchor(x, tr, std::move(built), true);
+}
+
+// --------------------------------------------------------------------------------------------
+// Periodic work and status
+// --------------------------------------------------------------------------------------------
+
+void CalibratorNode::pruneOldTagRanges() {
+  const Timestamp cutoff = *newest_ - Duration::fromSec(node_options_.history_window_s);
+  for (auto& [x, tr] : tracks_) {
+    if (tr.state != State::Collecting && tr.state != State::Refused) continue;
+    std::deque<RangeSample> kept;
+    int64_t dropped = 0;
+    for (const RangeSample& r : tr.ranges) {
+      const SensorId ref = r.id_initiator == x ? r.id_responder : r.id_initiator;
+      if (setup_.isTag(ref) && r.t < cutoff) {
+        ++dropped;
+        auto it = tr.ranges_by_device.find(ref);
+        if (it != tr.ranges_by_device.end() && --it->second <= 0) tr.ranges_by_device.erase(it);
+      } else {
+        kept.push_back(r);
+      }
+    }
+    if (dropped > 0) {
+      tr.ranges.swap(kept);
+      diag_.count("ranges_dropped_no_pose", dropped);
+    }
+  }
+}
+
+void CalibratorNode::runPeriodic() {
+  if (!newest_) return;
+  const Timestamp now = *newest_;
+  if (!next_prune_ || now >= *next_prune_) {
+    if (next_prune_) pruneOldTagRanges();
+    next_prune_ = now + Duration::fromSec(kPruneSlackS);
+  }
+  if (node_options_.auto_mode) {
+    for (auto& [x, tr] : tracks_)
+      if (tr.state == State::Collecting || tr.state == State::Refused) checkAuto(x, tr);
+  }
+  const Duration period = Duration::fromSec(node_options_.status_period_s);
+  if (!next_status_) next_status_ = now;
+  if (now >= *next_status_) {
+    // Next multiple of the period after now (a jump in time emits one status, not many).
+    const int64_t k = (now - *next_status_).us / period.us + 1;
+    next_status_ = *next_status_ + Duration{k * period.us};
+    publishStatus();
+  }
+}
+
+void CalibratorNode::publishStatus() {
+  if (sinks_.status) sinks_.status(status());
+}
+
+CalibStatus CalibratorNode::status() const {
+  CalibStatus s;
+  s.t = newest_.value_or(Timestamp{});
+  s.wall_utime = wallUtime();
+  for (const auto& [x, tr] : tracks_) {
+    CalibAnchorStatus a;
+    a.id = x;
+    a.state = toString(tr.state);
+    a.reason = tr.reason;
+    if (tr.state == State::Calibrated && tr.result) {
+      a.n_ranges = tr.result->n_observations;
+      a.n_refs = static_cast<int32_t>(tr.result->references.size());
+    } else {
+      a.n_ranges = static_cast<int64_t>(tr.ranges.size());
+      for (const auto& [dev, n] : tr.ranges_by_device) a.n_refs += (n > 0 && isReference(dev)) ? 1 : 0;
+    }
+    s.anchors.push_back(a);
+  }
+  s.counters = diag_.snapshot();
+  s.counters["ranges_waiting_for_pose"] = last_waiting_for_pose_;
+  s.counters["ranges_waiting_for_reference"] = last_waiting_for_reference_;
+  s.counters["poses_held"] = static_cast<int64_t>(poses_.size());
+  s.counters["anchors_calibrated"] = static_cast<int64_t>(calibratedAnchors().size());
+  return s;
+}
+
+std::vector<SensorId> CalibratorNode::calibratedAnchors() const {
+  std::vector<SensorId> out;
+  for (const auto& [x, tr] : tracks_)
+    if (tr.state == State::Calibrated) out.push_back(x);
+  return out;
+}
+
+}  // namespace meshnav::calib

@@ -1,0 +1,86 @@
+#pragma once
+/// @file mission_node.h
+/// @brief The `mission` node (DESIGN §3), free of LCM: runs a `Mission` in data time.
+/// Subscribes POSE (or any data time, `onTime`), CALIB_STATUS and ESTIMATOR_STATUS; publishes
+/// CALIB_CMD, ESTIMATOR_CMD and MISSION_STATUS through sinks. The same class runs behind LCM
+/// (mission/process/) and in the in-process pipeline.
+///
+/// - **t0.** Step times are seconds after t0, the dataset's first sample. `setT0()` sets it (the
+///   pipeline knows the first sample; a process replaying a simulated dataset can pass 0);
+///   otherwise the first `onTime`/`onPose` defines it. Note that over LCM the first POSE comes
+///   only after the estimator initialised, so taking t0 from it shifts the mission by that delay.
+/// - **Start.** At the first data time, when `Mission::collect_at_start`, one CALIB_CMD Collect
+///   with an empty list (= all anchors, also those seen later).
+/// - **Steps** run once each, in order, at the first data time >= t0 + step.t (several steps passed
+///   by one jump all run, in order). Commands carry the data time at which they are issued.
+///   collect/calibrate/abort → one CALIB_CMD; remove → one ESTIMATOR_CMD RemoveInstance per id.
+///   Data time going backwards never re-runs a step (counted as "time_backwards").
+/// - **Status** (MISSION_STATUS, the heartbeat) every `status_period_s` of data time and right
+///   after a step ran: index of the last executed step, step count and a text with the next step
+///   and the calibrator's per-anchor states from CALIB_STATUS (refusals are also logged).
+/// Not thread-safe: call from one thread.
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "common/diagnostics.h"
+#include "common/messages.h"
+#include "common/types.h"
+#include "mission/mission.h"
+
+namespace meshnav::mission {
+
+struct MissionSinks {
+  std::function<void(const CalibCommand&)> calib_cmd;          ///< CALIB_CMD
+  std::function<void(const EstimatorCommand&)> estimator_cmd;  ///< ESTIMATOR_CMD
+  std::function<void(const MissionStatus&)> status;            ///< MISSION_STATUS
+};
+
+struct MissionNodeOptions {
+  double status_period_s = 1.0;  ///< MISSION_STATUS period in data time [s] (> 0)
+};
+
+class MissionNode {
+ public:
+  /// Throws std::invalid_argument for a non-positive status period.
+  MissionNode(Mission mission, MissionSinks sinks = {}, MissionNodeOptions options = {});
+
+  /// Sets t0 (the dataset's first sample). Ignored with a warning once the mission started.
+  void setT0(Timestamp t0);
+  void onPose(const PoseEstimate& p) { onTime(p.t); }
+  /// Advances data time; runs the start, the due steps and the heartbeat.
+  void onTime(Timestamp data_time);
+  void onCalibStatus(const CalibStatus& s);
+  void onEstimatorStatus(const EstimatorStatus& s);
+
+  MissionStatus status() const;
+  bool started() const { return started_; }
+  /// Every step ran.
+  bool finished() const { return started_ && next_step_ >= mission_.steps.size(); }
+  /// Index of the next step to run (== number of steps run).
+  size_t nextStep() const { return next_step_; }
+  std::optional<Timestamp> t0() const { return t0_; }
+  const Mission& mission() const { return mission_; }
+  const Diagnostics& diagnostics() const { return diag_; }
+
+ private:
+  void runStep(const MissionStep& step);
+  void publishStatus();
+  std::string text() const;
+
+  Mission mission_;
+  MissionSinks sinks_;
+  MissionNodeOptions options_;
+  Diagnostics diag_;
+  std::optional<Timestamp> t0_;
+  Timestamp now_;
+  bool started_ = false;
+  size_t next_step_ = 0;
+  std::optional<Timestamp> next_status_;
+  std::map<SensorId, CalibAnchorStatus> calib_;  ///< last CALIB_STATUS per anchor
+  bool estimator_initialized_ = false;
+};
+
+}  // namespace meshnav::mission
