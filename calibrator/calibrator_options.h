@@ -51,6 +51,10 @@ struct CalibratorOptions {
 
   // --- covariance --------------------------------------------------------------------------
   bool scale_covariance_by_residuals = true;  ///< multiply by s² when s² > 1
+  /// Share c ∈ [0, 1] of the moving references' position covariance treated as an error common to
+  /// all of them (an estimated trajectory's error is correlated over the collection window, so it
+  /// does not average out): Σ_x += c·S Σ̄_R Sᵀ with S = ∂x̂/∂δ of a common shift δ. 0 = independent.
+  double correlated_reference_fraction = 1.0;
   double outlier_threshold_sigmas = 3.0;      ///< final inlier test |r| < k·σ_eff·max(1, s_robust)
 
   // --- refusals ----------------------------------------------------------------------------

@@ -38,8 +38,14 @@ struct CovarianceEstimate {
   double s2 = 1.0;            ///< whitened residual variance Σ r²/σ_eff² / (n − dim)
   int n = 0;
 };
+///
+/// With `correlated_reference_fraction` c > 0, a common error δ ~ N(0, c·Σ̄_R) of the moving
+/// references (Σ̄_R: mean position covariance of their used observations) is added: a shift δ
+/// changes residual i by β_i u_iᵀ δ, hence the estimate by S δ with S = H⁻¹ Σ_i j_i β_i u_iᵀ / σ_eff,i²
+/// (≈ [I; 0] for the position when only moving references carry geometry), so P += c·S Σ̄_R Sᵀ.
 CovarianceEstimate estimateCovariance(const CalibrationProblem& pb, const AnchorParams& x,
-                                      const std::vector<bool>& use, bool scale_by_residuals);
+                                      const std::vector<bool>& use, bool scale_by_residuals,
+                                      double correlated_reference_fraction = 0.0);
 
 /// Cramér–Rao bound of the same data: (H at the true parameters, with priors)⁻¹ over the stacked
 /// unknowns. Returns an empty matrix when H is singular.

@@ -126,7 +126,8 @@ CalibrationResult AnchorCalibrator::calibrate(SensorId anchor_id, const std::vec
   const AnchorParams& x = ref.params;
 
   // 3. Covariance on the final inliers.
-  const CovarianceEstimate cov = estimateCovariance(pb, x, inl, options_.scale_covariance_by_residuals);
+  const CovarianceEstimate cov = estimateCovariance(pb, x, inl, options_.scale_covariance_by_residuals,
+                                                    options_.correlated_reference_fraction);
   if (!cov.ok) return refuse(CalibrationStatus::IllConditioned, "information matrix is singular");
   const Eigen::Matrix3d Pp = cov.P.block<3, 3>(0, 0);
   const double sig_max = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Pp).eigenvalues()(2)));

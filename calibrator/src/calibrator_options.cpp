@@ -49,6 +49,7 @@ void visitOptions(Opts& o, F&& f) {
   f("ransac_max_iterations", o.ransac_max_iterations);
   f("ransac_rows_margin", o.ransac_rows_margin);
   f("scale_covariance_by_residuals", o.scale_covariance_by_residuals);
+  f("correlated_reference_fraction", o.correlated_reference_fraction);
   f("outlier_threshold_sigmas", o.outlier_threshold_sigmas);
   f("min_measurements", o.min_measurements);
   f("min_measurements_per_reference", o.min_measurements_per_reference);

@@ -98,7 +98,8 @@ Eigen::MatrixXd informationMatrix(const CalibrationProblem& pb, const AnchorPara
 }
 
 CovarianceEstimate estimateCovariance(const CalibrationProblem& pb, const AnchorParams& x,
-                                      const std::vector<bool>& use, bool scale_by_residuals) {
+                                      const std::vector<bool>& use, bool scale_by_residuals,
+                                      double correlated_reference_fraction) {
   CovarianceEstimate c;
   const Eigen::MatrixXd H = informationMatrix(pb, x, use, /*with_priors=*/true);
   c.P = spdInverse(H);
@@ -113,6 +114,37 @@ CovarianceEstimate estimateCovariance(const CalibrationProblem& pb, const Anchor
   const int dof = c.n - pb.dim();
   c.s2 = dof > 0 ? chi2 / dof : 1.0;
   if (scale_by_residuals && c.s2 > 1.0) c.P *= c.s2;
+  if (correlated_reference_fraction > 0.0) {
+    // Sensitivity of the estimate to a shift δ common to every moving reference.
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(pb.dim(), 3);
+    Eigen::Matrix3d cov_sum = Eigen::Matrix3d::Zero();
+    int n_moving = 0;
+    for (int s = 0; s < static_cast<int>(pb.slots().size()); ++s) {
+      const auto& slot = pb.slots()[static_cast<size_t>(s)];
+      if (!slot.moving) continue;
+      const double beta = x.beta[static_cast<size_t>(s)];
+      const int ig = pb.gammaIndex(s), ib = pb.betaIndex(s);
+      for (int i : slot.obs) {
+        if (!use.empty() && !use[static_cast<size_t>(i)]) continue;
+        const auto& o = pb.observations()[static_cast<size_t>(i)];
+        const Eigen::Vector3d diff = x.p_AinG - o.p_RinG;
+        const double d = std::max(diff.norm(), kMinDistance);
+        const Eigen::Vector3d u = diff / d;
+        const double var = o.sigma_d_m * o.sigma_d_m + beta * beta * u.dot(o.cov_p_RinG_m2 * u);
+        const Eigen::RowVector3d dr = beta * u.transpose() / var;  // ∂r/∂δ, whitened once
+        G.topRows<3>() += beta * u * dr;
+        G.row(ig) += dr;
+        if (ib >= 0) G.row(ib) += d * dr;
+        cov_sum += o.cov_p_RinG_m2;
+        ++n_moving;
+      }
+    }
+    if (n_moving > 0) {
+      const Eigen::MatrixXd S = spdInverse(H) * G;
+      const Eigen::Matrix3d cov_mean = cov_sum / n_moving;
+      c.P += correlated_reference_fraction * S * cov_mean * S.transpose();
+    }
+  }
   c.ok = c.P.allFinite();
   return c;
 }
