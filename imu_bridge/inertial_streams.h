@@ -1,0 +1,35 @@
+#pragma once
+/// @file inertial_streams.h
+/// @brief The inputs the imu_bridge replays from a dataset folder (DESIGN §6): imu.csv → IMU,
+/// baro.csv → BARO, flight_state.csv → FLIGHT_STATE, merged into one deterministic time line.
+
+#include <string>
+#include <vector>
+
+#include "common/diagnostics.h"
+#include "common/types.h"
+#include "transport/replay/replay_event.h"
+
+namespace meshnav::imu {
+
+struct InertialStreams {
+  std::vector<ImuSample> imu;
+  std::vector<BaroSample> baro;
+  std::vector<FlightStateSample> flight_states;
+
+  /// Stream indices of ReplayEvent::stream.
+  static constexpr int kImuStream = 0;
+  static constexpr int kBaroStream = 1;
+  static constexpr int kFlightStateStream = 2;
+
+  /// IMU, BARO, FLIGHT_STATE merged by time (equal times: IMU first, then BARO, then FLIGHT_STATE).
+  std::vector<replay::ReplayEvent> timeline() const;
+  size_t size() const { return imu.size() + baro.size() + flight_states.size(); }
+};
+
+/// Reads imu.csv, baro.csv and flight_state.csv of `dataset_dir`; each file is optional, but at
+/// least one must exist (else std::runtime_error naming the folder). Bad rows are reported and
+/// counted in `diag` (file:line) and dropped.
+InertialStreams loadInertialStreams(const std::string& dataset_dir, Diagnostics& diag);
+
+}  // namespace meshnav::imu

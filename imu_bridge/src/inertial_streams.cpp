@@ -1,0 +1,41 @@
+#include "imu_bridge/inertial_streams.h"
+
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "common/dataset.h"
+
+namespace meshnav::imu {
+
+std::vector<replay::ReplayEvent> InertialStreams::timeline() const {
+  return replay::mergeTimeline({replay::timesOf(imu), replay::timesOf(baro), replay::timesOf(flight_states)});
+}
+
+InertialStreams loadInertialStreams(const std::string& dataset_dir, Diagnostics& diag) {
+  namespace fs = std::filesystem;
+  const fs::path dir(dataset_dir);
+  if (!fs::is_directory(dir)) throw std::runtime_error(dataset_dir + ": not a dataset folder");
+  InertialStreams s;
+  bool any = false;
+  if (fs::exists(dir / "imu.csv")) {
+    s.imu = readImuCsv((dir / "imu.csv").string(), diag);
+    any = true;
+  }
+  if (fs::exists(dir / "baro.csv")) {
+    s.baro = readBaroCsv((dir / "baro.csv").string(), diag);
+    any = true;
+  }
+  if (fs::exists(dir / "flight_state.csv")) {
+    s.flight_states = readFlightStateCsv((dir / "flight_state.csv").string(), diag);
+    any = true;
+  }
+  if (!any)
+    throw std::runtime_error(dataset_dir + ": none of imu.csv, baro.csv, flight_state.csv found");
+  spdlog::info("{}: {} IMU, {} baro, {} flight-state samples", dataset_dir, s.imu.size(), s.baro.size(),
+               s.flight_states.size());
+  return s;
+}
+
+}  // namespace meshnav::imu

@@ -1,0 +1,83 @@
+#pragma once
+/// @file run_recorder.h
+/// @brief The recorder behind the `logging` process (LCM-free): writes what the estimator and the
+/// calibrator publish into the files of DESIGN §6 and keeps a summary of the run.
+///
+/// Files in the output folder:
+///  - estimate.csv    every POSE (common/estimate_io.h)
+///  - anchors.csv     every anchor of every ANCHORS message
+///  - anchor_init.yaml  every ANCHOR_INIT, in the calibration YAML format (`anchors:` list)
+///  - groundtruth.csv GROUND_TRUTH when present (TUM)
+///  - summary.yaml    written by finish(): messages and bytes per channel, the last
+///                    ESTIMATOR_STATUS / CALIB_STATUS / MISSION_STATUS, and the recorder's counters
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/diagnostics.h"
+#include "common/estimate_io.h"
+#include "common/messages.h"
+#include "common/types.h"
+
+namespace meshnav::logging {
+
+/// Traffic of one channel.
+struct ChannelStats {
+  int64_t messages = 0;
+  int64_t bytes = 0;
+  int64_t first_wall_utime = 0;  ///< receipt time of the first message [µs, Unix epoch]
+  int64_t last_wall_utime = 0;   ///< receipt time of the last message [µs, Unix epoch]
+};
+
+class RunRecorder {
+ public:
+  /// Creates `out_dir` and opens estimate.csv and anchors.csv there (header written at once).
+  /// Throws std::runtime_error when the folder or files cannot be written.
+  explicit RunRecorder(const std::string& out_dir);
+  ~RunRecorder();
+
+  /// Any message on any channel (for the summary), received at `wall_utime`.
+  void countMessage(const std::string& channel, int64_t bytes, int64_t wall_utime);
+
+  void onPose(const PoseEstimate& e);
+  void onAnchors(const std::vector<AnchorEstimate>& anchors);
+  void onAnchorInit(const AnchorInit& a);
+  void onGroundTruth(const PoseSample& p);
+  void onEstimatorStatus(const EstimatorStatus& s) { last_estimator_status_ = s; }
+  void onCalibStatus(const CalibStatus& s) { last_calib_status_ = s; }
+  void onMissionStatus(const MissionStatus& s) { last_mission_status_ = s; }
+
+  /// Flushes the CSV files (call periodically, so readers see progress).
+  void flush();
+  /// Flushes everything and writes anchor_init.yaml, groundtruth.csv and summary.yaml (with the
+  /// process's own counters `process_diag`). Idempotent.
+  void finish(const Diagnostics& process_diag);
+
+  /// Multi-line human-readable summary (what finish() also logs).
+  std::string summaryText() const;
+
+  const std::map<std::string, ChannelStats>& channels() const { return channels_; }
+  int64_t posesWritten() const { return n_poses_; }
+  int64_t anchorRowsWritten() const { return n_anchor_rows_; }
+  const std::string& outDir() const { return out_dir_; }
+
+ private:
+  std::string out_dir_;
+  std::unique_ptr<EstimateCsvWriter> estimate_;
+  std::unique_ptr<AnchorsCsvWriter> anchors_;
+  std::vector<AnchorInit> anchor_inits_;
+  std::vector<PoseSample> ground_truth_;
+  std::map<std::string, ChannelStats> channels_;
+  std::optional<EstimatorStatus> last_estimator_status_;
+  std::optional<CalibStatus> last_calib_status_;
+  std::optional<MissionStatus> last_mission_status_;
+  int64_t n_poses_ = 0;
+  int64_t n_anchor_rows_ = 0;
+  bool finished_ = false;
+};
+
+}  // namespace meshnav::logging

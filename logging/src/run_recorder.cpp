@@ -1,0 +1,202 @@
+#include "logging/run_recorder.h"
+
+#include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/dataset.h"
+
+namespace meshnav::logging {
+namespace fs = std::filesystem;
+
+namespace {
+
+void writeYaml(const YAML::Emitter& e, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error(path + ": cannot write file");
+  out << e.c_str() << "\n";
+}
+
+YAML::Emitter& flowSeq(YAML::Emitter& e, const double* v, int n) {
+  e << YAML::Flow << YAML::BeginSeq;
+  for (int i = 0; i < n; ++i) e << v[i];
+  return e << YAML::EndSeq;
+}
+
+}  // namespace
+
+RunRecorder::RunRecorder(const std::string& out_dir) : out_dir_(out_dir) {
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) throw std::runtime_error(out_dir + ": cannot create folder: " + ec.message());
+  estimate_ = std::make_unique<EstimateCsvWriter>((fs::path(out_dir) / "estimate.csv").string());
+  anchors_ = std::make_unique<AnchorsCsvWriter>((fs::path(out_dir) / "anchors.csv").string());
+}
+
+RunRecorder::~RunRecorder() = default;
+
+void RunRecorder::countMessage(const std::string& channel, int64_t bytes, int64_t wall_utime) {
+  auto& c = channels_[channel];
+  if (c.messages == 0) c.first_wall_utime = wall_utime;
+  ++c.messages;
+  c.bytes += bytes;
+  c.last_wall_utime = wall_utime;
+}
+
+void RunRecorder::onPose(const PoseEstimate& e) {
+  estimate_->write(e);
+  ++n_poses_;
+}
+
+void RunRecorder::onAnchors(const std::vector<AnchorEstimate>& anchors) {
+  for (const auto& a : anchors) {
+    anchors_->write(a);
+    ++n_anchor_rows_;
+  }
+}
+
+void RunRecorder::onAnchorInit(const AnchorInit& a) { anchor_inits_.push_back(a); }
+
+void RunRecorder::onGroundTruth(const PoseSample& p) { ground_truth_.push_back(p); }
+
+void RunRecorder::flush() {
+  estimate_->flush();
+  anchors_->flush();
+}
+
+void RunRecorder::finish(const Diagnostics& process_diag) {
+  if (finished_) return;
+  finished_ = true;
+  flush();
+  const fs::path dir(out_dir_);
+
+  if (!anchor_inits_.empty()) {
+    YAML::Emitter e;
+    e << YAML::BeginMap << YAML::Key << "anchors" << YAML::Value << YAML::BeginSeq;
+    for (const auto& a : anchor_inits_) {
+      e << YAML::BeginMap;
+      e << YAML::Key << "id" << YAML::Value << a.id;
+      e << YAML::Key << "t" << YAML::Value << a.t.sec();
+      e << YAML::Key << "p_AinG" << YAML::Value;
+      flowSeq(e, a.p_AinG.data(), 3);
+      double cov[9];
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) cov[3 * r + c] = a.cov_p_m2(r, c);
+      e << YAML::Key << "p_AinG_cov" << YAML::Value;
+      flowSeq(e, cov, 9);
+      std::vector<int> refs;
+      std::vector<double> g, b, sg, sb, sr;
+      for (const auto& pb : a.biases) {
+        refs.push_back(pb.a);
+        g.push_back(pb.gamma_m);
+        b.push_back(pb.beta);
+        sg.push_back(pb.sigma_gamma_m);
+        sb.push_back(pb.sigma_beta);
+        sr.push_back(pb.sigma_m);
+      }
+      e << YAML::Key << "ref_ids" << YAML::Value << YAML::Flow << refs;
+      e << YAML::Key << "const_biases" << YAML::Value << YAML::Flow << g;
+      e << YAML::Key << "dist_biases" << YAML::Value << YAML::Flow << b;
+      e << YAML::Key << "sigma_const_biases" << YAML::Value << YAML::Flow << sg;
+      e << YAML::Key << "sigma_dist_biases" << YAML::Value << YAML::Flow << sb;
+      e << YAML::Key << "sigma_ranges" << YAML::Value << YAML::Flow << sr;
+      e << YAML::Key << "n_inliers" << YAML::Value << a.n_inliers;
+      e << YAML::Key << "n_outliers" << YAML::Value << a.n_outliers;
+      e << YAML::EndMap;
+    }
+    e << YAML::EndSeq << YAML::EndMap;
+    writeYaml(e, (dir / "anchor_init.yaml").string());
+  }
+  if (!ground_truth_.empty()) writeTumCsv(ground_truth_, (dir / "groundtruth.csv").string());
+
+  YAML::Emitter e;
+  e << YAML::BeginMap;
+  e << YAML::Key << "channels" << YAML::Value << YAML::BeginMap;
+  for (const auto& [name, c] : channels_) {
+    const double span = (c.last_wall_utime - c.first_wall_utime) * 1e-6;
+    e << YAML::Key << name << YAML::Value << YAML::Flow << YAML::BeginMap;
+    e << YAML::Key << "messages" << YAML::Value << c.messages;
+    e << YAML::Key << "bytes" << YAML::Value << c.bytes;
+    e << YAML::Key << "rate_hz" << YAML::Value << (span > 0 ? (c.messages - 1) / span : 0.0);
+    e << YAML::EndMap;
+  }
+  e << YAML::EndMap;
+  e << YAML::Key << "files" << YAML::Value << YAML::Flow << YAML::BeginMap;
+  e << YAML::Key << "estimate_rows" << YAML::Value << n_poses_;
+  e << YAML::Key << "anchor_rows" << YAML::Value << n_anchor_rows_;
+  e << YAML::Key << "anchor_inits" << YAML::Value << anchor_inits_.size();
+  e << YAML::Key << "ground_truth_rows" << YAML::Value << ground_truth_.size();
+  e << YAML::EndMap;
+  if (last_estimator_status_) {
+    const auto& s = *last_estimator_status_;
+    e << YAML::Key << "estimator_status" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "t" << YAML::Value << s.t.sec();
+    e << YAML::Key << "initialized" << YAML::Value << s.initialized;
+    e << YAML::Key << "strategy" << YAML::Value << s.strategy;
+    e << YAML::Key << "counters" << YAML::Value << YAML::BeginMap;
+    for (const auto& [k, v] : s.counters) e << YAML::Key << k << YAML::Value << v;
+    e << YAML::EndMap;
+    e << YAML::Key << "mean_step_us" << YAML::Value << YAML::BeginMap;
+    for (const auto& [k, v] : s.mean_step_us) e << YAML::Key << k << YAML::Value << v;
+    e << YAML::EndMap;
+    e << YAML::Key << "instances" << YAML::Value << YAML::BeginSeq;
+    for (const auto& i : s.instances) {
+      e << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << i.id << YAML::Key << "type"
+        << YAML::Value << i.type << YAML::Key << "n_updates" << YAML::Value << i.n_updates << YAML::Key
+        << "n_rejected" << YAML::Value << i.n_rejected << YAML::EndMap;
+    }
+    e << YAML::EndSeq << YAML::EndMap;
+  }
+  if (last_calib_status_) {
+    const auto& s = *last_calib_status_;
+    e << YAML::Key << "calib_status" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "t" << YAML::Value << s.t.sec();
+    e << YAML::Key << "anchors" << YAML::Value << YAML::BeginSeq;
+    for (const auto& a : s.anchors) {
+      e << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << a.id << YAML::Key << "state"
+        << YAML::Value << a.state << YAML::Key << "n_ranges" << YAML::Value << a.n_ranges << YAML::Key << "n_refs"
+        << YAML::Value << a.n_refs << YAML::Key << "reason" << YAML::Value << a.reason << YAML::EndMap;
+    }
+    e << YAML::EndSeq;
+    e << YAML::Key << "counters" << YAML::Value << YAML::BeginMap;
+    for (const auto& [k, v] : s.counters) e << YAML::Key << k << YAML::Value << v;
+    e << YAML::EndMap << YAML::EndMap;
+  }
+  if (last_mission_status_) {
+    const auto& s = *last_mission_status_;
+    e << YAML::Key << "mission_status" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    e << YAML::Key << "t" << YAML::Value << s.t.sec();
+    e << YAML::Key << "step_index" << YAML::Value << s.step_index;
+    e << YAML::Key << "n_steps" << YAML::Value << s.n_steps;
+    e << YAML::Key << "text" << YAML::Value << s.text;
+    e << YAML::EndMap;
+  }
+  e << YAML::Key << "logger_counters" << YAML::Value << YAML::BeginMap;
+  for (const auto& [k, v] : process_diag.snapshot()) e << YAML::Key << k << YAML::Value << v;
+  e << YAML::EndMap;
+  e << YAML::EndMap;
+  writeYaml(e, (dir / "summary.yaml").string());
+}
+
+std::string RunRecorder::summaryText() const {
+  std::ostringstream s;
+  s << "recorded into " << out_dir_ << ": " << n_poses_ << " poses, " << n_anchor_rows_ << " anchor rows, "
+    << anchor_inits_.size() << " anchor inits\n";
+  for (const auto& [name, c] : channels_)
+    s << fmt::format("  {:<17} {:>8} msgs {:>11} bytes\n", name, c.messages, c.bytes);
+  if (last_estimator_status_) {
+    const auto& st = *last_estimator_status_;
+    s << "  estimator: t=" << formatSeconds(st.t) << " s, " << (st.initialized ? "initialized" : "NOT initialized")
+      << ", strategy " << st.strategy << ", counters:";
+    for (const auto& [k, v] : st.counters) s << ' ' << k << '=' << v;
+    s << '\n';
+  }
+  return s.str();
+}
+
+}  // namespace meshnav::logging

@@ -1,0 +1,144 @@
+#pragma once
+/// @file lcm_node.h
+/// @brief The small runtime every process uses: one LCM instance, typed subscriptions that decode
+/// and validate messages themselves (a malformed message is reported with its channel, counted,
+/// and dropped: never a crash), a loop with a periodic heartbeat, and a clean stop on SIGINT /
+/// SIGTERM (StopSignal) or on request.
+///
+/// Counter keys in diagnostics(): "<CHANNEL>:decode_error" (bytes that do not decode as the
+/// channel's type), "<CHANNEL>:invalid_message" (decoded, but NaN / unknown code),
+/// "<CHANNEL>:handler_error" (the callback threw), "lcm:publish_error".
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/diagnostics.h"
+#include "common/time.h"
+#include "transport/convert.h"
+
+namespace meshnav::transport {
+
+class LcmNode {
+ public:
+  /// `url` "" means LCM's default (LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0).
+  /// Throws std::runtime_error when LCM cannot be initialised (bad URL, no multicast route).
+  LcmNode(std::string name, const std::string& url);
+  ~LcmNode();
+  LcmNode(const LcmNode&) = delete;
+  LcmNode& operator=(const LcmNode&) = delete;
+
+  const std::string& name() const { return name_; }
+  const std::string& url() const { return url_; }
+  lcm::LCM& lcm() { return *lcm_; }
+
+  /// Messages LCM queues per subscription before it drops (LCM's default is 30).
+  static constexpr int kQueueCapacity = 10000;
+
+  /// Raw subscription (channel is a regex, as in LCM): the callback gets the undecoded bytes.
+  using RawHandler = std::function<void(const lcm::ReceiveBuffer& rbuf, const std::string& channel)>;
+  void subscribeRaw(const std::string& channel_regex, RawHandler fn);
+
+  /// Subscription to an LCM type: decoded here, decode failures reported and counted.
+  template <class Msg>
+  void subscribeLcm(const std::string& channel, std::function<void(const Msg&, const std::string& channel)> fn) {
+    subscribeRaw(channel, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+      Msg msg;
+      if (!decode(rbuf, ch, msg)) return;
+      guarded(ch, [&] { fn(msg, ch); });
+    });
+  }
+
+  /// Subscription delivering the plain struct (common/types.h, common/messages.h): decoded and
+  /// converted with fromLcm (which validates: NaN, unknown codes → "<CHANNEL>:invalid_message").
+  template <class Plain>
+  void subscribe(const std::string& channel, std::function<void(const Plain&)> fn) {
+    using Msg = typename LcmTypeOf<Plain>::type;
+    subscribeRaw(channel, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+      Msg msg;
+      if (!decode(rbuf, ch, msg)) return;
+      guarded(ch, [&] { fn(fromLcm(msg)); });
+    });
+  }
+
+  template <class Msg>
+  bool publishLcm(const std::string& channel, const Msg& msg) {
+    const int rc = lcm_->publish(channel, &msg);
+    if (rc != 0) diag_.report("lcm:publish_error", "publish on " + channel + " failed");
+    return rc == 0;
+  }
+  /// Publishes a plain struct converted with toLcm.
+  template <class Plain>
+  bool publish(const std::string& channel, const Plain& value) {
+    return publishLcm(channel, toLcm(value));
+  }
+
+  /// Calls `fn` every `period` of wall time from spin() (the process heartbeat / status).
+  void setHeartbeat(Duration period, std::function<void()> fn);
+
+  /// Handles messages until StopSignal or requestStop(), or until `until()` returns true (checked
+  /// after every handled message and at least every 100 ms). Returns 0, or 1 after an LCM error.
+  int spin(const std::function<bool()>& until = {});
+  /// Handles at most one batch of messages, waiting up to `timeout_ms`; runs a due heartbeat.
+  /// Returns > 0 when something was handled, 0 on timeout, < 0 on an LCM error.
+  int spinOnce(int timeout_ms);
+  /// Waits until a message arrives on `channel` (a heartbeat, typically), a stop is requested or
+  /// `timeout` passes (≤ 0: no limit). Returns true when the message was seen.
+  bool waitForMessage(const std::string& channel, Duration timeout);
+
+  void requestStop() { stop_ = true; }
+  bool stopRequested() const;
+
+  Diagnostics& diagnostics() { return diag_; }
+  /// Messages received and decoded per channel (typed subscriptions).
+  std::map<std::string, int64_t> receivedCounts() const { return received_; }
+  int64_t received(const std::string& channel) const;
+
+ private:
+  template <class Msg>
+  bool decode(const lcm::ReceiveBuffer& rbuf, const std::string& ch, Msg& msg) {
+    int rc = -1;
+    std::string what = "not a valid " + std::string(Msg::getTypeName());
+    try {
+      rc = msg.decode(rbuf.data, 0, static_cast<int>(rbuf.data_size));
+    } catch (const std::exception& e) {  // e.g. a corrupted length field
+      what += std::string(": ") + e.what();
+      rc = -1;
+    }
+    if (rc < 0) {
+      diag_.report(ch + ":decode_error", "channel " + ch + ": dropped a malformed message (" +
+                                             std::to_string(rbuf.data_size) + " bytes, " + what + ")");
+      return false;
+    }
+    ++received_[ch];
+    return true;
+  }
+  void guarded(const std::string& ch, const std::function<void()>& body);
+  void runHeartbeatIfDue();
+
+  struct RawSub {
+    LcmNode* node;
+    RawHandler fn;
+  };
+  static void dispatchRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel, RawSub* sub);
+
+  std::string name_;
+  std::string url_;
+  std::unique_ptr<lcm::LCM> lcm_;
+  std::vector<std::unique_ptr<RawSub>> subs_;
+  Diagnostics diag_;
+  std::map<std::string, int64_t> received_;
+  bool stop_ = false;
+  Duration heartbeat_period_{0};
+  std::function<void()> heartbeat_;
+  int64_t next_heartbeat_us_ = 0;
+};
+
+/// The LCM URL a process uses: `--lcm-url` if given, else LCM_DEFAULT_URL, else LCM's default.
+std::string resolveLcmUrl(const std::string& cli_value);
+
+}  // namespace meshnav::transport

@@ -1,0 +1,111 @@
+#include "transport/lcm_node.h"
+
+#include <spdlog/spdlog.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "transport/replay/clock.h"
+#include "transport/stop_signal.h"
+
+namespace meshnav::transport {
+
+std::string resolveLcmUrl(const std::string& cli_value) {
+  if (!cli_value.empty()) return cli_value;
+  if (const char* env = std::getenv("LCM_DEFAULT_URL"); env && *env) return env;
+  return "udpm://239.255.76.67:7667?ttl=0";
+}
+
+LcmNode::LcmNode(std::string name, const std::string& url) : name_(std::move(name)), url_(resolveLcmUrl(url)) {
+  lcm_ = std::make_unique<lcm::LCM>(url_);
+  if (!lcm_->good())
+    throw std::runtime_error(name_ + ": cannot initialise LCM with URL '" + url_ +
+                             "' (for udpm on loopback: ip link set lo multicast on; "
+                             "ip route add 224.0.0.0/4 dev lo)");
+  spdlog::debug("{}: LCM on {}", name_, url_);
+}
+
+LcmNode::~LcmNode() = default;
+
+void LcmNode::dispatchRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel, RawSub* sub) {
+  sub->node->guarded(channel, [&] { sub->fn(*rbuf, channel); });
+}
+
+void LcmNode::subscribeRaw(const std::string& channel_regex, RawHandler fn) {
+  subs_.push_back(std::make_unique<RawSub>(RawSub{this, std::move(fn)}));
+  lcm::Subscription* sub = lcm_->subscribeFunction(channel_regex, &LcmNode::dispatchRaw, subs_.back().get());
+  // LCM drops messages of a subscription whose queue is full (default 30): a burst (a replay at
+  // high speed, lcm-logplayer catching up) must not lose data for a process that is briefly busy.
+  if (sub) sub->setQueueCapacity(kQueueCapacity);
+}
+
+void LcmNode::guarded(const std::string& ch, const std::function<void()>& body) {
+  try {
+    body();
+  } catch (const InvalidMessage& e) {
+    diag_.report(ch + ":invalid_message", "channel " + ch + ": dropped an invalid message (" + e.what() + ")");
+  } catch (const std::exception& e) {
+    diag_.report(ch + ":handler_error", "channel " + ch + ": handler failed: " + e.what());
+  }
+}
+
+void LcmNode::setHeartbeat(Duration period, std::function<void()> fn) {
+  heartbeat_period_ = period;
+  heartbeat_ = std::move(fn);
+  next_heartbeat_us_ = replay::wallUtimeNow();  // first beat at once: subscribers see us early
+}
+
+void LcmNode::runHeartbeatIfDue() {
+  if (!heartbeat_ || heartbeat_period_.us <= 0) return;
+  const int64_t now = replay::wallUtimeNow();
+  if (now < next_heartbeat_us_) return;
+  next_heartbeat_us_ = now + heartbeat_period_.us;
+  guarded("heartbeat", heartbeat_);
+}
+
+bool LcmNode::stopRequested() const { return stop_ || StopSignal::requested(); }
+
+int64_t LcmNode::received(const std::string& channel) const {
+  auto it = received_.find(channel);
+  return it == received_.end() ? 0 : it->second;
+}
+
+int LcmNode::spinOnce(int timeout_ms) {
+  if (heartbeat_ && heartbeat_period_.us > 0) {
+    const int64_t to_beat_ms = (next_heartbeat_us_ - replay::wallUtimeNow()) / 1000;
+    timeout_ms = static_cast<int>(std::max<int64_t>(0, std::min<int64_t>(timeout_ms, to_beat_ms)));
+  }
+  const int rc = lcm_->handleTimeout(timeout_ms);
+  runHeartbeatIfDue();
+  if (rc < 0 && (errno == EINTR || stopRequested())) return 0;  // interrupted by a signal
+  return rc;
+}
+
+int LcmNode::spin(const std::function<bool()>& until) {
+  runHeartbeatIfDue();
+  while (!stopRequested()) {
+    if (until && until()) break;
+    const int rc = spinOnce(100);
+    if (rc < 0) {
+      spdlog::error("{}: LCM handle failed (URL {})", name_, url_);
+      return 1;
+    }
+  }
+  return 0;
+}
+
+bool LcmNode::waitForMessage(const std::string& channel, Duration timeout) {
+  bool seen = false;
+  lcm::Subscription* sub = lcm_->subscribeFunction(
+      channel, +[](const lcm::ReceiveBuffer*, const std::string&, bool* flag) { *flag = true; }, &seen);
+  const int64_t deadline = timeout.us > 0 ? replay::wallUtimeNow() + timeout.us : 0;
+  while (!seen && !stopRequested()) {
+    if (deadline && replay::wallUtimeNow() >= deadline) break;
+    if (spinOnce(100) < 0) break;
+  }
+  lcm_->unsubscribe(sub);
+  return seen;
+}
+
+}  // namespace meshnav::transport
