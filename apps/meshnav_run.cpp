@@ -28,7 +28,8 @@ Usage: meshnav_run --dataset DIR --out DIR [--strategy centralized|dp|dah] [--co
 
   --dataset DIR    dataset folder (imu.csv, baro.csv, ranges.csv, flight_state.csv, setup.yaml)
   --out DIR        output folder (created): estimate.csv, anchors.csv, timings.csv, status.txt
-  --strategy S     fusion strategy (default: centralized; dp and dah come with the next issue)
+  --strategy S     fusion strategy: centralized (dense EKF), dp (modular, centralized-equivalent),
+                   dah (modular, updates only the involved instances); default: the config's
   --config FILE    estimator options YAML (default: built-in defaults = config/estimator.yaml)
   --mission FILE   mission script (accepted; calibration is a later issue, so it is ignored)
   --print-config   print the estimator options (defaults or --config) as YAML and exit
@@ -78,12 +79,16 @@ int main(int argc, char** argv) {
     std::cerr << "meshnav_run: --dataset and --out are required\n\n" << kUsage;
     return 2;
   }
-  const std::string strategy = cli.get("strategy", "centralized");
-  if (strategy == "dp" || strategy == "dah") {
-    std::cerr << "meshnav_run: strategy '" << strategy << "' is not implemented yet (next issue); use centralized\n";
-    return 2;
+  std::string strategy = cli.get("strategy", "");
+  if (strategy.empty()) {
+    try {
+      strategy = cli.has("config") ? EstimatorOptions::fromYaml(cli.get("config")).strategy : EstimatorOptions{}.strategy;
+    } catch (const std::exception& e) {
+      std::cerr << "meshnav_run: " << e.what() << "\n";
+      return 1;
+    }
   }
-  if (strategy != "centralized") {
+  if (!strategyImplemented(strategy)) {
     std::cerr << "meshnav_run: unknown strategy '" << strategy << "'\n\n" << kUsage;
     return 2;
   }

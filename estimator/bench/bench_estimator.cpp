@@ -1,53 +1,164 @@
 /// @file bench_estimator.cpp
-/// @brief Google Benchmark of the estimator. Names follow `<Step>/<strategy>/<anchors>` with
-/// <anchors> the number of estimated (3-state) anchors besides the exact ones:
-///  - Propagate/centralized/N: one 5 ms IMU propagation (nominal + covariance);
-///  - RangeUpdate/centralized/N: one tag–anchor range update (linearize + EKF update);
-///  - Sequence/centralized/N: a whole synthetic 140 s sequence through EstimatorNode (as fast as
-///    possible; counter `realtime_factor`).
+/// @brief Google Benchmark of the estimator (`./meshnav bench estimator` runs it with repetitions).
+/// <strategy> ∈ {centralized, dp, dah}, <anchors> = estimated (3-state) anchors besides the exact
+/// 101–104, on the real 15-state IMU instance with two tags and the baro, in steady state after a
+/// 5 s warm-up flight (IMU 200 Hz, baro 20 Hz, one range per 10 ms slot cycling through the
+/// tag–anchor pairs and the anchor ring i → i+1):
+///  - Propagate/<s>/<n>: one 5 ms IMU propagation;
+///  - RangeUpdate/<s>/<n>: one tag–anchor range (linearize + update);
+///  - AnchorRangeUpdate/<s>/<n>: one anchor–anchor range;
+///  - DelayedRangeUpdate/<s>/<n>: through EstimatorNode, one IMU sample plus one range arriving
+///    50 ms late (rewind to the snapshot before it, re-process 50 ms of inputs);
+///  - Micro/<s>/<N>: reference scenario (a 6-state p, v body at 100 Hz, N stationary 3-state
+///    anchors, body–anchor ranges at 10 Hz each, ring i → i+1 ranges, σ 0.1 m): one range update;
+///  - Sequence/<s>: a whole simulated paper sequence (seed 1) through EstimatorNode (needs the
+///    simulator library), counter realtime_factor.
+/// Covariances are restored from the warm-up snapshot every 1000 iterations (outside the timing).
 
 #include <benchmark/benchmark.h>
 #include <spdlog/spdlog.h>
 
+#include <random>
+
+#include "estimator/filter/dense_ekf_update.h"
+#include "estimator/filter/factorized_covariance.h"
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/testing/synthetic_scenario.h"
 #include "estimator/uwb/range_model.h"
+#ifdef MESHNAV_BENCH_WITH_SIM
+#include "sim/scenario_simulator.h"
+#endif
 
 using namespace meshnav;
 using namespace meshnav::estimator;
 
 namespace {
 
-constexpr int kAnchorCounts[] = {0, 5, 9, 20};
+constexpr int kAnchorCounts[] = {5, 10, 20, 50, 100};
+const char* kStrategies[] = {"centralized", "dp", "dah"};
+constexpr int kRestoreEvery = 1000;
 
-/// A filter with the IMU, the baro and `n` estimated anchors, correlated by a few updates.
-std::unique_ptr<FusionStrategy> makeFilter(int n, UwbNetwork& net) {
-  synthetic::SyntheticOptions so;
-  so.n_estimated_anchors = n;
-  const SystemSetup setup = synthetic::syntheticSetup(so);
-  net = UwbNetwork(setup, 0.1);
-  auto f = makeStrategy(EstimatorOptions{});
-  ImuState x;
-  x.p_IinG = {0.5, 0.5, 2.0};
-  f->reset(setup.imu_id, x, ImuMatrix::Identity() * 0.01, Timestamp{});
-  f->addBaro(setup.baro_id, 0.0, 0.25);
-  for (const auto& [id, sigma] : setup.abs_anchor_sigmas_m)
-    f->addAnchor(id, setup.abs_anchor_positions.at(id), Eigen::Matrix3d::Identity() * sigma * sigma);
-  for (const auto& [id, p] : setup.abs_anchor_positions) {
-    Linearization lin;
-    RangeMeasurement z{Timestamp{}, 100, id, (p - x.p_IinG).norm(), 0.01};
-    if (RangeModel::linearize(z, f->state(), net, &lin) == RangeModel::Status::Ok) f->update(lin, 0.0);
+/// The warm-up flight as a stream of inputs (synthetic trajectory, exact readings + small range noise).
+class FlightStream {
+ public:
+  FlightStream(int n_est, double landed_s = 1.5) : opts_(options(n_est, landed_s)), traj_(landed_s, 0.5) {
+    setup_ = synthetic::syntheticSetup(opts_);
+    anchors_ = synthetic::syntheticAnchors(n_est);
+    for (const auto& [id, p] : anchors_) ids_.push_back(id);
+    for (SensorId tag : {100, 105})
+      for (SensorId a : ids_) pairs_.emplace_back(tag, a);
+    for (size_t i = 0; i < ids_.size(); ++i) pairs_.emplace_back(ids_[i], ids_[(i + 1) % ids_.size()]);
   }
-  return f;
+  static synthetic::SyntheticOptions options(int n_est, double landed_s) {
+    synthetic::SyntheticOptions o;
+    o.n_estimated_anchors = n_est;
+    o.landed_s = landed_s;
+    o.yaw0_deg = 0.5 * 180.0 / M_PI;
+    return o;
+  }
+  const SystemSetup& setup() const { return setup_; }
+  const synthetic::SyntheticTrajectory& trajectory() const { return traj_; }
+  ImuSample imu(double t) const { return traj_.imu(t); }
+  Eigen::Vector3d where(SensorId id, double t) const {
+    auto it = setup_.rel_tag_positions.find(id);
+    if (it != setup_.rel_tag_positions.end()) return traj_.position(t) + traj_.rotation(t) * it->second;
+    return anchors_.at(id);
+  }
+  RangeSample range(size_t k, double t) {
+    const auto [a, b] = pairs_[k % pairs_.size()];
+    PairBias pb{a, b, 0.0, 1.0, 0.1, 0.0, 0.0};
+    if (auto p = setup_.findPairBias(a, b)) pb = *p;
+    RangeSample r;
+    r.t = Timestamp::fromSec(t);
+    r.id_initiator = a;
+    r.id_responder = b;
+    r.type_initiator = setup_.isTag(a) ? UwbType::Tag : UwbType::Anchor;
+    r.type_responder = setup_.isTag(b) ? UwbType::Tag : UwbType::Anchor;
+    r.range_m = pb.beta * (where(a, t) - where(b, t)).norm() + pb.gamma_m + 0.05 * n01_(rng_);
+    r.range_corr_m = r.range_m;
+    r.R_m2 = 0.01;
+    return r;
+  }
+  /// Inputs of [t0, t1): IMU every 5 ms, baro every 50 ms, a range every 10 ms.
+  std::vector<EstimatorInput> inputs(double t0, double t1) {
+    std::vector<EstimatorInput> v;
+    if (t0 == 0.0) {
+      v.emplace_back(FlightStateSample{Timestamp{}, true});
+      v.emplace_back(FlightStateSample{Timestamp::fromSec(opts_.landed_s), false});
+    }
+    for (int k = static_cast<int>(std::lround(t0 * 200)); k < std::lround(t1 * 200); ++k) {
+      const double t = k / 200.0;
+      v.emplace_back(imu(t));
+      if (k % 10 == 0) {
+        const double h = (traj_.position(t) + traj_.rotation(t) * setup_.baro_p_IP).z();
+        v.emplace_back(BaroSample{Timestamp::fromSec(t), 101325.0 * std::pow(1.0 - 2.25577e-5 * h, 5.25588)});
+      }
+      if (k % 2 == 1) v.emplace_back(range(slot_++, t));
+    }
+    std::stable_sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return inputOrder(a) < inputOrder(b); });
+    return v;
+  }
+  size_t nPairs() const { return pairs_.size(); }
+  const std::vector<SensorId>& anchorIds() const { return ids_; }
+
+ private:
+  synthetic::SyntheticOptions opts_;
+  synthetic::SyntheticTrajectory traj_;
+  SystemSetup setup_;
+  std::map<SensorId, Eigen::Vector3d> anchors_;
+  std::vector<SensorId> ids_;
+  std::vector<std::pair<SensorId, SensorId>> pairs_;
+  size_t slot_ = 0;
+  std::mt19937 rng_{7};
+  std::normal_distribution<double> n01_{0.0, 1.0};
+};
+
+EstimatorOptions benchOptions(const std::string& strategy) {
+  EstimatorOptions o;
+  o.strategy = strategy;
+  o.window_s = 0.5;
+  o.uwb.gate_probability = 0.0;
+  o.baro.gate_probability = 0.0;
+  return o;
 }
 
-void Propagate(benchmark::State& state, int n) {
+/// A node after a 5 s warm-up flight (initialized from the setup's initial pose, flying).
+std::unique_ptr<EstimatorNode> warmNode(const std::string& strategy, FlightStream& fs, double until_s = 5.0) {
+  auto node = std::make_unique<EstimatorNode>(benchOptions(strategy), fs.setup());
+  for (const auto& in : fs.inputs(0.0, until_s)) node->onInput(in);
+  if (!node->initialized()) throw std::runtime_error("bench: node did not initialize");
+  return node;
+}
+
+struct Warm {
+  std::unique_ptr<FlightStream> stream;
+  std::unique_ptr<FusionStrategy> filter;
   UwbNetwork net;
-  auto f = makeFilter(n, net);
+};
+
+Warm warmFilter(const std::string& strategy, int n) {
+  Warm w;
+  w.stream = std::make_unique<FlightStream>(n);
+  w.filter = warmNode(strategy, *w.stream)->filter()->clone();
+  w.net = UwbNetwork(w.stream->setup(), 0.1);
+  return w;
+}
+
+void Propagate(benchmark::State& state, std::string strategy, int n) {
+  Warm w = warmFilter(strategy, n);
+  auto f = w.filter->clone();
   const Eigen::Vector3d acc(0.1, -0.2, 9.81), gyro(0.01, 0.02, 0.1);
-  Timestamp t = f->state().t;
+  const Timestamp t0 = f->state().t;
+  Timestamp t = t0;
+  int64_t k = 0;
   for (auto _ : state) {
+    if (++k % kRestoreEvery == 0) {
+      state.PauseTiming();
+      f = w.filter->clone();
+      t = t0;
+      state.ResumeTiming();
+    }
     t = t + Duration::fromMs(5);
     f->propagate(acc, gyro, t);
     benchmark::DoNotOptimize(f->state().imu.p_IinG.data());
@@ -55,51 +166,191 @@ void Propagate(benchmark::State& state, int n) {
   state.counters["state_dim"] = f->layout().dim();
 }
 
-void RangeUpdate(benchmark::State& state, int n) {
-  UwbNetwork net;
-  auto f = makeFilter(n, net);
-  const SensorId anchor = n > 0 ? 106 : 101;
-  const Eigen::Vector3d p_A = n > 0 ? f->state().anchor_p_AinG.at(anchor) : *net.exactAnchor(anchor);
+void Update(benchmark::State& state, std::string strategy, int n, bool anchor_anchor) {
+  Warm w = warmFilter(strategy, n);
+  auto f = w.filter->clone();
+  const auto& ids = w.stream->anchorIds();
+  std::vector<SensorId> est(ids.end() - n, ids.end());  // the estimated anchors 106…
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n01(0.0, 0.05);
+  int64_t k = 0;
   for (auto _ : state) {
-    // Keep the covariance from collapsing over millions of iterations.
-    state.PauseTiming();
-    auto g = f->clone();
-    state.ResumeTiming();
-    const double d = (p_A - g->state().imu.p_IinG).norm();
-    RangeMeasurement z{Timestamp{}, 100, anchor, d + 0.05, 0.01};
+    if (++k % kRestoreEvery == 0) {
+      state.PauseTiming();
+      f = w.filter->clone();
+      state.ResumeTiming();
+    }
+    const size_t i = static_cast<size_t>(k) % est.size();
+    RangeMeasurement z;
+    z.a = anchor_anchor ? est[i] : 100;
+    z.b = anchor_anchor ? est[(i + 1) % est.size()] : est[i];
+    z.R_m2 = 0.01;
+    z.z_m = RangeModel::predict(z, f->state(), w.net)->first + n01(rng);
     Linearization lin;
-    RangeModel::linearize(z, g->state(), net, &lin);
-    benchmark::DoNotOptimize(g->update(lin, 0.0));
+    RangeModel::linearize(z, f->state(), w.net, &lin);
+    benchmark::DoNotOptimize(f->update(lin, 0.0));
   }
   state.counters["state_dim"] = f->layout().dim();
 }
 
-void Sequence(benchmark::State& state, int n) {
-  synthetic::SyntheticOptions so;
-  so.duration_s = 140.0;
-  so.noise = true;
-  so.n_estimated_anchors = n;
-  const Dataset ds = synthetic::makeSyntheticDataset(so);
-  const auto inputs = mergeInTimeOrder(ds);
+void DelayedRangeUpdate(benchmark::State& state, std::string strategy, int n) {
+  FlightStream fs(n);
+  auto node = warmNode(strategy, fs);
+  double t = 5.0;
+  size_t slot = 0;
   for (auto _ : state) {
-    EstimatorNode node(EstimatorOptions{}, ds.setup);
+    node->onImu(fs.imu(t));
+    node->onRange(fs.range(slot++, t - 0.05));  // 50 ms late
+    t += 0.005;
+  }
+  state.counters["out_of_sequence"] = static_cast<double>(node->diagnostics().get("out_of_sequence"));
+  state.counters["history"] = static_cast<double>(node->historySize());
+}
+
+/// Micro reference scenario over the covariance core (6-state body id 1, anchors 2…N+1).
+struct MicroScenario {
+  int N;
+  Eigen::Matrix<double, 6, 6> Phi, Q;
+  std::vector<Eigen::Vector3d> anchors;
+  Eigen::Vector3d p = Eigen::Vector3d(0.5, 0.2, 1.0);
+  explicit MicroScenario(int n) : N(n) {
+    const double dt = 0.01, q = 0.1;
+    Phi.setIdentity();
+    Phi.topRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * dt;
+    Q.setZero();
+    Q.topLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() * q * dt * dt * dt / 3.0;
+    Q.topRightCorner<3, 3>() = Q.bottomLeftCorner<3, 3>() = Eigen::Matrix3d::Identity() * q * dt * dt / 2.0;
+    Q.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * q * dt;
+    for (int i = 0; i < N; ++i) {
+      const double a = 2.0 * M_PI * i / N;
+      anchors.emplace_back(4.0 * std::cos(a), 4.0 * std::sin(a), 0.5 + 2.0 * (i % 3));
+    }
+  }
+  /// Range body–anchor i (ring = false) or anchor i → i+1 (ring = true) at the true positions.
+  Linearization range(int i, bool ring) const {
+    const Eigen::Vector3d a = ring ? anchors[i] : p, b = ring ? anchors[(i + 1) % N] : anchors[i];
+    const Eigen::RowVector3d u = (b - a).normalized().transpose();
+    Linearization lin;
+    lin.residual = Eigen::VectorXd::Constant(1, 0.03);
+    lin.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
+    Eigen::MatrixXd Ha = Eigen::MatrixXd::Zero(1, ring ? 3 : 6);
+    Ha.leftCols<3>() = -u;
+    lin.blocks.push_back({ring ? 2 + i : 1, Ha});
+    lin.blocks.push_back({2 + (ring ? (i + 1) % N : i), Eigen::MatrixXd(u)});
+    return lin;
+  }
+};
+
+/// Dense reference (centralized) for the micro scenario.
+struct DenseMicro {
+  StateLayout layout;
+  Eigen::MatrixXd P;
+  void add(SensorId id, InstanceKind k, const Eigen::MatrixXd& c) {
+    const int n = layout.dim();
+    layout.add(id, k, static_cast<int>(c.rows()));
+    Eigen::MatrixXd Pn = Eigen::MatrixXd::Zero(layout.dim(), layout.dim());
+    Pn.topLeftCorner(n, n) = P;
+    Pn.bottomRightCorner(c.rows(), c.rows()) = c;
+    P = Pn;
+  }
+  void propagate(const Eigen::Matrix<double, 6, 6>& F, const Eigen::Matrix<double, 6, 6>& Q, Timestamp) {
+    P.topRows<6>() = (F * P.topRows<6>()).eval();
+    P.leftCols<6>() = (P.leftCols<6>() * F.transpose()).eval();
+    P.topLeftCorner<6, 6>() += Q;
+  }
+  void update(const Linearization& lin, Timestamp) { denseEkfUpdate(P, layout, lin, 0.0, true); }
+};
+
+struct FactorMicro {
+  FactorizedCovariance cov;
+  explicit FactorMicro(FactorizedCovariance::Mode m) : cov(m, true) {}
+  void add(SensorId id, InstanceKind k, const Eigen::MatrixXd& c) { cov.add(id, k, c, Timestamp{}); }
+  void propagate(const Eigen::Matrix<double, 6, 6>& F, const Eigen::Matrix<double, 6, 6>& Q, Timestamp t) {
+    cov.propagate(1, F, Q, t);
+  }
+  void update(const Linearization& lin, Timestamp t) { cov.update(lin, 0.0, t); }
+};
+
+template <typename F>
+void runMicro(benchmark::State& state, F f0, int N) {
+  MicroScenario sc(N);
+  f0.add(1, InstanceKind::Imu, Eigen::MatrixXd::Identity(6, 6) * 0.01);  // the "body" (kind only names it)
+  for (int i = 0; i < N; ++i) f0.add(2 + i, InstanceKind::Anchor, Eigen::MatrixXd::Identity(3, 3) * 0.04);
+  // Warm-up: 10 s at 100 Hz, every anchor ranged at 10 Hz (one body–anchor and one ring range per
+  // step, cycling), so that everything is correlated.
+  Timestamp t;
+  int k = 0;
+  for (; k < 1000; ++k) {
+    t = t + Duration::fromMs(10);
+    f0.propagate(sc.Phi, sc.Q, t);
+    for (int j = 0; j < std::max(1, N / 10); ++j) {
+      f0.update(sc.range((k * std::max(1, N / 10) + j) % N, false), t);
+      f0.update(sc.range((k * std::max(1, N / 10) + j) % N, true), t);
+    }
+  }
+  F f = f0;
+  int64_t it = 0;
+  for (auto _ : state) {
+    if (++it % kRestoreEvery == 0) {
+      state.PauseTiming();
+      f = f0;
+      state.ResumeTiming();
+    }
+    f.update(sc.range(static_cast<int>(it / 2 % N), it % 2 == 1), t);
+  }
+}
+
+void Micro(benchmark::State& state, std::string strategy, int N) {
+  if (strategy == "centralized")
+    runMicro(state, DenseMicro{}, N);
+  else
+    runMicro(state, FactorMicro(strategy == "dp" ? FactorizedCovariance::Mode::DP : FactorizedCovariance::Mode::DAH),
+             N);
+}
+
+#ifdef MESHNAV_BENCH_WITH_SIM
+const Dataset& paperSequence() {
+  static const Dataset ds = [] {
+    sim::SimulationOptions so;
+    so.seed = 1;
+    return sim::ScenarioSimulator(so).run().dataset;
+  }();
+  return ds;
+}
+
+void Sequence(benchmark::State& state, std::string strategy) {
+  const Dataset& ds = paperSequence();
+  const auto inputs = mergeInTimeOrder(ds);
+  EstimatorOptions o;
+  o.strategy = strategy;
+  for (auto _ : state) {
+    EstimatorNode node(o, ds.setup, {});
     for (const auto& in : inputs) node.onInput(in);
     benchmark::DoNotOptimize(node.pose());
   }
+  const double dur = (inputTime(inputs.back()) - inputTime(inputs.front())).sec();
   state.counters["inputs"] = static_cast<double>(inputs.size());
   state.counters["realtime_factor"] =
-      benchmark::Counter(so.duration_s * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+      benchmark::Counter(dur * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
+#endif
 
 void registerAll() {
-  for (int n : kAnchorCounts) {
-    const std::string s = std::to_string(n);
-    benchmark::RegisterBenchmark(("Propagate/centralized/" + s).c_str(), Propagate, n);
-    benchmark::RegisterBenchmark(("RangeUpdate/centralized/" + s).c_str(), RangeUpdate, n);
-  }
-  for (int n : {0, 5})
-    benchmark::RegisterBenchmark(("Sequence/centralized/" + std::to_string(n)).c_str(), Sequence, n)
-        ->Unit(benchmark::kMillisecond);
+  for (const char* s : kStrategies)
+    for (int n : kAnchorCounts) {
+      const std::string tail = std::string(s) + "/" + std::to_string(n);
+      benchmark::RegisterBenchmark(("Propagate/" + tail).c_str(), Propagate, s, n);
+      benchmark::RegisterBenchmark(("RangeUpdate/" + tail).c_str(), Update, s, n, false);
+      benchmark::RegisterBenchmark(("AnchorRangeUpdate/" + tail).c_str(), Update, s, n, true);
+      benchmark::RegisterBenchmark(("DelayedRangeUpdate/" + tail).c_str(), DelayedRangeUpdate, s, n);
+    }
+  for (const char* s : kStrategies)
+    for (int N : {2, 5, 10, 20})
+      benchmark::RegisterBenchmark(("Micro/" + std::string(s) + "/" + std::to_string(N)).c_str(), Micro, s, N);
+#ifdef MESHNAV_BENCH_WITH_SIM
+  for (const char* s : kStrategies)
+    benchmark::RegisterBenchmark(("Sequence/" + std::string(s)).c_str(), Sequence, s)->Unit(benchmark::kMillisecond);
+#endif
 }
 
 }  // namespace

@@ -34,16 +34,19 @@ struct NominalState {
   std::map<SensorId, Eigen::Vector3d> anchor_p_AinG; ///< estimated anchors' positions [m]
   std::map<SensorId, TagBiasState> tag_biases;        ///< estimated tag–anchor biases γ [m]
 
+  /// Applies the correction `dx` (size b.dim) of one instance's block.
+  template <typename Derived>
+  void boxplusBlock(const StateBlock& b, const Eigen::MatrixBase<Derived>& dx) {
+    switch (b.kind) {
+      case InstanceKind::Imu: imu.boxplus(dx.template head<ImuErr::kDim>()); break;
+      case InstanceKind::Baro: baro_bias_m.at(b.id) += dx(0); break;
+      case InstanceKind::Anchor: anchor_p_AinG.at(b.id) += dx.template head<3>(); break;
+      case InstanceKind::Tag: tag_biases.at(b.id).gamma_m += dx.head(b.dim); break;
+    }
+  }
   /// Applies a stacked error-state correction laid out as `layout`.
   void boxplus(const StateLayout& layout, const Eigen::VectorXd& dx) {
-    for (const StateBlock& b : layout.blocks()) {
-      switch (b.kind) {
-        case InstanceKind::Imu: imu.boxplus(dx.segment<ImuErr::kDim>(b.offset)); break;
-        case InstanceKind::Baro: baro_bias_m.at(b.id) += dx(b.offset); break;
-        case InstanceKind::Anchor: anchor_p_AinG.at(b.id) += dx.segment<3>(b.offset); break;
-        case InstanceKind::Tag: tag_biases.at(b.id).gamma_m += dx.segment(b.offset, b.dim); break;
-      }
-    }
+    for (const StateBlock& b : layout.blocks()) boxplusBlock(b, dx.segment(b.offset, b.dim));
   }
 };
 

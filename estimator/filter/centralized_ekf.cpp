@@ -1,5 +1,7 @@
 #include "estimator/filter/centralized_ekf.h"
 
+#include "estimator/filter/dense_ekf_update.h"
+
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <stdexcept>
@@ -86,35 +88,11 @@ void CentralizedEkf::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vec
 }
 
 UpdateResult CentralizedEkf::update(const Linearization& lin, double nis_gate) {
-  const int n = layout_.dim(), m = lin.dim();
-  // U = P Hᵀ and S = H P Hᵀ + R from the named blocks (H is zero elsewhere).
-  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n, m);
-  for (const JacobianBlock& jb : lin.blocks) {
-    const StateBlock& b = layout_.at(jb.id);
-    if (jb.H.rows() != m || jb.H.cols() != b.dim)
-      throw std::logic_error("CentralizedEkf::update: Jacobian block of " + std::to_string(jb.id) + " has wrong size");
-    U.noalias() += P_.middleCols(b.offset, b.dim) * jb.H.transpose();
-  }
-  Eigen::MatrixXd S = lin.R;
-  for (const JacobianBlock& jb : lin.blocks) {
-    const StateBlock& b = layout_.at(jb.id);
-    S.noalias() += jb.H * U.middleRows(b.offset, b.dim);
-  }
-  S = 0.5 * (S + S.transpose()).eval();
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
+  const DenseUpdateOutput out = denseEkfUpdate(P_, layout_, lin, nis_gate, joseph_form_);
   UpdateResult res;
-  res.nis = lin.residual.dot(ldlt.solve(lin.residual));
-  if (!std::isfinite(res.nis) || (nis_gate > 0.0 && res.nis > nis_gate)) return res;
-  const Eigen::MatrixXd K = ldlt.solve(U.transpose()).transpose();  // n × m
-  const Eigen::VectorXd dx = K * lin.residual;
-  if (joseph_form_) {
-    const Eigen::MatrixXd KU = K * U.transpose();
-    P_ += -KU - KU.transpose() + K * S * K.transpose();
-  } else {
-    P_.noalias() -= K * U.transpose();
-  }
-  P_ = 0.5 * (P_ + P_.transpose()).eval();
-  x_.boxplus(layout_, dx);
+  res.nis = out.nis;
+  if (!out.accepted) return res;
+  x_.boxplus(layout_, out.dx);
   res.accepted = true;
   checkInvariants("update");
   return res;
@@ -124,6 +102,13 @@ Eigen::MatrixXd CentralizedEkf::covariance(SensorId a, SensorId b) const {
   const StateBlock& ba = layout_.at(a);
   const StateBlock& bb = layout_.at(b);
   return P_.block(ba.offset, bb.offset, ba.dim, bb.dim);
+}
+
+void CentralizedEkf::checkInvariants() const {
+  if (!(P_ - P_.transpose()).isZero(1e-9 * (1.0 + P_.norm())))
+    throw std::logic_error("CentralizedEkf: covariance not symmetric");
+  if (P_.size() && Eigen::LLT<Eigen::MatrixXd>(P_).info() != Eigen::Success)
+    throw std::logic_error("CentralizedEkf: covariance not positive definite");
 }
 
 void CentralizedEkf::checkInvariants(const char* where) const {

@@ -34,6 +34,7 @@ class CentralizedEkf final : public FusionStrategy {
   const StateLayout& layout() const override { return layout_; }
   Eigen::MatrixXd covariance(SensorId a, SensorId b) const override;
   Eigen::MatrixXd fullCovariance() const override { return P_; }
+  void checkInvariants() const override;
 
  private:
   /// Appends a block with covariance `cov`, uncorrelated with the others.

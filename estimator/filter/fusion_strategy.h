@@ -1,8 +1,8 @@
 #pragma once
 /// @file fusion_strategy.h
 /// @brief The interface behind which the fusion strategies live (DESIGN §4): `centralized` (a
-/// plain full-covariance error-state EKF, the reference), and in the next issue `dp` and `dah`
-/// over isolated instances. The node (instance handler) only talks to this interface.
+/// plain full-covariance error-state EKF, the reference), `dp` and `dah` over isolated instances
+/// with factorized cross-covariances (ModularFilter, docs/modular_estimator.md). The node (instance handler) only talks to this interface.
 
 #include <Eigen/Core>
 #include <memory>
@@ -49,8 +49,12 @@ class FusionStrategy {
   virtual const StateLayout& layout() const = 0;
   /// Σ_ab between two instances with state.
   virtual Eigen::MatrixXd covariance(SensorId a, SensorId b) const = 0;
-  /// The stacked covariance in `layout()` order.
+  /// The stacked covariance in `layout()` order (for DP/DAH: reconstructed from Σ_ii and the
+  /// factors, Σ_ij = S_ij S_jiᵀ).
   virtual Eigen::MatrixXd fullCovariance() const = 0;
+  /// Throws std::logic_error unless the (reconstructed) full covariance is symmetric positive
+  /// definite and, for the modular strategies, the factor bookkeeping is consistent.
+  virtual void checkInvariants() const = 0;
 };
 
 }  // namespace meshnav::estimator

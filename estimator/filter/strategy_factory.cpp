@@ -3,17 +3,20 @@
 #include <stdexcept>
 
 #include "estimator/filter/centralized_ekf.h"
+#include "estimator/filter/modular_filter.h"
 
 namespace meshnav::estimator {
 
-bool strategyImplemented(const std::string& name) { return name == "centralized"; }
+bool strategyImplemented(const std::string& name) { return name == "centralized" || name == "dp" || name == "dah"; }
 
 std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& o) {
   if (o.strategy == "centralized")
     return std::make_unique<CentralizedEkf>(ImuPropagator(o.gravity_m_s2, o.imu), o.baro.bias_rw_m_per_sqrt_s,
                                             o.joseph_form);
   if (o.strategy == "dp" || o.strategy == "dah")
-    throw std::invalid_argument("strategy '" + o.strategy + "' is not implemented yet (next issue)");
+    return std::make_unique<ModularFilter>(o.strategy == "dp" ? ModularFilter::Mode::DP : ModularFilter::Mode::DAH,
+                                           ImuPropagator(o.gravity_m_s2, o.imu), o.baro.bias_rw_m_per_sqrt_s,
+                                           o.joseph_form);
   throw std::invalid_argument("unknown strategy '" + o.strategy + "'");
 }
 

@@ -9,9 +9,9 @@
 
 namespace meshnav::estimator {
 
-/// True for strategies this build implements ("centralized").
+/// True for strategies this build implements ("centralized", "dp", "dah").
 bool strategyImplemented(const std::string& name);
-/// Throws std::invalid_argument for unknown or not yet implemented strategies.
+/// Throws std::invalid_argument for unknown strategies.
 std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& options);
 
 }  // namespace meshnav::estimator

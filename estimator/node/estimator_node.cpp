@@ -149,6 +149,7 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   } else {
     // Out of sequence: rewind to the snapshot before its place, re-process in order.
     diag_.count("out_of_sequence");
+    ScopedStepTimer rewind_timer(timings_, "rewind");
     cur_ = pos->before->copy();
     e.before = pos->before;
     auto it = history_.insert(pos, std::move(e));

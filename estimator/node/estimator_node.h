@@ -10,6 +10,9 @@
 ///   snapshot before its place and re-processes the rest in the canonical order
 ///   (estimator_input.h), so the result equals in-order processing. Older than the window:
 ///   rejected ("rejected_too_old"). Bad values: "bad_input". Unknown range ids: "unknown_id".
+///   A snapshot is `FusionStrategy::clone()`: for dp/dah O(#instances) pointer copies
+///   (copy-on-write instances), so the history is also each instance's belief/factor history.
+///   Step timings include "rewind" (restore + re-processing of one late input).
 /// - IMU samples propagate (inputs interpolated to the middle of the step); baro and range
 ///   updates propagate to their own time with the latest reading held. While landed a
 ///   zero-velocity update runs at `zupt.rate_hz` with the latest IMU reading.

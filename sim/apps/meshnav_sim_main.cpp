@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include <exception>
+#include <random>
 #include <iostream>
 
 #include "common/cli.h"
@@ -23,6 +24,9 @@ Usage: meshnav_sim --seed N --out DIR [options]
   --drop-fraction F        fraction of dropped range messages (default 0.02)
   --duration-scale S       multiply every time constant of the flight (default 1: ~140 s)
   --no-initial-pose        do not write the take-off pad prior to setup.yaml
+  --uncertain-anchors M    write every anchor (101-110) to setup.yaml as truth + N(0, M^2) per axis
+                           (seeded by --seed) with position sigma M [m], so that the estimator
+                           refines them online; truth.yaml is unchanged (default: off, 101-104 exact)
   --help                   this text
 
 Writes imu.csv (200 Hz), baro.csv (50 Hz), ranges.csv (meshed TDMA, 11 devices, 10 ms slots),
@@ -35,7 +39,7 @@ int main(int argc, char** argv) {
   meshnav::setupLogging("meshnav_sim");
   meshnav::Cli cli("meshnav_sim", kUsage);
   cli.option("seed").option("out").option("sigma-range").option("outlier-fraction").option("drop-fraction")
-      .option("duration-scale").option("no-initial-pose", false);
+      .option("duration-scale").option("no-initial-pose", false).option("uncertain-anchors");
   int exit_code = 0;
   if (!cli.parse(argc, argv, exit_code)) return exit_code;
   if (!cli.positional().empty()) {
@@ -59,8 +63,26 @@ int main(int argc, char** argv) {
     options.validate();
     spdlog::info("simulating: {}", options.toString());
 
+    const double uncertain_sigma_m = cli.getDouble("uncertain-anchors", 0.0);
+    if (cli.has("uncertain-anchors") && !(uncertain_sigma_m > 0.0 && uncertain_sigma_m < 10.0))
+      throw std::invalid_argument("--uncertain-anchors must be in (0, 10) m");
+
     const meshnav::sim::ScenarioSimulator simulator(options);
-    const meshnav::sim::SimulationResult result = simulator.run();
+    meshnav::sim::SimulationResult result = simulator.run();
+    if (cli.has("uncertain-anchors")) {
+      // Every anchor becomes "known but uncertain": a perturbed position with its sigma.
+      if (!result.dataset.truth) throw std::logic_error("simulator returned no truth");
+      std::mt19937_64 rng(options.seed * 0x9E3779B97F4A7C15ULL + 0x5EEDULL);
+      std::normal_distribution<double> n01(0.0, 1.0);
+      auto& setup = result.dataset.setup;
+      for (const auto& [id, p] : result.dataset.truth->anchor_positions) {
+        const Eigen::Vector3d e(n01(rng), n01(rng), n01(rng));
+        setup.abs_anchor_positions[id] = p + uncertain_sigma_m * e;
+        setup.abs_anchor_sigmas_m[id] = uncertain_sigma_m;
+      }
+      spdlog::info("uncertain anchors: {} anchors written with sigma {} m", result.dataset.truth->anchor_positions.size(),
+                   uncertain_sigma_m);
+    }
     spdlog::info("{}", result.trajectory.toString());
     const std::string out = cli.get("out");
     spdlog::info("writing dataset to {}", out);

@@ -1,5 +1,5 @@
-/// End to end: simulate the paper scenario (seed 1), run meshnav_run (centralized EKF, known anchors
-/// 101–104 only), and compare estimate.csv with the ground truth.
+/// End to end: simulate the paper scenario (seed 1), run meshnav_run (centralized EKF, DP and DAH;
+/// known anchors 101–104 only), and compare estimate.csv with the ground truth.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -20,17 +20,16 @@ int run(const std::string& cmd) {
   return std::system(cmd.c_str());
 }
 
-}  // namespace
-
-TEST(EndToEnd, CentralizedEkfOnSimulatedSeed1) {
-  const fs::path dir = fs::path(::testing::TempDir()) / "meshnav_e2e_estimator";
+void runAndCheck(const std::string& strategy) {
+  const fs::path dir = fs::path(::testing::TempDir()) / ("meshnav_e2e_estimator_" + strategy);
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path data = dir / "seed1", out = dir / "run";
   ASSERT_EQ(run(std::string(MESHNAV_SIM_BIN) + " --seed 1 --out " + data.string() + " > " + (dir / "sim.log").string() +
                 " 2>&1"),
             0);
-  ASSERT_EQ(run(std::string(MESHNAV_RUN_BIN) + " --dataset " + data.string() + " --out " + out.string() + " > " +
+  ASSERT_EQ(run(std::string(MESHNAV_RUN_BIN) + " --strategy " + strategy + " --dataset " + data.string() + " --out " +
+                out.string() + " > " +
                 (dir / "run.log").string() + " 2>&1"),
             0);
   for (const char* f : {"estimate.csv", "anchors.csv", "timings.csv", "status.txt"})
@@ -62,7 +61,7 @@ TEST(EndToEnd, CentralizedEkfOnSimulatedSeed1) {
   ASSERT_GT(n, 5000);
   const double rmse_p = std::sqrt(sq_p / n), rmse_q_deg = std::sqrt(sq_q / n) * 180.0 / M_PI;
   const double anees_p = nees / n;
-  std::cout << "seed 1: position RMSE " << rmse_p << " m, orientation RMSE " << rmse_q_deg
+  std::cout << strategy << ", seed 1: position RMSE " << rmse_p << " m, orientation RMSE " << rmse_q_deg
             << " deg, position ANEES " << anees_p << " (" << n << " samples)" << std::endl;
   EXPECT_LE(rmse_p, 0.15);
   // The target: orientation RMSE <= 3 deg.
@@ -70,3 +69,9 @@ TEST(EndToEnd, CentralizedEkfOnSimulatedSeed1) {
   EXPECT_GE(anees_p, 1.0);
   EXPECT_LE(anees_p, 6.0);
 }
+
+}  // namespace
+
+TEST(EndToEnd, CentralizedEkfOnSimulatedSeed1) { runAndCheck("centralized"); }
+TEST(EndToEnd, DpOnSimulatedSeed1) { runAndCheck("dp"); }
+TEST(EndToEnd, DahOnSimulatedSeed1) { runAndCheck("dah"); }

@@ -224,8 +224,12 @@ TEST(EstimatorNode, AnchorInitAddsAnEstimatedAnchorThatIsRefined) {
   EXPECT_EQ(node.diagnostics().get("unknown_id"), unknown_before + 1);
 }
 
-TEST(EstimatorNode, UnimplementedStrategyIsRefused) {
+TEST(EstimatorNode, UnknownStrategyIsRefusedAndModularOnesAreBuilt) {
   EstimatorOptions o;
-  o.strategy = "dah";
+  o.strategy = "fastest";
   EXPECT_THROW(EstimatorNode(o, synthetic::syntheticSetup({})), std::invalid_argument);
+  for (const char* s : {"centralized", "dp", "dah"}) {
+    o.strategy = s;
+    EXPECT_NO_THROW(EstimatorNode(o, synthetic::syntheticSetup({}))) << s;
+  }
 }

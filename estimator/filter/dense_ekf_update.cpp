@@ -1,0 +1,44 @@
+#include "estimator/filter/dense_ekf_update.h"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace meshnav::estimator {
+
+DenseUpdateOutput denseEkfUpdate(Eigen::MatrixXd& P, const StateLayout& layout, const Linearization& lin,
+                                 double nis_gate, bool joseph_form) {
+  const int n = layout.dim(), m = lin.dim();
+  // U = P Hᵀ and S = H P Hᵀ + R from the named blocks (H is zero elsewhere).
+  Eigen::MatrixXd U = Eigen::MatrixXd::Zero(n, m);
+  for (const JacobianBlock& jb : lin.blocks) {
+    const StateBlock& b = layout.at(jb.id);
+    if (jb.H.rows() != m || jb.H.cols() != b.dim)
+      throw std::logic_error("EKF update: Jacobian block of " + std::to_string(jb.id) + " has wrong size");
+    U.noalias() += P.middleCols(b.offset, b.dim) * jb.H.transpose();
+  }
+  Eigen::MatrixXd S = lin.R;
+  for (const JacobianBlock& jb : lin.blocks) {
+    const StateBlock& b = layout.at(jb.id);
+    S.noalias() += jb.H * U.middleRows(b.offset, b.dim);
+  }
+  S = 0.5 * (S + S.transpose()).eval();
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
+  DenseUpdateOutput out;
+  out.nis = lin.residual.dot(ldlt.solve(lin.residual));
+  if (!std::isfinite(out.nis) || (nis_gate > 0.0 && out.nis > nis_gate)) return out;
+  out.K = ldlt.solve(U.transpose()).transpose();  // n × m
+  out.dx = out.K * lin.residual;
+  if (joseph_form) {
+    const Eigen::MatrixXd KU = out.K * U.transpose();
+    P += -KU - KU.transpose() + out.K * S * out.K.transpose();
+  } else {
+    P.noalias() -= out.K * U.transpose();
+  }
+  P = 0.5 * (P + P.transpose()).eval();
+  out.accepted = true;
+  return out;
+}
+
+}  // namespace meshnav::estimator

@@ -1,0 +1,61 @@
+#pragma once
+/// @file modular_filter.h
+/// @brief Strategies `dp` and `dah` (DESIGN §4, docs/modular_estimator.md): the nominal state of
+/// every instance (NominalState, addressed by id) plus the isolated instance beliefs with
+/// factorized cross-covariances (FactorizedCovariance).
+///
+/// - Propagation is isolated: only the IMU instance (x_I, Σ_II, L_I ← Φ L_I) and the baro bias
+///   (Σ_bb += σ_b² Δt) change; no factor is touched.
+/// - DP: every update on the full stacked state (equal to `centralized` to rounding). A private
+///   measurement (ZUPT) is a full update too: the exact update also corrects the means of the
+///   instances correlated with the IMU (K_k = Σ_kI Hᵀ S⁻¹ ≠ 0).
+/// - DAH: an update stacks the instances named by the measurement (ZUPT: {IMU}; baro: {IMU, baro};
+///   tag–anchor range: {IMU, anchor} or {IMU, tag} for an estimated γ; anchor–anchor: {a, b}); the
+///   others' means are not corrected and their correlations are approximated.
+/// clone() copies pointers only (copy-on-write instances): cheap snapshots for the node's rewinds.
+
+#include "estimator/filter/factorized_covariance.h"
+#include "estimator/filter/fusion_strategy.h"
+#include "estimator/imu/imu_propagator.h"
+
+namespace meshnav::estimator {
+
+class ModularFilter final : public FusionStrategy {
+ public:
+  using Mode = FactorizedCovariance::Mode;
+  ModularFilter(Mode mode, const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s, bool joseph_form);
+
+  std::string name() const override { return cov_.mode() == Mode::DP ? "dp" : "dah"; }
+  std::unique_ptr<FusionStrategy> clone() const override { return std::make_unique<ModularFilter>(*this); }
+
+  void reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) override;
+  void addBaro(SensorId id, double bias_m, double var_m2) override;
+  void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) override;
+  void addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
+                    const Eigen::VectorXd& var_m2) override;
+  bool removeInstance(SensorId id) override;
+
+  void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) override;
+  UpdateResult update(const Linearization& lin, double nis_gate) override;
+
+  const NominalState& state() const override { return x_; }
+  const StateLayout& layout() const override { return cov_.layout(); }
+  Eigen::MatrixXd covariance(SensorId a, SensorId b) const override { return cov_.block(a, b); }
+  Eigen::MatrixXd fullCovariance() const override { return cov_.full(); }
+  void checkInvariants() const override { cov_.checkInvariants("explicit check"); }
+
+  /// The instances (beliefs, pending factors, factor dictionaries).
+  const FactorizedCovariance& instances() const { return cov_; }
+  /// Folds instance `id`'s pending factor into its factors (exact; for tests and maintenance).
+  void renormalize(SensorId id) { cov_.renormalize(id); }
+
+ private:
+  void checkAfter(const char* where) const;
+
+  ImuPropagator propagator_;
+  double baro_bias_rw_;
+  NominalState x_;
+  FactorizedCovariance cov_;
+};
+
+}  // namespace meshnav::estimator
