@@ -1,7 +1,8 @@
 /// @file meshnav_run.cpp
 /// @brief The whole pipeline in one process, deterministic and as fast as possible (DESIGN §8):
 /// reads a dataset, merges every sample into time order, feeds the estimator node, writes
-/// estimate.csv, anchors.csv, timings.csv and status.txt into --out.
+/// estimate.csv, anchors.csv, timings.csv and status.txt into --out. The estimator, calibrator and
+/// mission nodes run in one `pipeline::Pipeline`, wired as the processes are over LCM.
 
 #include <spdlog/spdlog.h>
 
@@ -16,6 +17,8 @@
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/node/estimator_input.h"
 #include "estimator/node/estimator_node.h"
+#include "calibrator/calibration_io.h"
+#include "pipeline/pipeline.h"
 
 using namespace meshnav;
 using namespace meshnav::estimator;
@@ -24,14 +27,20 @@ namespace {
 
 const char* kUsage = R"(meshnav_run — run the estimator on a dataset folder, as fast as possible.
 
-Usage: meshnav_run --dataset DIR --out DIR [--strategy centralized|dp|dah] [--config FILE] [--mission FILE]
+Usage: meshnav_run --dataset DIR --out DIR [--strategy centralized|dp|dah] [--config FILE]
+                   [--mission FILE | --no-calibration] [--calib-config FILE]
 
   --dataset DIR    dataset folder (imu.csv, baro.csv, ranges.csv, flight_state.csv, setup.yaml)
   --out DIR        output folder (created): estimate.csv, anchors.csv, timings.csv, status.txt
   --strategy S     fusion strategy: centralized (dense EKF), dp (modular, centralized-equivalent),
                    dah (modular, updates only the involved instances); default: the config's
   --config FILE    estimator options YAML (default: built-in defaults = config/estimator.yaml)
-  --mission FILE   mission script (accepted; calibration is a later issue, so it is ignored)
+  --mission FILE   mission script (YAML steps: collect / calibrate anchors at dataset times,
+                   e.g. config/missions/paper_s2.yaml); without one, new anchors are collected
+                   and calibrated automatically once their data suffices
+  --no-calibration known anchors only: ranges to unknown anchors are ignored (and counted)
+  --calib-config FILE  calibrator options YAML (default: built-in = config/calibrator.yaml);
+                   calibration results are written to calibration.yaml in --out
   --print-config   print the estimator options (defaults or --config) as YAML and exit
   --help           this text
 )";
@@ -63,6 +72,7 @@ int main(int argc, char** argv) {
   setupLogging("meshnav_run");
   Cli cli("meshnav_run", kUsage);
   cli.option("dataset").option("out").option("strategy").option("config").option("mission");
+  cli.option("no-calibration", false).option("calib-config");
   cli.option("print-config", false);
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
@@ -96,8 +106,18 @@ int main(int argc, char** argv) {
     EstimatorOptions options;
     if (cli.has("config")) options = EstimatorOptions::fromYaml(cli.get("config"));
     options.strategy = strategy;
-    if (cli.has("mission"))
-      spdlog::warn("--mission {} is ignored: anchor calibration comes with a later issue", cli.get("mission"));
+    if (cli.has("mission") && cli.has("no-calibration")) {
+      std::cerr << "meshnav_run: --mission and --no-calibration exclude each other\n";
+      return 2;
+    }
+    pipeline::PipelineOptions popts;
+    popts.estimator = options;
+    popts.calibration_enabled = !cli.has("no-calibration");
+    if (cli.has("calib-config")) {
+      popts.calibrator = calib::CalibratorOptions::load(cli.get("calib-config"));
+      popts.calibrator_node = calib::CalibratorNodeOptions::load(cli.get("calib-config"));
+    }
+    if (cli.has("mission")) popts.mission = mission::loadMission(cli.get("mission"));
 
     Diagnostics diag;
     const std::string dir = cli.get("dataset");
@@ -116,8 +136,15 @@ int main(int argc, char** argv) {
     sinks.anchors = [&](const std::vector<AnchorEstimate>& v) {
       for (const auto& a : v) anchor_writer.write(a);
     };
-    EstimatorNode node(options, ds.setup, sinks);
+    pipeline::PipelineSinks psinks;
+    psinks.pose = sinks.pose;
+    psinks.anchors = sinks.anchors;
+    pipeline::Pipeline pipe(popts, ds.setup, psinks);
+    EstimatorNode& node = pipe.estimator();
     spdlog::info("estimator options:\n{}", node.options().toString());
+    spdlog::info("calibration: {}", !popts.calibration_enabled ? "off (known anchors only)"
+                                    : popts.mission ? "by mission " + cli.get("mission")
+                                                    : std::string("automatic"));
 
     const std::vector<EstimatorInput> inputs = mergeInTimeOrder(ds);
     if (inputs.empty()) throw std::runtime_error(dir + ": no samples");
@@ -126,7 +153,7 @@ int main(int argc, char** argv) {
     const auto wall0 = std::chrono::steady_clock::now();
     int next_progress = 1;
     for (size_t i = 0; i < inputs.size(); ++i) {
-      node.onInput(inputs[i]);
+      pipe.onInput(inputs[i]);
       if (data_s > 0 && (inputTime(inputs[i]) - t_first).sec() >= next_progress * 0.25 * data_s) {
         spdlog::info("progress {:3d}% (t = {} s)", next_progress * 25, formatSeconds(inputTime(inputs[i])));
         ++next_progress;
@@ -138,6 +165,15 @@ int main(int argc, char** argv) {
     est_writer.flush();
     anchor_writer.flush();
     writeTimings(node.timings(), (out_dir / "timings.csv").string());
+    if (const auto* cal = pipe.calibrator()) {
+      calib::writeCalibrationYaml(cal->results(), (out_dir / "calibration.yaml").string());
+      spdlog::info("calibration: {} anchors initialized ({}), results in calibration.yaml", pipe.anchorInits().size(),
+                   [&] {
+                     std::string ids;
+                     for (const auto& a : pipe.anchorInits()) ids += (ids.empty() ? "" : ",") + std::to_string(a.id);
+                     return ids.empty() ? std::string("none") : ids;
+                   }());
+    }
     const EstimatorStatus st = node.status();
     writeStatus(st, wall_s, data_s, (out_dir / "status.txt").string());
 

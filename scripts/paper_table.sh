@@ -7,11 +7,12 @@
 #   --mission FILE         mission file for meshnav_run (fly-by calibration)
 #   --config FILE          estimator options
 #   --sim-args "..."       extra meshnav_sim options (e.g. "--outlier-fraction 0.1")
+#   --run-args "..."       extra meshnav_run options (e.g. "--no-calibration")
 #   --table-md FILE        also write the table as Markdown
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${MESHNAV_BUILD_DIR:-$ROOT/build}/bin"
-seeds="1-12"; strategy="centralized"; out=""; mission=""; config=""; sim_args=""; table_md=""
+seeds="1-12"; strategy="centralized"; out=""; mission=""; config=""; sim_args=""; run_args_extra=""; table_md=""
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --seeds) seeds="$2"; shift 2 ;;
@@ -20,8 +21,9 @@ while [[ $# -gt 0 ]]; do
     --mission) mission="$2"; shift 2 ;;
     --config) config="$2"; shift 2 ;;
     --sim-args) sim_args="$2"; shift 2 ;;
+    --run-args) run_args_extra="$2"; shift 2 ;;
     --table-md) table_md="$2"; shift 2 ;;
-    -h|--help) sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "paper_table: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -37,6 +39,8 @@ for ((s = first; s <= last; s++)); do
   run_args=(--dataset "$d/dataset" --out "$d/run" --strategy "$strategy")
   [[ -n "$mission" ]] && run_args+=(--mission "$mission")
   [[ -n "$config" ]] && run_args+=(--config "$config")
+  # shellcheck disable=SC2206
+  [[ -n "$run_args_extra" ]] && run_args+=($run_args_extra)
   "$BIN/meshnav_run" "${run_args[@]}" > "$d/run.log" 2>&1 || { cat "$d/run.log"; exit 1; }
   "$BIN/meshnav_eval" --dataset "$d/dataset" --run "$d/run" --no-plots --only-flying > "$d/eval.log" 2>&1 \
     || { cat "$d/eval.log"; exit 1; }
