@@ -10,7 +10,9 @@
 
 #include "common/cli.h"
 #include "common/dataset.h"
+#include "sim/paper_scenario.h"
 #include "sim/scenario_simulator.h"
+#include "sim/uwb_hardware_biases.h"
 
 namespace {
 constexpr const char* kUsage = R"(meshnav_sim: simulate one sequence of the paper's scenario (DESIGN §7)
@@ -26,7 +28,8 @@ Usage: meshnav_sim --seed N --out DIR [options]
   --no-initial-pose        do not write the take-off pad prior to setup.yaml
   --uncertain-anchors M    write every anchor (101-110) to setup.yaml as truth + N(0, M^2) per axis
                            (seeded by --seed) with position sigma M [m], so that the estimator
-                           refines them online; truth.yaml is unchanged (default: off, 101-104 exact)
+                           refines them online, with a-priori pair biases for every pair (as for
+                           101-104); truth.yaml is unchanged (default: off, 101-104 exact)
   --help                   this text
 
 Writes imu.csv (200 Hz), baro.csv (50 Hz), ranges.csv (meshed TDMA, 11 devices, 10 ms slots),
@@ -80,8 +83,16 @@ int main(int argc, char** argv) {
         setup.abs_anchor_positions[id] = p + uncertain_sigma_m * e;
         setup.abs_anchor_sigmas_m[id] = uncertain_sigma_m;
       }
-      spdlog::info("uncertain anchors: {} anchors written with sigma {} m", result.dataset.truth->anchor_positions.size(),
-                   uncertain_sigma_m);
+      // Known-but-uncertain anchors come with their a-priori pair biases, like 101–104: every pair
+      // of devices gets the hardware bias plus the same calibration error model (σ_γ in setup).
+      const meshnav::sim::UwbHardwareBiases hw(meshnav::sim::PaperScenario::paper().uwbDeviceIds(), options.hardware);
+      const auto ids = meshnav::sim::PaperScenario::paper().uwbDeviceIds();
+      for (size_t i = 0; i < ids.size(); ++i)
+        for (size_t j = i + 1; j < ids.size(); ++j)
+          if (!setup.findPairBias(ids[i], ids[j]) && !(setup.isTag(ids[i]) && setup.isTag(ids[j])))
+            setup.pair_biases.push_back(hw.calibrated(ids[i], ids[j], options.uwb.sigma_range_m));
+      spdlog::info("uncertain anchors: {} anchors written with sigma {} m, {} a-priori pair biases",
+                   result.dataset.truth->anchor_positions.size(), uncertain_sigma_m, setup.pair_biases.size());
     }
     spdlog::info("{}", result.trajectory.toString());
     const std::string out = cli.get("out");
