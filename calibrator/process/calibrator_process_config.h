@@ -1,0 +1,69 @@
+#pragma once
+/// @file calibrator_process_config.h
+/// @brief What the `calibrator` process reads from its command line and `--config` file, free of
+/// LCM so that it is unit-tested (tests/integration/process_config_test.cpp): the option list, the
+/// loading of `config/calibrator.yaml` (`calibrator:` + `calibrator_node:` maps), `--auto`, the
+/// range σ_d taken from setup.yaml, and the calibration results file written during the run.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "calibrator/calibration_types.h"
+#include "calibrator/calibrator_options.h"
+#include "calibrator/node/calibrator_node_options.h"
+#include "common/cli.h"
+#include "common/setup.h"
+
+namespace meshnav::calib {
+
+/// Options of the `calibrator` process.
+struct CalibratorProcessConfig {
+  std::string setup_path;           ///< --setup (required to run)
+  std::string config_path;          ///< --config ("" = built-in defaults)
+  std::string out_yaml;             ///< --out-yaml ("" = none)
+  double pose_rate_hz = 50.0;       ///< --pose-rate: POSE decimation towards the node (0 = every pose) [Hz]
+  double heartbeat_s = 1.0;         ///< --heartbeat: wall time between CALIB_STATUS heartbeats [s]
+  bool print_config = false;        ///< --print-config
+  CalibratorOptions calibrator;     ///< `calibrator:` of --config
+  CalibratorNodeOptions node;       ///< `calibrator_node:` of --config, auto_mode forced on by --auto
+  /// Whether --config sets `calibrator.sigma_range`; if not, applySetup() takes setup.yaml's.
+  bool sigma_range_from_config = false;
+  std::string sigma_range_source = "built-in default";  ///< for the log
+
+  /// Multi-line listing (YAML-like, both option maps and the process options).
+  std::string toString() const;
+};
+
+/// The process's usage text (without the common process options).
+extern const char* const kCalibratorProcessUsage;
+
+/// Declares every option of the process on `cli` (including the common ones of
+/// transport/process_options.h: --lcm-url, --config, --log-level).
+void declareCalibratorProcessOptions(Cli& cli);
+
+/// Reads the parsed command line and loads --config. Throws std::runtime_error naming the option
+/// (or the file and key) on a bad value.
+CalibratorProcessConfig calibratorProcessConfig(const Cli& cli);
+
+/// σ_d from `setup.noise.sigma_range` unless the config file set it.
+void applySetup(CalibratorProcessConfig& config, const SystemSetup& setup);
+
+/// Writes the calibration results YAML (calibration_io.h) when the number of calibration attempts
+/// changed since the last write; the file is replaced atomically (written beside, then renamed), so
+/// a reader never sees half a file.
+class CalibrationYamlWriter {
+ public:
+  explicit CalibrationYamlWriter(std::string path) : path_(std::move(path)) {}
+  bool enabled() const { return !path_.empty(); }
+  const std::string& path() const { return path_; }
+  /// `attempts` = calibrations done so far (ok + refused). Writes when it changed, or when
+  /// `force` (on exit). Returns true when written; I/O errors are logged and return false.
+  bool update(const std::vector<CalibrationResult>& results, int64_t attempts, bool force = false);
+
+ private:
+  std::string path_;
+  int64_t written_attempts_ = -1;
+};
+
+}  // namespace meshnav::calib

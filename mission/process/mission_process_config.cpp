@@ -1,0 +1,141 @@
+#include "mission/process/mission_process_config.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace meshnav::mission {
+
+const char* const kMissionProcessUsage =
+    "mission --mission FILE [options]\n"
+    "  Runs a mission script (mission/README.md) in data time: subscribes POSE, RANGE (data time;\n"
+    "  see --time-from), CALIB_STATUS, ESTIMATOR_STATUS; publishes CALIB_CMD, ESTIMATOR_CMD and\n"
+    "  MISSION_STATUS (also a wall-clock heartbeat). Step times are seconds after t0. Exits once\n"
+    "  every step ran and the calibrator answered the last Calibrate (or --linger passed), unless\n"
+    "  --stay.\n"
+    "  --mission FILE     mission script (e.g. config/missions/paper_s2.yaml)\n"
+    "  --t0 S|auto        dataset time [s] of step time 0 (e.g. 0 for meshnav_sim datasets);\n"
+    "                     auto (default): the first data time received (start the mission before\n"
+    "                     the data flows)\n"
+    "  --time-from LIST   comma-separated channels whose message time advances the mission clock,\n"
+    "                     besides POSE (which starts only once the estimator initialized):\n"
+    "                     RANGE, IMU, BARO, FLIGHT_STATE, or none (default RANGE)\n"
+    "  --stay             keep running (heartbeat) after the mission finished\n"
+    "  --linger S         wall seconds to wait for the calibrator's answer to the last step\n"
+    "                     before exiting (default 10)\n"
+    "  --status-period S  MISSION_STATUS period in data time (default 1)\n"
+    "  --heartbeat S      wall seconds between heartbeat MISSION_STATUS (default 1)\n"
+    "  --print-config     print the options and exit\n";
+
+void declareMissionProcessOptions(Cli& cli) {
+  cli.option("mission").option("t0").option("time-from").option("linger").option("status-period").option("heartbeat");
+  cli.option("stay", false).option("print-config", false);
+  cli.option("lcm-url").option("config").option("log-level");
+}
+
+namespace {
+
+double number(const Cli& cli, const std::string& name, double fallback, double min, bool strict) {
+  const double v = cli.getDouble(name, fallback);  // throws naming the option when not a number
+  if (!std::isfinite(v) || v < min || (strict && v == min)) {
+    std::ostringstream s;
+    s << "--" << name << " must be " << (strict ? "> " : ">= ") << min << ", got '" << cli.get(name) << "'";
+    throw std::runtime_error(s.str());
+  }
+  return v;
+}
+
+std::vector<std::string> splitChannels(const std::string& list) {
+  std::vector<std::string> out;
+  if (list == "none" || list.empty()) return out;
+  std::stringstream ss(list);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    item.erase(0, item.find_first_not_of(" \t"));
+    item.erase(item.find_last_not_of(" \t") + 1);
+    if (item.empty()) continue;
+    if (std::find(kTimeChannels.begin(), kTimeChannels.end(), item) == kTimeChannels.end())
+      throw std::runtime_error("--time-from: unknown channel '" + item + "' (RANGE, IMU, BARO, FLIGHT_STATE or none)");
+    if (std::find(out.begin(), out.end(), item) == out.end()) out.push_back(item);
+  }
+  return out;
+}
+
+}  // namespace
+
+MissionProcessConfig missionProcessConfig(const Cli& cli) {
+  MissionProcessConfig c;
+  c.mission_path = cli.get("mission");
+  c.print_config = cli.has("print-config");
+  c.stay = cli.has("stay");
+  const std::string t0 = cli.get("t0", "auto");
+  if (t0 != "auto") {
+    const double v = cli.getDouble("t0", 0.0);
+    if (!std::isfinite(v)) throw std::runtime_error("--t0 must be a finite number of seconds or auto");
+    c.t0_s = v;
+  }
+  if (cli.has("time-from")) c.time_channels = splitChannels(cli.get("time-from"));
+  c.linger_s = number(cli, "linger", 10.0, 0.0, false);
+  c.status_period_s = number(cli, "status-period", 1.0, 0.0, true);
+  c.heartbeat_s = number(cli, "heartbeat", 1.0, 0.0, true);
+  return c;
+}
+
+std::string MissionProcessConfig::toString() const {
+  std::ostringstream s;
+  s << "mission: " << (mission_path.empty() ? "(none)" : mission_path) << "\n";
+  s << "t0: " << (t0_s ? std::to_string(*t0_s) : std::string("auto (first data time)")) << "  # [s]\n";
+  s << "time_from: [POSE";
+  for (const auto& ch : time_channels) s << ", " << ch;
+  s << "]\n";
+  s << "stay: " << (stay ? "true" : "false") << "\n";
+  s << "linger: " << linger_s << "  # [s] wall time\n";
+  s << "status_period: " << status_period_s << "  # [s] data time\n";
+  s << "heartbeat: " << heartbeat_s << "  # [s] wall time\n";
+  return s.str();
+}
+
+MissionCompletion::MissionCompletion(const Mission& mission, double linger_s) : linger_s_(linger_s) {
+  if (!mission.steps.empty() && mission.steps.back().action == MissionAction::Calibrate)
+    last_calibrate_ = mission.steps.back();
+  answered_ = !last_calibrate_;
+}
+
+int64_t MissionCompletion::attempts(const CalibStatus& s) {
+  int64_t n = 0;
+  for (const char* key : {"calibrations_ok", "calibrations_refused"}) {
+    const auto it = s.counters.find(key);
+    if (it != s.counters.end()) n += it->second;
+  }
+  return n;
+}
+
+void MissionCompletion::onCalibStatus(const CalibStatus& s) {
+  attempts_seen_ = std::max(attempts_seen_, attempts(s));
+  if (answered_ || !attempts_at_finish_) return;
+  const int64_t expected = std::max<int64_t>(1, static_cast<int64_t>(last_calibrate_->anchors.size()));
+  if (attempts(s) < *attempts_at_finish_ + expected) return;
+  for (const auto& a : s.anchors) {
+    const auto& ids = last_calibrate_->anchors;
+    const bool named = ids.empty() || std::find(ids.begin(), ids.end(), a.id) != ids.end();
+    if (named && a.state == "collecting") return;
+  }
+  answered_ = true;
+}
+
+void MissionCompletion::onFinished(int64_t wall_us) {
+  if (finished_wall_us_) return;
+  finished_wall_us_ = wall_us;
+  attempts_at_finish_ = attempts_seen_;
+}
+
+bool MissionCompletion::done(int64_t wall_us) const {
+  return finished_wall_us_ && (answered_ || timedOut(wall_us));
+}
+
+bool MissionCompletion::timedOut(int64_t wall_us) const {
+  return finished_wall_us_ && !answered_ && static_cast<double>(wall_us - *finished_wall_us_) >= linger_s_ * 1e6;
+}
+
+}  // namespace meshnav::mission

@@ -1,0 +1,94 @@
+#pragma once
+/// @file mission_process_config.h
+/// @brief The `mission` process's options and its small bits of logic, free of LCM so that they
+/// are unit-tested (tests/integration/process_config_test.cpp):
+///  - MissionProcessConfig: command line → options (`--t0 S|auto`, `--time-from CHANNELS`, ...);
+///  - DataClock: data time over LCM comes from several channels (RANGE, POSE, ...) that do not
+///    arrive in time order with respect to each other (POSE lags RANGE by the estimator's
+///    processing); only advancing times are passed on to the MissionNode;
+///  - MissionCompletion: when a finished mission may let the process exit (its last Calibrate
+///    command answered by the calibrator, or a wall-clock linger passed).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/cli.h"
+#include "common/messages.h"
+#include "common/time.h"
+#include "mission/mission.h"
+
+namespace meshnav::mission {
+
+/// Data channels whose message time may drive the mission clock (POSE always does).
+inline const std::vector<std::string> kTimeChannels = {"RANGE", "IMU", "BARO", "FLIGHT_STATE"};
+
+struct MissionProcessConfig {
+  std::string mission_path;                     ///< --mission (required)
+  std::optional<double> t0_s;                   ///< --t0: dataset time of step time 0 [s]; nullopt (auto): first data time
+  std::vector<std::string> time_channels = {"RANGE"};  ///< --time-from: channels besides POSE that advance data time
+  bool stay = false;                            ///< --stay: keep running after the mission finished
+  double linger_s = 10.0;                       ///< --linger: wall time to wait for the calibrator's answer to the last step [s]
+  double heartbeat_s = 1.0;                     ///< --heartbeat: wall time between MISSION_STATUS heartbeats [s]
+  double status_period_s = 1.0;                 ///< --status-period: MISSION_STATUS period in data time [s]
+  bool print_config = false;                    ///< --print-config
+  std::string toString() const;
+};
+
+/// The process's usage text (without the common process options).
+extern const char* const kMissionProcessUsage;
+
+/// Declares every option of the process on `cli` (including --lcm-url, --config, --log-level).
+void declareMissionProcessOptions(Cli& cli);
+
+/// Reads the parsed command line. Throws std::runtime_error naming the option on a bad value.
+MissionProcessConfig missionProcessConfig(const Cli& cli);
+
+/// Passes on only advancing data times (several channels, arriving out of order between them).
+class DataClock {
+ public:
+  /// True when `t` is newer than every time seen so far (then it is the new data time).
+  bool advance(Timestamp t) {
+    if (now_ && t <= *now_) return false;
+    now_ = t;
+    return true;
+  }
+  std::optional<Timestamp> now() const { return now_; }
+
+ private:
+  std::optional<Timestamp> now_;
+};
+
+/// Decides when the process of a finished mission may exit. When the mission's last step is a
+/// Calibrate, the process waits until a CALIB_STATUS received after the mission finished shows the
+/// calibrator answered it: its attempt count (counters calibrations_ok + calibrations_refused) grew
+/// past the count known when the mission finished, and none of the step's anchors (all anchors
+/// for an empty list) is still "collecting". Otherwise, or after `linger_s` of wall time, it may
+/// exit right away.
+class MissionCompletion {
+ public:
+  MissionCompletion(const Mission& mission, double linger_s);
+  /// Every CALIB_STATUS (before and after the mission finished).
+  void onCalibStatus(const CalibStatus& s);
+  /// The mission node reported finished() at wall time `wall_us` (first call counts).
+  void onFinished(int64_t wall_us);
+  bool finished() const { return finished_wall_us_.has_value(); }
+  /// The calibrator answered the last step (or there is nothing to wait for).
+  bool answered() const { return answered_; }
+  /// May exit now: finished and (answered or lingered `linger_s`).
+  bool done(int64_t wall_us) const;
+  /// The linger ran out without an answer (for a warning).
+  bool timedOut(int64_t wall_us) const;
+
+ private:
+  static int64_t attempts(const CalibStatus& s);
+  std::optional<MissionStep> last_calibrate_;  ///< the last step, when it is a Calibrate
+  double linger_s_;
+  int64_t attempts_seen_ = 0;                  ///< in the newest CALIB_STATUS
+  std::optional<int64_t> attempts_at_finish_;
+  std::optional<int64_t> finished_wall_us_;
+  bool answered_ = false;
+};
+
+}  // namespace meshnav::mission

@@ -1,0 +1,348 @@
+/// Unit tests of the LCM-free parts of the `calibrator` and `mission` processes
+/// (calibrator/process/calibrator_process_config.h, mission/process/mission_process_config.h):
+/// option parsing, config loading, σ_d from setup.yaml, the results file, the mission clock and
+/// when a finished mission lets its process exit.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "calibrator/calibration_io.h"
+#include "calibrator/process/calibrator_process_config.h"
+#include "mission/process/mission_process_config.h"
+
+namespace {
+
+using namespace meshnav;
+namespace fs = std::filesystem;
+
+/// Parses `args` (without the program name) with `declare`d options; returns the parse result.
+struct Parsed {
+  std::unique_ptr<Cli> cli;
+  bool ok = false;
+  int code = -1;
+};
+template <typename Declare>
+Parsed parse(const std::string& program, Declare declare, std::vector<std::string> args) {
+  Parsed p;
+  p.cli = std::make_unique<Cli>(program, "usage");
+  declare(*p.cli);
+  std::vector<char*> argv{const_cast<char*>(program.c_str())};
+  for (auto& a : args) argv.push_back(a.data());
+  p.ok = p.cli->parse(static_cast<int>(argv.size()), argv.data(), p.code);
+  return p;
+}
+
+class TempDir {
+ public:
+  TempDir() {
+    path_ = fs::temp_directory_path() / ("meshnav_process_config_" + std::to_string(::getpid()) + "_" +
+                                         std::to_string(counter_++));
+    fs::create_directories(path_);
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  std::string file(const std::string& name, const std::string& text = "") const {
+    const auto p = (path_ / name).string();
+    if (!text.empty()) std::ofstream(p) << text;
+    return p;
+  }
+
+ private:
+  fs::path path_;
+  static inline int counter_ = 0;
+};
+
+std::string repoFile(const std::string& rel) { return std::string(MESHNAV_SOURCE_DIR) + "/" + rel; }
+
+// ------------------------------------------------------------------------------------ calibrator
+
+TEST(CalibratorProcessConfig, DefaultsWithoutConfig) {
+  auto p = parse("calibrator", calib::declareCalibratorProcessOptions, {"--setup", "s.yaml"});
+  ASSERT_TRUE(p.ok);
+  const auto c = calib::calibratorProcessConfig(*p.cli);
+  EXPECT_EQ(c.setup_path, "s.yaml");
+  EXPECT_TRUE(c.config_path.empty());
+  EXPECT_TRUE(c.out_yaml.empty());
+  EXPECT_FALSE(c.node.auto_mode);
+  EXPECT_DOUBLE_EQ(c.pose_rate_hz, 50.0);
+  EXPECT_DOUBLE_EQ(c.heartbeat_s, 1.0);
+  EXPECT_FALSE(c.sigma_range_from_config);
+}
+
+TEST(CalibratorProcessConfig, AutoOutYamlAndRates) {
+  auto p = parse("calibrator", calib::declareCalibratorProcessOptions,
+                 {"--setup", "s.yaml", "--auto", "--out-yaml", "o/c.yaml", "--pose-rate", "0", "--heartbeat", "0.2",
+                  "--lcm-url", "memq://"});
+  ASSERT_TRUE(p.ok);
+  const auto c = calib::calibratorProcessConfig(*p.cli);
+  EXPECT_TRUE(c.node.auto_mode);
+  EXPECT_EQ(c.out_yaml, "o/c.yaml");
+  EXPECT_DOUBLE_EQ(c.pose_rate_hz, 0.0);
+  EXPECT_DOUBLE_EQ(c.heartbeat_s, 0.2);
+}
+
+TEST(CalibratorProcessConfig, BadValuesNameTheOption) {
+  for (const auto& args : std::vector<std::vector<std::string>>{
+           {"--heartbeat", "0"}, {"--heartbeat", "x"}, {"--pose-rate", "-1"}, {"--pose-rate", "nan"}}) {
+    auto p = parse("calibrator", calib::declareCalibratorProcessOptions, args);
+    ASSERT_TRUE(p.ok);
+    try {
+      calib::calibratorProcessConfig(*p.cli);
+      FAIL() << "accepted " << args[0] << " " << args[1];
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(args[0]), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(CalibratorProcessConfig, UnknownOptionIsRejected) {
+  auto p = parse("calibrator", calib::declareCalibratorProcessOptions, {"--autom"});
+  EXPECT_FALSE(p.ok);
+  EXPECT_EQ(p.code, 2);
+}
+
+TEST(CalibratorProcessConfig, RepoConfigEqualsBuiltInDefaults) {
+  auto p = parse("calibrator", calib::declareCalibratorProcessOptions,
+                 {"--config", repoFile("config/calibrator.yaml")});
+  ASSERT_TRUE(p.ok);
+  const auto c = calib::calibratorProcessConfig(*p.cli);
+  EXPECT_EQ(c.calibrator.toString(), calib::CalibratorOptions{}.toString());
+  EXPECT_EQ(c.node.toString(), calib::CalibratorNodeOptions{}.toString());
+  EXPECT_FALSE(c.sigma_range_from_config);  // left to setup.yaml on purpose
+}
+
+TEST(CalibratorProcessConfig, SigmaRangeFromSetupUnlessConfigured) {
+  TempDir dir;
+  SystemSetup setup;
+  setup.noise.sigma_range_m = 0.17;
+
+  auto p = parse("calibrator", calib::declareCalibratorProcessOptions, {});
+  ASSERT_TRUE(p.ok);
+  auto c = calib::calibratorProcessConfig(*p.cli);
+  calib::applySetup(c, setup);
+  EXPECT_DOUBLE_EQ(c.calibrator.sigma_range_m, 0.17);
+
+  const auto cfg = dir.file("c.yaml", "calibrator:\n  sigma_range: 0.12\ncalibrator_node:\n  auto_min_ranges: 50\n");
+  auto q = parse("calibrator", calib::declareCalibratorProcessOptions, {"--config", cfg});
+  ASSERT_TRUE(q.ok);
+  auto d = calib::calibratorProcessConfig(*q.cli);
+  EXPECT_TRUE(d.sigma_range_from_config);
+  calib::applySetup(d, setup);
+  EXPECT_DOUBLE_EQ(d.calibrator.sigma_range_m, 0.12);
+  EXPECT_EQ(d.node.auto_min_ranges, 50);
+
+  SystemSetup no_noise;
+  auto e = calib::calibratorProcessConfig(*p.cli);
+  calib::applySetup(e, no_noise);
+  EXPECT_DOUBLE_EQ(e.calibrator.sigma_range_m, calib::CalibratorOptions{}.sigma_range_m);
+}
+
+TEST(CalibratorProcessConfig, EitherMapMayBeMissing) {
+  TempDir dir;
+  auto p = parse("calibrator", calib::declareCalibratorProcessOptions,
+                 {"--config", dir.file("n.yaml", "calibrator_node:\n  auto_min_ranges: 50\n")});
+  ASSERT_TRUE(p.ok);
+  const auto c = calib::calibratorProcessConfig(*p.cli);
+  EXPECT_EQ(c.node.auto_min_ranges, 50);
+  EXPECT_EQ(c.calibrator.toString(), calib::CalibratorOptions{}.toString());
+  auto q = parse("calibrator", calib::declareCalibratorProcessOptions,
+                 {"--config", dir.file("flat.yaml", "min_measurements: 40\n")});
+  ASSERT_TRUE(q.ok);
+  const auto d = calib::calibratorProcessConfig(*q.cli);
+  EXPECT_EQ(d.calibrator.min_measurements, 40);
+}
+
+TEST(CalibratorProcessConfig, ConfigErrorsNameFileAndKey) {
+  TempDir dir;
+  const auto bad = dir.file("bad.yaml", "calibrator_node:\n  auto_min_rangez: 50\n");
+  auto p = parse("calibrator", calib::declareCalibratorProcessOptions, {"--config", bad});
+  ASSERT_TRUE(p.ok);
+  try {
+    calib::calibratorProcessConfig(*p.cli);
+    FAIL() << "accepted an unknown key";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("bad.yaml"), std::string::npos) << what;
+    EXPECT_NE(what.find("auto_min_rangez"), std::string::npos) << what;
+  }
+  const auto typo = dir.file("typo.yaml", "calibrator:\n  min_measurements: 40\ncalibrator_nodes:\n  auto_mode: true\n");
+  auto t = parse("calibrator", calib::declareCalibratorProcessOptions, {"--config", typo});
+  ASSERT_TRUE(t.ok);
+  try {
+    calib::calibratorProcessConfig(*t.cli);
+    FAIL() << "accepted an unknown top-level key";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("calibrator_nodes"), std::string::npos) << e.what();
+  }
+  auto q = parse("calibrator", calib::declareCalibratorProcessOptions, {"--config", dir.file("missing.yaml")});
+  ASSERT_TRUE(q.ok);
+  EXPECT_THROW(calib::calibratorProcessConfig(*q.cli), std::runtime_error);
+}
+
+TEST(CalibrationYamlWriter, WritesOnChangeAndReadsBack) {
+  TempDir dir;
+  const auto path = dir.file("sub/calibration.yaml");
+  calib::CalibrationYamlWriter w(path);
+  ASSERT_TRUE(w.enabled());
+  calib::CalibrationResult r;
+  r.anchor_id = 106;
+  r.status = calib::CalibrationStatus::Ok;
+  r.t = Timestamp::fromSec(80.0);
+  r.p_AinG = Eigen::Vector3d(-1.7, 0.9, 3.2);
+  r.cov_p_m2 = Eigen::Matrix3d::Identity() * 0.01;
+  std::vector<calib::CalibrationResult> results{r};
+  EXPECT_TRUE(w.update(results, 1));
+  EXPECT_FALSE(w.update(results, 1));  // nothing new
+  EXPECT_TRUE(w.update(results, 1, true));
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+  const auto inits = calib::readAnchorInitsYaml(path);
+  ASSERT_EQ(inits.size(), 1u);
+  EXPECT_EQ(inits[0].id, 106);
+  EXPECT_NEAR(inits[0].p_AinG.x(), -1.7, 1e-9);
+  EXPECT_FALSE(calib::CalibrationYamlWriter("").update(results, 2));
+}
+
+// --------------------------------------------------------------------------------------- mission
+
+TEST(MissionProcessConfig, Defaults) {
+  auto p = parse("mission", mission::declareMissionProcessOptions, {"--mission", "m.yaml"});
+  ASSERT_TRUE(p.ok);
+  const auto c = mission::missionProcessConfig(*p.cli);
+  EXPECT_EQ(c.mission_path, "m.yaml");
+  EXPECT_FALSE(c.t0_s.has_value());
+  EXPECT_EQ(c.time_channels, std::vector<std::string>{"RANGE"});
+  EXPECT_FALSE(c.stay);
+  EXPECT_DOUBLE_EQ(c.linger_s, 10.0);
+}
+
+TEST(MissionProcessConfig, T0TimeChannelsStay) {
+  auto p = parse("mission", mission::declareMissionProcessOptions,
+                 {"--t0", "0", "--time-from", "RANGE, IMU,RANGE", "--stay", "--linger", "0"});
+  ASSERT_TRUE(p.ok);
+  const auto c = mission::missionProcessConfig(*p.cli);
+  ASSERT_TRUE(c.t0_s.has_value());
+  EXPECT_DOUBLE_EQ(*c.t0_s, 0.0);
+  EXPECT_EQ(c.time_channels, (std::vector<std::string>{"RANGE", "IMU"}));
+  EXPECT_TRUE(c.stay);
+  EXPECT_DOUBLE_EQ(c.linger_s, 0.0);
+
+  auto q = parse("mission", mission::declareMissionProcessOptions, {"--t0", "auto", "--time-from", "none"});
+  ASSERT_TRUE(q.ok);
+  const auto d = mission::missionProcessConfig(*q.cli);
+  EXPECT_FALSE(d.t0_s.has_value());
+  EXPECT_TRUE(d.time_channels.empty());
+}
+
+TEST(MissionProcessConfig, BadValuesNameTheOption) {
+  for (const auto& args : std::vector<std::vector<std::string>>{{"--time-from", "POSE"},
+                                                                {"--time-from", "RANGE,GARBAGE"},
+                                                                {"--t0", "soon"},
+                                                                {"--linger", "-1"},
+                                                                {"--heartbeat", "0"},
+                                                                {"--status-period", "inf"}}) {
+    auto p = parse("mission", mission::declareMissionProcessOptions, args);
+    ASSERT_TRUE(p.ok);
+    try {
+      mission::missionProcessConfig(*p.cli);
+      FAIL() << "accepted " << args[0] << " " << args[1];
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(args[0]), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(DataClock, PassesOnlyAdvancingTimes) {
+  mission::DataClock clock;
+  EXPECT_FALSE(clock.now().has_value());
+  EXPECT_TRUE(clock.advance(Timestamp::fromSec(1.0)));   // RANGE
+  EXPECT_FALSE(clock.advance(Timestamp::fromSec(0.9)));  // a lagging POSE
+  EXPECT_FALSE(clock.advance(Timestamp::fromSec(1.0)));
+  EXPECT_TRUE(clock.advance(Timestamp::fromSec(1.1)));
+  EXPECT_EQ(*clock.now(), Timestamp::fromSec(1.1));
+}
+
+CalibStatus calibStatus(int64_t ok, int64_t refused, std::vector<std::pair<SensorId, std::string>> states) {
+  CalibStatus s;
+  s.counters["calibrations_ok"] = ok;
+  s.counters["calibrations_refused"] = refused;
+  for (const auto& [id, st] : states) {
+    CalibAnchorStatus a;
+    a.id = id;
+    a.state = st;
+    s.anchors.push_back(a);
+  }
+  return s;
+}
+
+mission::Mission paperMission() {
+  return mission::parseMission(
+      "steps:\n  - {t: 80.0, action: calibrate, anchors: [106, 107]}\n"
+      "  - {t: 100.0, action: calibrate, anchors: [108, 109, 110]}\n",
+      "test");
+}
+
+TEST(MissionCompletion, WaitsForTheAnswerToTheLastCalibrate) {
+  mission::MissionCompletion done(paperMission(), 10.0);
+  done.onCalibStatus(calibStatus(2, 0, {{106, "calibrated"}, {107, "calibrated"}, {108, "collecting"}}));
+  EXPECT_FALSE(done.done(0));  // not finished
+  done.onFinished(1'000'000);
+  EXPECT_FALSE(done.done(1'000'000));
+  // A heartbeat sent before the calibrator handled the command.
+  done.onCalibStatus(calibStatus(2, 0, {{108, "collecting"}, {109, "collecting"}, {110, "collecting"}}));
+  EXPECT_FALSE(done.done(2'000'000));
+  // Handled in part (two of three).
+  done.onCalibStatus(calibStatus(4, 0, {{108, "calibrated"}, {109, "calibrated"}, {110, "collecting"}}));
+  EXPECT_FALSE(done.answered());
+  // Answered: a refusal is an answer too.
+  done.onCalibStatus(calibStatus(4, 1, {{108, "calibrated"}, {109, "calibrated"}, {110, "refused"}}));
+  EXPECT_TRUE(done.answered());
+  EXPECT_TRUE(done.done(2'000'000));
+  EXPECT_FALSE(done.timedOut(2'000'000));
+}
+
+TEST(MissionCompletion, StaleRefusalIsNotAnAnswer) {
+  mission::MissionCompletion done(paperMission(), 10.0);
+  done.onCalibStatus(calibStatus(2, 3, {{108, "refused"}, {109, "refused"}, {110, "refused"}}));
+  done.onFinished(0);
+  done.onCalibStatus(calibStatus(2, 3, {{108, "refused"}, {109, "refused"}, {110, "refused"}}));
+  EXPECT_FALSE(done.answered());
+  done.onCalibStatus(calibStatus(5, 3, {{108, "calibrated"}, {109, "calibrated"}, {110, "calibrated"}}));
+  EXPECT_TRUE(done.answered());
+}
+
+TEST(MissionCompletion, LingerBoundsTheWait) {
+  mission::MissionCompletion done(paperMission(), 2.0);
+  done.onFinished(10'000'000);
+  EXPECT_FALSE(done.done(11'000'000));
+  EXPECT_TRUE(done.done(12'000'000));
+  EXPECT_TRUE(done.timedOut(12'000'000));
+}
+
+TEST(MissionCompletion, NothingToWaitForWhenTheLastStepIsNotACalibrate) {
+  const auto m = mission::parseMission(
+      "steps:\n  - {t: 80.0, action: calibrate}\n  - {t: 90.0, action: remove, anchors: [106]}\n", "test");
+  mission::MissionCompletion done(m, 10.0);
+  EXPECT_FALSE(done.done(0));
+  done.onFinished(0);
+  EXPECT_TRUE(done.done(0));
+  mission::MissionCompletion empty(mission::parseMission("steps: []\n", "test"), 10.0);
+  empty.onFinished(0);
+  EXPECT_TRUE(empty.done(0));
+}
+
+TEST(MissionCompletion, CalibrateAllWaitsUntilNothingCollects) {
+  const auto m = mission::parseMission("steps:\n  - {t: 80.0, action: calibrate}\n", "test");
+  mission::MissionCompletion done(m, 10.0);
+  done.onFinished(0);
+  done.onCalibStatus(calibStatus(1, 0, {{106, "calibrated"}, {107, "collecting"}}));
+  EXPECT_FALSE(done.answered());
+  done.onCalibStatus(calibStatus(2, 0, {{106, "calibrated"}, {107, "calibrated"}}));
+  EXPECT_TRUE(done.answered());
+}
+
+}  // namespace
