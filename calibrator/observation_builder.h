@@ -45,4 +45,9 @@ class ObservationBuilder {
   std::vector<PoseEstimate> poses_;
 };
 
+/// Tag position p_TinG = p_IinG + R_ItoG p_TinI at a pose and its covariance
+/// Σ_T = Σ_p + (R[p_TinI]ₓ) Σ_θ (R[p_TinI]ₓ)ᵀ (local orientation error) + σ_min² I.
+std::pair<Eigen::Vector3d, Eigen::Matrix3d> tagPositionAtPose(const PoseEstimate& pose, const Eigen::Vector3d& p_TinI,
+                                                              double min_sigma_m);
+
 }  // namespace meshnav::calib

@@ -15,12 +15,6 @@ namespace meshnav::calib {
 
 namespace {
 
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
-
 /// Range sanity limits [m] (as the dataset reader's RangeLimits).
 constexpr double kMinRangeM = -0.5;
 constexpr double kMaxRangeM = 500.0;
@@ -297,12 +291,7 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> CalibratorNode::tagPo
   const auto& opt = calibrator_.options();
   const auto pose = interpolateEstimate(poses_, t, Duration::fromSec(opt.max_pose_gap_s));
   if (!pose) return std::nullopt;
-  // p_TinG = p_IinG + R_ItoG p_TinI;  Σ_T = Σ_p + (R[p_TinI]ₓ) Σ_θ (R[p_TinI]ₓ)ᵀ (local orientation error).
-  const Eigen::Matrix3d R = pose->q_ItoG.toRotationMatrix();
-  const Eigen::Matrix3d J = R * skew(lever->second);
-  Eigen::Matrix3d cov = pose->cov_p_m2 + J * pose->cov_theta_rad2 * J.transpose();
-  cov += opt.min_tag_position_sigma_m * opt.min_tag_position_sigma_m * Eigen::Matrix3d::Identity();
-  return std::make_pair(Eigen::Vector3d(pose->p_IinG + R * lever->second), cov);
+  return tagPositionAtPose(*pose, lever->second, opt.min_tag_position_sigma_m);
 }
 
 std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> CalibratorNode::anchorReference(SensorId id) const {

@@ -126,7 +126,11 @@ CalibratorOptions CalibratorOptions::load(const std::string& path) {
   } catch (const std::exception& e) {
     throw std::runtime_error(path + ": cannot read (" + e.what() + ")");
   }
-  return fromYaml(root["calibrator"] ? root["calibrator"] : root, path);
+  // config/calibrator.yaml holds `calibrator:` and `calibrator_node:` maps; a flat file is the
+  // `calibrator:` map itself; a file with only `calibrator_node:` leaves these at their defaults.
+  if (root["calibrator"]) return fromYaml(root["calibrator"], path);
+  if (root["calibrator_node"]) return fromYaml(YAML::Node(YAML::NodeType::Map), path);
+  return fromYaml(root, path);
 }
 
 std::string CalibratorOptions::toString() const {

@@ -42,12 +42,16 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> ObservationBuilder::t
   if (lever == setup_.rel_tag_positions.end()) return std::nullopt;
   const auto pose = interpolateEstimate(poses_, t, Duration::fromSec(options_.max_pose_gap_s));
   if (!pose) return std::nullopt;
-  const Eigen::Matrix3d R = pose->q_ItoG.toRotationMatrix();
-  const Eigen::Vector3d p = pose->p_IinG + R * lever->second;
-  const Eigen::Matrix3d J = R * skew(lever->second);  // ∂p_T/∂δθ = −R[l]ₓ; sign irrelevant in J Σ Jᵀ
-  Eigen::Matrix3d cov = pose->cov_p_m2 + J * pose->cov_theta_rad2 * J.transpose();
-  cov += options_.min_tag_position_sigma_m * options_.min_tag_position_sigma_m * Eigen::Matrix3d::Identity();
-  return std::make_pair(p, cov);
+  return tagPositionAtPose(*pose, lever->second, options_.min_tag_position_sigma_m);
+}
+
+std::pair<Eigen::Vector3d, Eigen::Matrix3d> tagPositionAtPose(const PoseEstimate& pose, const Eigen::Vector3d& p_TinI,
+                                                              double min_sigma_m) {
+  const Eigen::Matrix3d R = pose.q_ItoG.toRotationMatrix();
+  const Eigen::Matrix3d J = R * skew(p_TinI);  // ∂p_T/∂δθ = −R[l]ₓ; the sign cancels in J Σ Jᵀ
+  Eigen::Matrix3d cov = pose.cov_p_m2 + J * pose.cov_theta_rad2 * J.transpose();
+  cov += min_sigma_m * min_sigma_m * Eigen::Matrix3d::Identity();
+  return {pose.p_IinG + R * p_TinI, cov};
 }
 
 std::vector<CalibObservation> ObservationBuilder::collect(SensorId x, const std::vector<RangeSample>& ranges,
