@@ -84,6 +84,10 @@ class FactorizedCovariance {
   void writeBackDp(const std::vector<int>& part, const StateLayout& sub, const Eigen::MatrixXd& P, Timestamp t);
   void writeBackDah(const std::vector<int>& part, const StateLayout& sub, const Eigen::MatrixXd& P,
                     const Eigen::MatrixXd& K, const Linearization& lin, Timestamp t);
+  /// DAH update of a scalar measurement on at most 4 participants of dimension ≤ 15 (every range
+  /// and baro update): the same steps as update() + writeBackDah() on stack storage, with the
+  /// rank-one forms of the scalar update (see the .cpp). False: not applicable, use the general path.
+  bool updateDahScalar(const Linearization& lin, double nis_gate, Timestamp t, Result* res);
 
   Mode mode_;
   bool joseph_;
