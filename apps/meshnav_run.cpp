@@ -20,6 +20,8 @@
 #include "calibrator/calibration_io.h"
 #include "pipeline/pipeline.h"
 
+#include <yaml-cpp/yaml.h>
+
 using namespace meshnav;
 using namespace meshnav::estimator;
 
@@ -136,6 +138,15 @@ int main(int argc, char** argv) {
     sinks.anchors = [&](const std::vector<AnchorEstimate>& v) {
       for (const auto& a : v) anchor_writer.write(a);
     };
+    // The calibrator's range σ_d comes from setup.yaml (noise.sigma_range) unless the calibrator
+    // config sets it, as in the calibrator process.
+    bool sigma_in_config = false;
+    if (cli.has("calib-config")) {
+      const YAML::Node root = YAML::LoadFile(cli.get("calib-config"));
+      const YAML::Node cal = root["calibrator"] ? root["calibrator"] : (root["calibrator_node"] ? YAML::Node() : root);
+      sigma_in_config = cal.IsMap() && cal["sigma_range"].IsDefined();
+    }
+    if (ds.setup.noise.sigma_range_m && !sigma_in_config) popts.calibrator.sigma_range_m = *ds.setup.noise.sigma_range_m;
     pipeline::PipelineSinks psinks;
     psinks.pose = sinks.pose;
     psinks.anchors = sinks.anchors;
