@@ -454,7 +454,9 @@ EstimatorStatus EstimatorNode::status() const {
   };
   if (initialized()) {
     for (const StateBlock& b : cur_.filter->layout().blocks()) add(b.id, kindName(b.kind));
-    for (const auto& [id, p] : cur_.network->tags()) add(id, "tag");
+    // Tags without state (no estimated biases) are instances too; list each instance once.
+    for (const auto& [id, p] : cur_.network->tags())
+      if (!cur_.filter->layout().find(id)) add(id, "tag");
     for (const auto& [id, p] : cur_.network->exactAnchors()) add(id, "anchor");
   }
   s.counters = diag_.snapshot();

@@ -3,6 +3,8 @@
 /// mid-flight without disturbing the others, invariants after every input.
 #include <gtest/gtest.h>
 
+#include <map>
+
 #include "modular_test_helpers.h"
 #include "node_test_helpers.h"
 
@@ -207,4 +209,8 @@ TEST(ModularNode, StatusReportsInstancesTimingsAndCounters) {
     if (i.id == 1) EXPECT_GT(i.n_updates, 0);
   }
   EXPECT_EQ(anchors, 7);  // 101–104 exact, 106–108 estimated
+  std::map<SensorId, int> seen;
+  for (const auto& i : st.instances) ++seen[i.id];
+  for (const auto& [id, n] : seen) EXPECT_EQ(n, 1) << "instance " << id << " listed " << n << " times";
+  EXPECT_TRUE(seen.count(100) && seen.count(105)) << "both tags are instances";
 }
