@@ -98,6 +98,11 @@ TEST(Pipeline, FlyByCalibrationWithTheS2Mission) {
     ASSERT_NE(it, r.status.instances.end()) << id;
     EXPECT_GT(it->n_updates, 20) << "ranges of " << id << " were fused";
   }
+  // Every instance is listed once in ESTIMATOR_STATUS (tags with estimated biases included).
+  std::map<SensorId, int> listed;
+  for (const auto& i : r.status.instances) ++listed[i.id];
+  for (const auto& [id, n] : listed) EXPECT_EQ(n, 1) << "instance " << id << " listed " << n << " times";
+  EXPECT_EQ(listed.size(), 1u + 1u + 2u + 9u);  // IMU, baro, tags 100/105, anchors 101–110
   const double rmse = positionRmse(r.poses, f.ds.ground_truth);
   std::cout << "position RMSE " << rmse << " m over " << r.poses.size() << " poses\n";
   EXPECT_LE(rmse, 0.15);
