@@ -47,7 +47,7 @@ void forEachField(Opt& o, Visitor&& v) {
   v("uwb.gate_probability", o.uwb.gate_probability, "chi^2 gate, 0 = off [-]");
   v("uwb.use_corrected_range", o.uwb.use_corrected_range, "fuse range_corr instead of range_raw");
   v("uwb.max_range_m", o.uwb.max_range_m, "longer ranges are bad input [m]");
-  v("uwb.estimate_tag_biases", o.uwb.estimate_tag_biases, "estimate tag-known-anchor gamma with sigma_gamma > 0 as states");
+  v("uwb.estimate_tag_biases", o.uwb.estimate_tag_biases, "estimate tag-anchor gamma (setup anchors, sigma_gamma > 0) as states");
   v("zupt.enabled", o.zupt.enabled, "");
   v("zupt.rate_hz", o.zupt.rate_hz, "pseudo-measurement rate while landed [Hz]");
   v("zupt.sigma_acc_m_s2", o.zupt.sigma_acc_m_s2, "sigma of a = 0 [m/s^2]");

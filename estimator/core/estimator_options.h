@@ -47,8 +47,9 @@ struct UwbOptions {
   double gate_probability = 0.997;       ///< χ² gate (0: no gating) [-]
   bool use_corrected_range = false;      ///< fuse range_corr instead of range_raw
   double max_range_m = 100.0;            ///< longer ranges are bad input [m]
-  /// Estimate γ of tag–known-anchor pairs whose a-priori bias has sigma_gamma > 0 as states of the
-  /// tag instances (else their σ_γ inflates the range noise).
+  /// Estimate γ of tag–setup-anchor pairs whose a-priori bias has sigma_gamma > 0 as states of the
+  /// tag instances (else their σ_γ inflates the range noise). Anchors added at run time
+  /// (ANCHOR_INIT) keep their calibrated γ as dictionary values.
   bool estimate_tag_biases = true;
 };
 

@@ -195,12 +195,12 @@ void EstimatorNode::initialize(const InitialBelief& b) {
       filter->addAnchor(id, p, Eigen::Matrix3d::Identity() * sig->second * sig->second);
   }
   if (options_.uwb.estimate_tag_biases) {
-    // Tag instances with state: γ towards exactly known anchors whose a-priori bias is uncertain.
+    // Tag instances with state: γ towards the setup's anchors (exact or known-but-uncertain) whose
+    // a-priori bias is uncertain. Constant per pair, so a state rather than white noise.
     for (const auto& [tag, lever] : setup_.rel_tag_positions) {
       std::vector<SensorId> peers;
       std::vector<double> gamma, var;
       for (const auto& [anchor, p] : setup_.abs_anchor_positions) {
-        if (setup_.abs_anchor_sigmas_m.count(anchor)) continue;
         const auto pb = setup_.findPairBias(tag, anchor);
         if (!pb || pb->sigma_gamma_m <= 0.0) continue;
         peers.push_back(anchor);
