@@ -26,11 +26,10 @@
 
 namespace meshnav::calib {
 
-/// Writes every result (refused ones under `refused:`). Throws std::runtime_error on I/O failure.
+/// Writes every result in the format of common/anchor_init_io.h (refused ones under `refused:`).
+/// Throws std::runtime_error on I/O failure.
 void writeCalibrationYaml(const std::vector<CalibrationResult>& results, const std::string& path);
 
-/// Reads the `anchors:` entries back as estimator inits (PairBias a = reference, b = anchor).
-/// Throws std::runtime_error naming the file and the key on a malformed file.
-std::vector<AnchorInit> readAnchorInitsYaml(const std::string& path);
+/// Reading the file back: `meshnav::readAnchorInitsYaml` (common/anchor_init_io.h).
 
 }  // namespace meshnav::calib

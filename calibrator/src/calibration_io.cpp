@@ -1,140 +1,17 @@
 #include "calibrator/calibration_io.h"
 
-#include <yaml-cpp/yaml.h>
-
-#include <fstream>
-#include <stdexcept>
+#include "common/anchor_init_io.h"
 
 namespace meshnav::calib {
 
-namespace {
-
-template <typename T>
-void seq(YAML::Emitter& e, const char* key, const std::vector<T>& v) {
-  e << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
-  for (const auto& x : v) e << x;
-  e << YAML::EndSeq;
-}
-
-[[noreturn]] void fail(const std::string& path, const std::string& what) {
-  throw std::runtime_error(path + ": " + what);
-}
-
-std::vector<double> numbers(const YAML::Node& n, const std::string& path, const std::string& key, size_t expect) {
-  if (!n || !n.IsSequence()) fail(path, "key '" + key + "' missing or not a list");
-  if (expect > 0 && n.size() != expect)
-    fail(path, "key '" + key + "' must have " + std::to_string(expect) + " values, has " + std::to_string(n.size()));
-  std::vector<double> v;
-  for (const auto& x : n) {
-    try {
-      v.push_back(x.as<double>());
-    } catch (const std::exception&) {
-      fail(path, "key '" + key + "' holds a non-number");
-    }
-  }
-  return v;
-}
-
-}  // namespace
-
 void writeCalibrationYaml(const std::vector<CalibrationResult>& results, const std::string& path) {
-  YAML::Emitter e;
-  e.SetDoublePrecision(15);
-  e << YAML::BeginMap;
-  e << YAML::Key << "anchors" << YAML::Value << YAML::BeginSeq;
+  std::vector<AnchorInit> inits;
+  std::vector<RefusedAnchor> refused;
   for (const auto& r : results) {
-    if (!r.ok()) continue;
-    e << YAML::BeginMap;
-    e << YAML::Key << "id" << YAML::Value << r.anchor_id;
-    e << YAML::Key << "t" << YAML::Value << r.t.sec();
-    seq(e, "p_AinG", std::vector<double>{r.p_AinG.x(), r.p_AinG.y(), r.p_AinG.z()});
-    std::vector<double> cov;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) cov.push_back(r.cov_p_m2(i, j));
-    seq(e, "p_AinG_cov", cov);
-    std::vector<int> ids;
-    std::vector<double> g, b, sg, sb, sr;
-    for (const auto& ref : r.references) {
-      ids.push_back(ref.ref_id);
-      g.push_back(ref.gamma_m);
-      b.push_back(ref.beta);
-      sg.push_back(ref.sigma_gamma_m);
-      sb.push_back(ref.sigma_beta);
-      sr.push_back(ref.sigma_range_m);
-    }
-    seq(e, "ref_ids", ids);
-    seq(e, "const_biases", g);
-    seq(e, "dist_biases", b);
-    seq(e, "sigma_const_biases", sg);
-    seq(e, "sigma_dist_biases", sb);
-    seq(e, "sigma_ranges", sr);
-    e << YAML::Key << "n_inliers" << YAML::Value << r.n_inliers;
-    e << YAML::Key << "n_outliers" << YAML::Value << r.n_outliers;
-    e << YAML::EndMap;
+    if (r.ok()) inits.push_back(r.toAnchorInit());
+    else refused.push_back({r.anchor_id, toString(r.status), r.reason});
   }
-  e << YAML::EndSeq;
-  e << YAML::Key << "refused" << YAML::Value << YAML::BeginSeq;
-  for (const auto& r : results) {
-    if (r.ok()) continue;
-    e << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << r.anchor_id << YAML::Key << "status"
-      << YAML::Value << toString(r.status) << YAML::Key << "reason" << YAML::Value << r.reason << YAML::EndMap;
-  }
-  e << YAML::EndSeq << YAML::EndMap;
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot open for writing");
-  out << e.c_str() << "\n";
-  if (!out) throw std::runtime_error(path + ": write failed");
-}
-
-std::vector<AnchorInit> readAnchorInitsYaml(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const std::exception& ex) {
-    fail(path, std::string("cannot read (") + ex.what() + ")");
-  }
-  const YAML::Node list = root.IsSequence() ? root : root["anchors"];
-  if (!list || !list.IsSequence()) fail(path, "key 'anchors' missing or not a list");
-  std::vector<AnchorInit> out;
-  for (size_t k = 0; k < list.size(); ++k) {
-    const YAML::Node n = list[k];
-    const std::string pre = "anchors[" + std::to_string(k) + "].";
-    AnchorInit a;
-    try {
-      if (!n["id"]) fail(path, "key '" + pre + "id' missing");
-      a.id = n["id"].as<SensorId>();
-      a.t = n["t"] ? Timestamp::fromSec(n["t"].as<double>()) : Timestamp{};
-      a.n_inliers = n["n_inliers"] ? n["n_inliers"].as<int>() : 0;
-      a.n_outliers = n["n_outliers"] ? n["n_outliers"].as<int>() : 0;
-    } catch (const YAML::Exception& ex) {
-      fail(path, "entry '" + pre + "' has a malformed scalar (" + ex.what() + ")");
-    }
-    const auto p = numbers(n["p_AinG"], path, pre + "p_AinG", 3);
-    a.p_AinG = Eigen::Vector3d(p[0], p[1], p[2]);
-    const auto c = numbers(n["p_AinG_cov"], path, pre + "p_AinG_cov", 9);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) a.cov_p_m2(i, j) = c[static_cast<size_t>(3 * i + j)];
-    const auto ids = numbers(n["ref_ids"], path, pre + "ref_ids", 0);
-    const size_t m = ids.size();
-    const auto g = numbers(n["const_biases"], path, pre + "const_biases", m);
-    const auto b = numbers(n["dist_biases"], path, pre + "dist_biases", m);
-    const auto sg = numbers(n["sigma_const_biases"], path, pre + "sigma_const_biases", m);
-    const auto sb = numbers(n["sigma_dist_biases"], path, pre + "sigma_dist_biases", m);
-    const auto sr = n["sigma_ranges"] ? numbers(n["sigma_ranges"], path, pre + "sigma_ranges", m) : std::vector<double>(m, 0.1);
-    for (size_t i = 0; i < m; ++i) {
-      PairBias pbias;
-      pbias.a = static_cast<SensorId>(ids[i]);
-      pbias.b = a.id;
-      pbias.gamma_m = g[i];
-      pbias.beta = b[i];
-      pbias.sigma_gamma_m = sg[i];
-      pbias.sigma_beta = sb[i];
-      pbias.sigma_m = sr[i];
-      a.biases.push_back(pbias);
-    }
-    out.push_back(std::move(a));
-  }
-  return out;
+  writeAnchorInitsYaml(inits, path, refused);
 }
 
 }  // namespace meshnav::calib

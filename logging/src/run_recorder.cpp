@@ -1,5 +1,7 @@
 #include "logging/run_recorder.h"
 
+#include "common/anchor_init_io.h"
+
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
@@ -20,12 +22,6 @@ void writeYaml(const YAML::Emitter& e, const std::string& path) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error(path + ": cannot write file");
   out << e.c_str() << "\n";
-}
-
-YAML::Emitter& flowSeq(YAML::Emitter& e, const double* v, int n) {
-  e << YAML::Flow << YAML::BeginSeq;
-  for (int i = 0; i < n; ++i) e << v[i];
-  return e << YAML::EndSeq;
 }
 
 }  // namespace
@@ -75,43 +71,7 @@ void RunRecorder::finish(const Diagnostics& process_diag) {
   flush();
   const fs::path dir(out_dir_);
 
-  if (!anchor_inits_.empty()) {
-    YAML::Emitter e;
-    e << YAML::BeginMap << YAML::Key << "anchors" << YAML::Value << YAML::BeginSeq;
-    for (const auto& a : anchor_inits_) {
-      e << YAML::BeginMap;
-      e << YAML::Key << "id" << YAML::Value << a.id;
-      e << YAML::Key << "t" << YAML::Value << a.t.sec();
-      e << YAML::Key << "p_AinG" << YAML::Value;
-      flowSeq(e, a.p_AinG.data(), 3);
-      double cov[9];
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) cov[3 * r + c] = a.cov_p_m2(r, c);
-      e << YAML::Key << "p_AinG_cov" << YAML::Value;
-      flowSeq(e, cov, 9);
-      std::vector<int> refs;
-      std::vector<double> g, b, sg, sb, sr;
-      for (const auto& pb : a.biases) {
-        refs.push_back(pb.a);
-        g.push_back(pb.gamma_m);
-        b.push_back(pb.beta);
-        sg.push_back(pb.sigma_gamma_m);
-        sb.push_back(pb.sigma_beta);
-        sr.push_back(pb.sigma_m);
-      }
-      e << YAML::Key << "ref_ids" << YAML::Value << YAML::Flow << refs;
-      e << YAML::Key << "const_biases" << YAML::Value << YAML::Flow << g;
-      e << YAML::Key << "dist_biases" << YAML::Value << YAML::Flow << b;
-      e << YAML::Key << "sigma_const_biases" << YAML::Value << YAML::Flow << sg;
-      e << YAML::Key << "sigma_dist_biases" << YAML::Value << YAML::Flow << sb;
-      e << YAML::Key << "sigma_ranges" << YAML::Value << YAML::Flow << sr;
-      e << YAML::Key << "n_inliers" << YAML::Value << a.n_inliers;
-      e << YAML::Key << "n_outliers" << YAML::Value << a.n_outliers;
-      e << YAML::EndMap;
-    }
-    e << YAML::EndSeq << YAML::EndMap;
-    writeYaml(e, (dir / "anchor_init.yaml").string());
-  }
+  if (!anchor_inits_.empty()) writeAnchorInitsYaml(anchor_inits_, (dir / "anchor_init.yaml").string());
   if (!ground_truth_.empty()) writeTumCsv(ground_truth_, (dir / "groundtruth.csv").string());
 
   YAML::Emitter e;

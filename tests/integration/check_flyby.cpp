@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include "calibrator/calibration_io.h"
+#include "common/anchor_init_io.h"
 #include "common/cli.h"
 #include "common/dataset.h"
 #include "common/estimate_io.h"
@@ -70,7 +71,7 @@ int main(int argc, char** argv) {
 
     std::map<SensorId, AnchorInit> inits;  // the last one per anchor
     if (cli.has("anchor-init")) {
-      for (const auto& a : calib::readAnchorInitsYaml(cli.get("anchor-init"))) inits[a.id] = a;
+      for (const auto& a : readAnchorInitsYaml(cli.get("anchor-init"))) inits[a.id] = a;
       for (SensorId id : ids) {
         const auto* truth_p = truePos(id);
         if (!truth_p) {

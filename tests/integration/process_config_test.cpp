@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "calibrator/calibration_io.h"
+#include "common/anchor_init_io.h"
 #include "calibrator/process/calibrator_process_config.h"
 #include "mission/process/mission_process_config.h"
 
@@ -200,7 +201,7 @@ TEST(CalibrationYamlWriter, WritesOnChangeAndReadsBack) {
   EXPECT_FALSE(w.update(results, 1));  // nothing new
   EXPECT_TRUE(w.update(results, 1, true));
   EXPECT_FALSE(fs::exists(path + ".tmp"));
-  const auto inits = calib::readAnchorInitsYaml(path);
+  const auto inits = readAnchorInitsYaml(path);
   ASSERT_EQ(inits.size(), 1u);
   EXPECT_EQ(inits[0].id, 106);
   EXPECT_NEAR(inits[0].p_AinG.x(), -1.7, 1e-9);

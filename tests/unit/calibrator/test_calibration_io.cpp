@@ -6,6 +6,7 @@
 
 #include "calibrator/anchor_calibrator.h"
 #include "calibrator/calibration_io.h"
+#include "common/anchor_init_io.h"
 #include "calibrator/observation_builder.h"
 #include "calibrator/synthetic_scene.h"
 

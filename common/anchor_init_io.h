@@ -1,0 +1,31 @@
+#pragma once
+/// @file anchor_init_io.h
+/// @brief Calibration results file of DESIGN §6 (one entry per anchor: id, t, p_AinG, p_AinG_cov
+/// (3×3 row-major), ref_ids, const_biases, dist_biases, sigma_const_biases, sigma_dist_biases,
+/// sigma_ranges, n_inliers, n_outliers; refused anchors under `refused:`). Written by the
+/// calibrator and by the logger (ANCHOR_INIT), read by the estimator's users and the evaluation.
+
+#include <string>
+#include <vector>
+
+#include "common/types.h"
+
+namespace meshnav {
+
+/// An anchor the calibrator refused, with the reason.
+struct RefusedAnchor {
+  SensorId id = 0;
+  std::string status;  ///< e.g. "degenerate_geometry"
+  std::string reason;  ///< human-readable
+};
+
+/// Writes `inits` (PairBias a = reference device, b = the anchor) and `refused`. Throws
+/// std::runtime_error naming the file on I/O failure.
+void writeAnchorInitsYaml(const std::vector<AnchorInit>& inits, const std::string& path,
+                          const std::vector<RefusedAnchor>& refused = {});
+
+/// Reads the `anchors:` entries (or a top-level list) back. Throws std::runtime_error naming the
+/// file and the key on a malformed file.
+std::vector<AnchorInit> readAnchorInitsYaml(const std::string& path);
+
+}  // namespace meshnav
