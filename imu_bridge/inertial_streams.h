@@ -17,10 +17,11 @@ struct InertialStreams {
   std::vector<BaroSample> baro;
   std::vector<FlightStateSample> flight_states;
 
-  /// Stream indices of ReplayEvent::stream.
-  static constexpr int kImuStream = 0;
-  static constexpr int kBaroStream = 1;
-  static constexpr int kFlightStateStream = 2;
+  /// Stream indices of ReplayEvent::stream. At equal times the timeline keeps this order, which is
+  /// the estimator's canonical order (flight state, IMU, baro), so a replay causes no rewinds.
+  static constexpr int kFlightStateStream = 0;
+  static constexpr int kImuStream = 1;
+  static constexpr int kBaroStream = 2;
 
   /// IMU, BARO, FLIGHT_STATE merged by time (equal times: IMU first, then BARO, then FLIGHT_STATE).
   std::vector<replay::ReplayEvent> timeline() const;

@@ -65,7 +65,9 @@ int main(int argc, char** argv) {
       }
       ++n[ev.stream];
     });
-    spdlog::info("published IMU {}, BARO {}, FLIGHT_STATE {}{}", n[0], n[1], n[2],
+    using imu::InertialStreams;
+    spdlog::info("published IMU {}, BARO {}, FLIGHT_STATE {}{}", n[InertialStreams::kImuStream],
+                 n[InertialStreams::kBaroStream], n[InertialStreams::kFlightStateStream],
                  node.diagnostics().total() ? ", errors: " + node.diagnostics().summary() : "");
     (void)progress;
     return node.diagnostics().get("lcm:publish_error") > 0 ? 1 : 0;

@@ -10,7 +10,7 @@
 namespace meshnav::imu {
 
 std::vector<replay::ReplayEvent> InertialStreams::timeline() const {
-  return replay::mergeTimeline({replay::timesOf(imu), replay::timesOf(baro), replay::timesOf(flight_states)});
+  return replay::mergeTimeline({replay::timesOf(flight_states), replay::timesOf(imu), replay::timesOf(baro)});
 }
 
 InertialStreams loadInertialStreams(const std::string& dataset_dir, Diagnostics& diag) {

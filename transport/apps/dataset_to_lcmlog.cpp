@@ -57,9 +57,10 @@ int main(int argc, char** argv) {
     Diagnostics diag;
     const Dataset ds = readDataset(cli.get("dataset"), diag);
     const bool with_gt = !cli.has("no-ground-truth");
-    // Streams in this order: equal times keep it (inputs before the truth).
+    // Streams in this order: equal times keep it — the estimator's canonical order (flight state,
+    // IMU, baro, range), so a replay of the log causes no rewinds; inputs before the truth.
     const std::vector<std::vector<Timestamp>> times = {
-        replay::timesOf(ds.imu), replay::timesOf(ds.baro), replay::timesOf(ds.flight_states),
+        replay::timesOf(ds.flight_states), replay::timesOf(ds.imu), replay::timesOf(ds.baro),
         replay::timesOf(ds.ranges), with_gt ? replay::timesOf(ds.ground_truth) : std::vector<Timestamp>{}};
     const auto events = replay::mergeTimeline(times);
 
@@ -76,9 +77,9 @@ int main(int argc, char** argv) {
     for (const auto& ev : events) {
       bool ok = false;
       switch (ev.stream) {
-        case 0: ok = writeEvent(log, channels::kImu, ev.t.us, transport::toLcm(ds.imu[ev.index]), buf); break;
-        case 1: ok = writeEvent(log, channels::kBaro, ev.t.us, transport::toLcm(ds.baro[ev.index]), buf); break;
-        case 2: ok = writeEvent(log, channels::kFlightState, ev.t.us, transport::toLcm(ds.flight_states[ev.index]), buf); break;
+        case 0: ok = writeEvent(log, channels::kFlightState, ev.t.us, transport::toLcm(ds.flight_states[ev.index]), buf); break;
+        case 1: ok = writeEvent(log, channels::kImu, ev.t.us, transport::toLcm(ds.imu[ev.index]), buf); break;
+        case 2: ok = writeEvent(log, channels::kBaro, ev.t.us, transport::toLcm(ds.baro[ev.index]), buf); break;
         case 3: ok = writeEvent(log, channels::kRange, ev.t.us, transport::toLcm(ds.ranges[ev.index]), buf); break;
         case 4: ok = writeEvent(log, channels::kGroundTruth, ev.t.us, transport::toLcm(ds.ground_truth[ev.index]), buf); break;
         default: break;

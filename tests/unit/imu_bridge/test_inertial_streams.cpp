@@ -39,12 +39,13 @@ TEST(InertialStreams, LoadsAndMergesWithBadRowsDropped) {
   EXPECT_EQ(diag.get("baro.csv:bad_value"), 1);
   const auto tl = s.timeline();
   ASSERT_EQ(tl.size(), s.size());
-  // t=0: IMU, BARO, FLIGHT_STATE in that order; t=0.01: IMU then FLIGHT_STATE; t=0.05: BARO.
-  const std::vector<int> streams = {InertialStreams::kImuStream, InertialStreams::kBaroStream,
-                                    InertialStreams::kFlightStateStream, InertialStreams::kImuStream,
-                                    InertialStreams::kFlightStateStream, InertialStreams::kBaroStream};
+  // Equal times in the estimator's canonical order: t=0: FLIGHT_STATE, IMU, BARO;
+  // t=0.01: FLIGHT_STATE then IMU; t=0.05: BARO.
+  const std::vector<int> streams = {InertialStreams::kFlightStateStream, InertialStreams::kImuStream,
+                                    InertialStreams::kBaroStream, InertialStreams::kFlightStateStream,
+                                    InertialStreams::kImuStream, InertialStreams::kBaroStream};
   for (size_t i = 0; i < tl.size(); ++i) EXPECT_EQ(tl[i].stream, streams[i]) << i;
-  EXPECT_DOUBLE_EQ(s.imu[tl[3].index].acc_m_s2.z(), 9.80);
+  EXPECT_DOUBLE_EQ(s.imu[tl[4].index].acc_m_s2.z(), 9.80);
   fs::remove_all(d);
 }
 
