@@ -44,6 +44,13 @@ struct NominalState {
       case InstanceKind::Tag: tag_biases.at(b.id).gamma_m += dx.head(b.dim); break;
     }
   }
+  /// Forgets the nominal values of instance `id` (baro bias, anchor position or tag biases).
+  void erase(SensorId id) {
+    baro_bias_m.erase(id);
+    anchor_p_AinG.erase(id);
+    tag_biases.erase(id);
+  }
+
   /// Applies a stacked error-state correction laid out as `layout`.
   void boxplus(const StateLayout& layout, const Eigen::VectorXd& dx) {
     for (const StateBlock& b : layout.blocks()) boxplusBlock(b, dx.segment(b.offset, b.dim));

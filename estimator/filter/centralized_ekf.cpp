@@ -60,9 +60,7 @@ bool CentralizedEkf::removeInstance(SensorId id) {
   P.bottomRightCorner(tail, tail) = P_.bottomRightCorner(tail, tail);
   P_ = std::move(P);
   layout_.remove(id);
-  x_.baro_bias_m.erase(id);
-  x_.anchor_p_AinG.erase(id);
-  x_.tag_biases.erase(id);
+  x_.erase(id);
   return true;
 }
 

@@ -47,9 +47,7 @@ void ModularFilter::addTagBiases(SensorId tag_id, const std::vector<SensorId>& p
 bool ModularFilter::removeInstance(SensorId id) {
   if (!cov_.has(id) || cov_.layout().at(id).kind == InstanceKind::Imu) return false;
   cov_.remove(id);
-  x_.baro_bias_m.erase(id);
-  x_.anchor_p_AinG.erase(id);
-  x_.tag_biases.erase(id);
+  x_.erase(id);
   return true;
 }
 
