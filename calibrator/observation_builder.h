@@ -50,4 +50,10 @@ class ObservationBuilder {
 std::pair<Eigen::Vector3d, Eigen::Matrix3d> tagPositionAtPose(const PoseEstimate& pose, const Eigen::Vector3d& p_TinI,
                                                               double min_sigma_m);
 
+/// The range `r` involving the unknown anchor `x` as an observation of the reference at the other
+/// end: time, reference id, range and its σ_d (the range's own variance when
+/// `use_range_variance` and R > 0, else `sigma_range_m`). The reference position is left to the
+/// caller (tag pose, known or calibrated anchor).
+CalibObservation rangeObservation(const RangeSample& r, SensorId x, const CalibratorOptions& options);
+
 }  // namespace meshnav::calib

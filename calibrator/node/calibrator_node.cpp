@@ -311,12 +311,8 @@ CalibratorNode::Built CalibratorNode::buildObservations(SensorId x, Track& tr) {
   const auto& opt = calibrator_.options();
   std::deque<RangeSample> kept;
   for (const RangeSample& r : tr.ranges) {
-    const SensorId ref = r.id_initiator == x ? r.id_responder : r.id_initiator;
-    CalibObservation o;
-    o.t = r.t;
-    o.ref_id = ref;
-    o.z_m = r.range_m;
-    o.sigma_d_m = (opt.use_range_variance && r.R_m2 > 0) ? std::sqrt(r.R_m2) : opt.sigma_range_m;
+    CalibObservation o = rangeObservation(r, x, opt);
+    const SensorId ref = o.ref_id;
     if (setup_.isTag(ref)) {
       if (const auto tp = tagPosition(ref, r.t)) {
         o.p_RinG = tp->first;

@@ -54,6 +54,15 @@ std::pair<Eigen::Vector3d, Eigen::Matrix3d> tagPositionAtPose(const PoseEstimate
   return {pose.p_IinG + R * p_TinI, cov};
 }
 
+CalibObservation rangeObservation(const RangeSample& r, SensorId x, const CalibratorOptions& options) {
+  CalibObservation o;
+  o.t = r.t;
+  o.ref_id = r.id_initiator == x ? r.id_responder : r.id_initiator;
+  o.z_m = r.range_m;
+  o.sigma_d_m = (options.use_range_variance && r.R_m2 > 0) ? std::sqrt(r.R_m2) : options.sigma_range_m;
+  return o;
+}
+
 std::vector<CalibObservation> ObservationBuilder::collect(SensorId x, const std::vector<RangeSample>& ranges,
                                                           Diagnostics& diag, std::optional<Timestamp> t_start,
                                                           std::optional<Timestamp> t_end) const {
@@ -68,11 +77,7 @@ std::vector<CalibObservation> ObservationBuilder::collect(SensorId x, const std:
                                               " and " + std::to_string(r.id_responder) + " is unusable");
       continue;
     }
-    CalibObservation o;
-    o.t = r.t;
-    o.ref_id = ref;
-    o.z_m = r.range_m;
-    o.sigma_d_m = (options_.use_range_variance && r.R_m2 > 0) ? std::sqrt(r.R_m2) : options_.sigma_range_m;
+    CalibObservation o = rangeObservation(r, x, options_);
     if (setup_.isTag(ref)) {
       const auto tp = tagPosition(ref, r.t);
       if (!tp) {
