@@ -18,9 +18,8 @@
 #include "estimator/node/estimator_input.h"
 #include "estimator/node/estimator_node.h"
 #include "calibrator/calibration_io.h"
+#include "calibrator/node/calibrator_config.h"
 #include "pipeline/pipeline.h"
-
-#include <yaml-cpp/yaml.h>
 
 using namespace meshnav;
 using namespace meshnav::estimator;
@@ -115,10 +114,7 @@ int main(int argc, char** argv) {
     pipeline::PipelineOptions popts;
     popts.estimator = options;
     popts.calibration_enabled = !cli.has("no-calibration");
-    if (cli.has("calib-config")) {
-      popts.calibrator = calib::CalibratorOptions::load(cli.get("calib-config"));
-      popts.calibrator_node = calib::CalibratorNodeOptions::load(cli.get("calib-config"));
-    }
+    calib::CalibratorConfig calib_config = calib::CalibratorConfig::load(cli.get("calib-config", ""));
     if (cli.has("mission")) popts.mission = mission::loadMission(cli.get("mission"));
 
     Diagnostics diag;
@@ -138,15 +134,11 @@ int main(int argc, char** argv) {
     sinks.anchors = [&](const std::vector<AnchorEstimate>& v) {
       for (const auto& a : v) anchor_writer.write(a);
     };
-    // The calibrator's range σ_d comes from setup.yaml (noise.sigma_range) unless the calibrator
-    // config sets it, as in the calibrator process.
-    bool sigma_in_config = false;
-    if (cli.has("calib-config")) {
-      const YAML::Node root = YAML::LoadFile(cli.get("calib-config"));
-      const YAML::Node cal = root["calibrator"] ? root["calibrator"] : (root["calibrator_node"] ? YAML::Node() : root);
-      sigma_in_config = cal.IsMap() && cal["sigma_range"].IsDefined();
-    }
-    if (ds.setup.noise.sigma_range_m && !sigma_in_config) popts.calibrator.sigma_range_m = *ds.setup.noise.sigma_range_m;
+    // The calibrator's range σ_d comes from setup.yaml unless the calibrator config sets it, as in
+    // the calibrator process.
+    calib_config.applySetup(ds.setup);
+    popts.calibrator = calib_config.calibrator;
+    popts.calibrator_node = calib_config.node;
     pipeline::PipelineSinks psinks;
     psinks.pose = sinks.pose;
     psinks.anchors = sinks.anchors;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "calibrator/calibration_io.h"
+#include "calibrator/node/calibrator_config.h"
 
 namespace meshnav::calib {
 
@@ -51,34 +52,12 @@ double nonNegative(const Cli& cli, const std::string& name, double fallback, boo
   return v;
 }
 
-/// Loads `calibrator:` and `calibrator_node:` of the file (either may be missing; any other
-/// top-level key is an error, so that a typo does not silently leave defaults). A file with neither
-/// map is read as a flat `calibrator:` map (as CalibratorOptions::load does).
+/// --config through the shared loader (calibrator/node/calibrator_config.h).
 void loadConfigFile(CalibratorProcessConfig& c) {
-  const std::string& path = c.config_path;
-  if (!std::filesystem::exists(path)) throw std::runtime_error(path + ": no such file (--config)");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": cannot read (" + e.what() + ")");
-  }
-  if (!root || root.IsNull()) return;  // empty file: defaults
-  if (!root.IsMap()) throw std::runtime_error(path + ": expected a map with 'calibrator' and/or 'calibrator_node'");
-  const YAML::Node& croot = root;  // const lookups: yaml-cpp's non-const operator[] inserts keys
-  const bool sections = croot["calibrator"] || croot["calibrator_node"];
-  if (sections) {
-    for (const auto& kv : croot) {
-      const auto key = kv.first.as<std::string>();
-      if (key != "calibrator" && key != "calibrator_node")
-        throw std::runtime_error(path + ": unknown top-level key '" + key + "' (expected calibrator, calibrator_node)");
-    }
-  }
-  const YAML::Node cal = sections ? croot["calibrator"] : croot;
-  const YAML::Node node = croot["calibrator_node"];
-  c.calibrator = CalibratorOptions::fromYaml(cal, path);
-  c.node = CalibratorNodeOptions::fromYaml(node, path);
-  c.sigma_range_from_config = cal && cal.IsMap() && cal["sigma_range"];
+  const CalibratorConfig cc = CalibratorConfig::load(c.config_path);
+  c.calibrator = cc.calibrator;
+  c.node = cc.node;
+  c.sigma_range_from_config = cc.sigma_range_from_config;
 }
 
 }  // namespace
@@ -100,14 +79,10 @@ CalibratorProcessConfig calibratorProcessConfig(const Cli& cli) {
 }
 
 void applySetup(CalibratorProcessConfig& config, const SystemSetup& setup) {
-  if (config.sigma_range_from_config || !setup.noise.sigma_range_m) return;
-  const double s = *setup.noise.sigma_range_m;
-  if (!(s > 0.0) || !std::isfinite(s)) {
-    spdlog::warn("setup noise.sigma_range = {} is not > 0: keeping σ_d = {} m", s, config.calibrator.sigma_range_m);
-    return;
-  }
-  config.calibrator.sigma_range_m = s;
-  config.sigma_range_source = "setup.yaml noise.sigma_range";
+  CalibratorConfig cc{config.calibrator, config.node, config.sigma_range_from_config, config.sigma_range_source};
+  cc.applySetup(setup);
+  config.calibrator = cc.calibrator;
+  config.sigma_range_source = cc.sigma_range_source;
 }
 
 std::string CalibratorProcessConfig::toString() const {
