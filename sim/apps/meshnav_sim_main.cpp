@@ -5,14 +5,13 @@
 #include <spdlog/spdlog.h>
 
 #include <exception>
-#include <random>
 #include <iostream>
 
 #include "common/cli.h"
 #include "common/dataset.h"
 #include "sim/paper_scenario.h"
 #include "sim/scenario_simulator.h"
-#include "sim/uwb_hardware_biases.h"
+#include "sim/uncertain_anchors.h"
 
 namespace {
 constexpr const char* kUsage = R"(meshnav_sim: simulate one sequence of the paper's scenario (DESIGN §7)
@@ -26,10 +25,14 @@ Usage: meshnav_sim --seed N --out DIR [options]
   --drop-fraction F        fraction of dropped range messages (default 0.02)
   --duration-scale S       multiply every time constant of the flight (default 1: ~140 s)
   --no-initial-pose        do not write the take-off pad prior to setup.yaml
-  --uncertain-anchors M    write every anchor (101-110) to setup.yaml as truth + N(0, M^2) per axis
-                           (seeded by --seed) with position sigma M [m], so that the estimator
-                           refines them online, with a-priori pair biases for every pair (as for
-                           101-104); truth.yaml is unchanged (default: off, 101-104 exact)
+  --uncertain-anchors M    write the anchors that are not known (106-110) to setup.yaml as
+                           truth + N(0, M^2) per axis (seeded by --seed) with position sigma M [m],
+                           so that the estimator refines them online, with a-priori pair biases for
+                           every pair (as for 101-104); 101-104 stay exact; truth.yaml is unchanged
+                           (default: off, only 101-104 in setup.yaml)
+  --uncertain-known-anchors
+                           with --uncertain-anchors: perturb 101-104 as well (no exact anchor left:
+                           the frame is held by the priors only)
   --help                   this text
 
 Writes imu.csv (200 Hz), baro.csv (50 Hz), ranges.csv (meshed TDMA, 11 devices, 10 ms slots),
@@ -42,7 +45,8 @@ int main(int argc, char** argv) {
   meshnav::setupLogging("meshnav_sim");
   meshnav::Cli cli("meshnav_sim", kUsage);
   cli.option("seed").option("out").option("sigma-range").option("outlier-fraction").option("drop-fraction")
-      .option("duration-scale").option("no-initial-pose", false).option("uncertain-anchors");
+      .option("duration-scale").option("no-initial-pose", false).option("uncertain-anchors")
+      .option("uncertain-known-anchors", false);
   int exit_code = 0;
   if (!cli.parse(argc, argv, exit_code)) return exit_code;
   if (!cli.positional().empty()) {
@@ -69,30 +73,19 @@ int main(int argc, char** argv) {
     const double uncertain_sigma_m = cli.getDouble("uncertain-anchors", 0.0);
     if (cli.has("uncertain-anchors") && !(uncertain_sigma_m > 0.0 && uncertain_sigma_m < 10.0))
       throw std::invalid_argument("--uncertain-anchors must be in (0, 10) m");
+    if (cli.has("uncertain-known-anchors") && !cli.has("uncertain-anchors"))
+      throw std::invalid_argument("--uncertain-known-anchors needs --uncertain-anchors M");
 
     const meshnav::sim::ScenarioSimulator simulator(options);
     meshnav::sim::SimulationResult result = simulator.run();
     if (cli.has("uncertain-anchors")) {
-      // Every anchor becomes "known but uncertain": a perturbed position with its sigma.
-      if (!result.dataset.truth) throw std::logic_error("simulator returned no truth");
-      std::mt19937_64 rng(options.seed * 0x9E3779B97F4A7C15ULL + 0x5EEDULL);
-      std::normal_distribution<double> n01(0.0, 1.0);
-      auto& setup = result.dataset.setup;
-      for (const auto& [id, p] : result.dataset.truth->anchor_positions) {
-        const Eigen::Vector3d e(n01(rng), n01(rng), n01(rng));
-        setup.abs_anchor_positions[id] = p + uncertain_sigma_m * e;
-        setup.abs_anchor_sigmas_m[id] = uncertain_sigma_m;
-      }
-      // Known-but-uncertain anchors come with their a-priori pair biases, like 101–104: every pair
-      // of devices gets the hardware bias plus the same calibration error model (σ_γ in setup).
-      const meshnav::sim::UwbHardwareBiases hw(meshnav::sim::PaperScenario::paper().uwbDeviceIds(), options.hardware);
-      const auto ids = meshnav::sim::PaperScenario::paper().uwbDeviceIds();
-      for (size_t i = 0; i < ids.size(); ++i)
-        for (size_t j = i + 1; j < ids.size(); ++j)
-          if (!setup.findPairBias(ids[i], ids[j]) && !(setup.isTag(ids[i]) && setup.isTag(ids[j])))
-            setup.pair_biases.push_back(hw.calibrated(ids[i], ids[j], options.uwb.sigma_range_m));
-      spdlog::info("uncertain anchors: {} anchors written with sigma {} m, {} a-priori pair biases",
-                   result.dataset.truth->anchor_positions.size(), uncertain_sigma_m, setup.pair_biases.size());
+      meshnav::sim::UncertainAnchorOptions uo;
+      uo.sigma_m = uncertain_sigma_m;
+      uo.include_known = cli.has("uncertain-known-anchors");
+      uo.seed = options.seed;
+      const int n = meshnav::sim::makeAnchorsUncertain(result.dataset, uo, options.hardware, options.uwb.sigma_range_m);
+      spdlog::info("uncertain anchors: {} anchors written with sigma {} m ({}), {} a-priori pair biases", n,
+                   uncertain_sigma_m, uo.include_known ? "all" : "101-104 exact", result.dataset.setup.pair_biases.size());
     }
     spdlog::info("{}", result.trajectory.toString());
     const std::string out = cli.get("out");

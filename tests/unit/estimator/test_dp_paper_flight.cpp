@@ -1,5 +1,6 @@
 /// DP ≡ centralized over a whole simulated paper sequence (seed 2, every anchor uncertain as with
-/// `meshnav_sim --uncertain-anchors 0.3`), with ranges and baro arriving up to 0.4 s late.
+/// `meshnav_sim --uncertain-anchors 0.3 --uncertain-known-anchors`: the most instances and
+/// correlations), with ranges and baro arriving up to 0.4 s late.
 #include <gtest/gtest.h>
 
 #include <random>
