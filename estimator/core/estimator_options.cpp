@@ -48,6 +48,8 @@ void forEachField(Opt& o, Visitor&& v) {
   v("uwb.use_corrected_range", o.uwb.use_corrected_range, "fuse range_corr instead of range_raw");
   v("uwb.max_range_m", o.uwb.max_range_m, "longer ranges are bad input [m]");
   v("uwb.estimate_tag_biases", o.uwb.estimate_tag_biases, "estimate tag-anchor gamma (setup anchors, sigma_gamma > 0) as states");
+  v("uwb.dah_fuse_estimated_anchor_pairs", o.uwb.dah_fuse_estimated_anchor_pairs,
+    "dah only: fuse ranges between two estimated anchors (overconfident, see docs)");
   v("zupt.enabled", o.zupt.enabled, "");
   v("zupt.rate_hz", o.zupt.rate_hz, "pseudo-measurement rate while landed [Hz]");
   v("zupt.sigma_acc_m_s2", o.zupt.sigma_acc_m_s2, "sigma of a = 0 [m/s^2]");

@@ -51,6 +51,12 @@ struct UwbOptions {
   /// tag instances (else their σ_γ inflates the range noise). Anchors added at run time
   /// (ANCHOR_INIT) keep their calibrated γ as dictionary values.
   bool estimate_tag_biases = true;
+  /// Strategy `dah` only: fuse ranges between two estimated anchors. Off by default: DAH keeps no
+  /// correlation between anchors that is built through a third instance (their common-mode error),
+  /// so these updates shrink both anchors' covariance for information they share and make the
+  /// filter overconfident (docs/modular_estimator.md, "DAH and anchor–anchor ranges"). Ranges
+  /// between an estimated and an exactly known anchor are private updates and always fused.
+  bool dah_fuse_estimated_anchor_pairs = false;
 };
 
 struct ZuptOptions {

@@ -340,6 +340,11 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
       event(first, RangeModel::statusName(status));
     return;
   }
+  if (options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs &&
+      cur_.filter->state().anchor_p_AinG.count(z.a) && cur_.filter->state().anchor_p_AinG.count(z.b)) {
+    event(first, "range_dah_anchor_pair_skipped");  // a policy, not bad input (see UwbOptions)
+    return;
+  }
   propagateTo(s.t);
   ScopedStepTimer timer(timings_, "range_update");
   Linearization lin;

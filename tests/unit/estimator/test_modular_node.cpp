@@ -206,11 +206,34 @@ TEST(ModularNode, StatusReportsInstancesTimingsAndCounters) {
   int anchors = 0;
   for (const auto& i : st.instances) {
     if (i.type == "anchor") ++anchors;
-    if (i.id == 1) EXPECT_GT(i.n_updates, 0);
+    if (i.id == 1) {
+      EXPECT_GT(i.n_updates, 0);
+    }
   }
   EXPECT_EQ(anchors, 7);  // 101–104 exact, 106–108 estimated
   std::map<SensorId, int> seen;
   for (const auto& i : st.instances) ++seen[i.id];
   for (const auto& [id, n] : seen) EXPECT_EQ(n, 1) << "instance " << id << " listed " << n << " times";
   EXPECT_TRUE(seen.count(100) && seen.count(105)) << "both tags are instances";
+}
+
+TEST(ModularNode, DahLeavesRangesBetweenEstimatedAnchorsOutUnlessAsked) {
+  const Dataset ds = dataset(8.0);
+  int pairs = 0;  // ranges between two estimated anchors (106–108)
+  for (const auto& r : ds.ranges) pairs += r.id_initiator >= 106 && r.id_responder >= 106;
+  ASSERT_GT(pairs, 10);
+  auto run = [&](const std::string& strategy, bool fuse) {
+    EstimatorOptions o = test::strategyOptions(strategy);
+    o.uwb.dah_fuse_estimated_anchor_pairs = fuse;
+    EstimatorNode node(o, ds.setup);
+    for (const auto& in : mergeInTimeOrder(ds)) node.onInput(in);
+    EXPECT_TRUE(node.initialized());
+    return node.diagnostics().get("range_dah_anchor_pair_skipped");
+  };
+  const int64_t skipped = run("dah", false);
+  EXPECT_GT(skipped, 0);
+  EXPECT_LE(skipped, pairs);  // those before initialization are not reached
+  EXPECT_EQ(run("dah", true), 0);
+  EXPECT_EQ(run("dp", false), 0) << "DP and centralized are exact: they always fuse them";
+  EXPECT_EQ(run("centralized", false), 0);
 }
