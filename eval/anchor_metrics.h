@@ -20,7 +20,7 @@ namespace meshnav::eval {
 
 struct AnchorError {
   SensorId id = 0;
-  bool known = false;          ///< given in setup.yaml (not calibrated)
+  bool known = false;          ///< exactly known: in setup.yaml without a σ (else calibrated or refined online)
   bool has_truth = false;
   Eigen::Vector3d p_true = Eigen::Vector3d::Zero();
   int n_estimates = 0;         ///< rows in anchors.csv
@@ -34,12 +34,14 @@ struct AnchorError {
 
 struct AnchorMetrics {
   std::vector<AnchorError> anchors;   ///< sorted by id
-  /// Means over calibrated anchors (not known) that have truth; NaN when there is none.
+  /// Means over the estimated anchors (not known: calibrated, or given with a σ and refined online)
+  /// that have truth; NaN when there is none.
   double mean_initial_error_m = 0.0;
   double mean_final_error_m = 0.0;
-  int n_calibrated = 0;
+  int n_estimated = 0;
 };
 
+/// `known_positions`: the exactly known anchors (setup.yaml entries without a σ).
 /// `initial_override`: id → initial belief (e.g. from the calibration YAML), replacing the first
 /// anchors.csv row. Anchors without truth are listed with has_truth = false (and reported once to
 /// `diag` as "eval:anchor_without_truth").

@@ -47,7 +47,7 @@ AnchorMetrics computeAnchorMetrics(const std::vector<AnchorEstimate>& anchor_row
       e.initial_nees = nees(d0, e.initial.cov_p_m2);
       e.final_nees = nees(d1, e.final_est.cov_p_m2);
       if (!e.known) {
-        ++m.n_calibrated;
+        ++m.n_estimated;
         sum_init += e.initial_error_m;
         sum_final += e.final_error_m;
       }
@@ -55,8 +55,8 @@ AnchorMetrics computeAnchorMetrics(const std::vector<AnchorEstimate>& anchor_row
     m.anchors.push_back(e);
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  m.mean_initial_error_m = m.n_calibrated > 0 ? sum_init / m.n_calibrated : nan;
-  m.mean_final_error_m = m.n_calibrated > 0 ? sum_final / m.n_calibrated : nan;
+  m.mean_initial_error_m = m.n_estimated > 0 ? sum_init / m.n_estimated : nan;
+  m.mean_final_error_m = m.n_estimated > 0 ? sum_final / m.n_estimated : nan;
   return m;
 }
 

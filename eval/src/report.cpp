@@ -213,12 +213,12 @@ std::string formatRunReport(const RunEvaluation& ev) {
       std::string pos = a.has_truth ? "[" + formatNumber(a.p_true.x(), 2) + ", " + formatNumber(a.p_true.y(), 2) + ", " +
                                           formatNumber(a.p_true.z(), 2) + "]"
                                     : "no truth";
-      t.addRow({std::to_string(a.id), a.known ? "known" : "calibrated", std::to_string(a.n_estimates),
+      t.addRow({std::to_string(a.id), a.known ? "known" : "estimated", std::to_string(a.n_estimates),
                 a.has_truth ? formatNumber(a.initial_error_m, 3) : "–", a.has_truth ? formatNumber(a.final_error_m, 3) : "–",
                 fmtOpt(a.initial_nees, 2), fmtOpt(a.final_nees, 2), pos});
     }
     t.addRule();
-    t.addRow({"mean", "calibrated", std::to_string(ev.anchors->n_calibrated),
+    t.addRow({"mean", "estimated", std::to_string(ev.anchors->n_estimated),
               formatNumber(ev.anchors->mean_initial_error_m, 3), formatNumber(ev.anchors->mean_final_error_m, 3), "", "", ""});
     os << t.plain();
     os << "  (single NEES, 3 dof: " << formatNumber(100.0 * conf, 0) << " % interval " << fmtBounds(single, 3)
@@ -267,7 +267,7 @@ YAML::Node metricsNode(const RunEvaluation& ev) {
   } else {
     const auto& a = *ev.anchors;
     YAML::Node an;
-    an["n_calibrated"] = a.n_calibrated;
+    an["n_estimated"] = a.n_estimated;
     an["mean_initial_error_m"] = num(a.mean_initial_error_m);
     an["mean_final_error_m"] = num(a.mean_final_error_m);
     const auto single = aneesBounds(1, 3, ev.options.confidence);
@@ -364,7 +364,7 @@ void writeAnchorsEvalCsv(const RunEvaluation& ev, const std::string& path) {
 // Batch
 
 TextTable makeBatchTable(const std::vector<BatchEntry>& entries) {
-  std::set<SensorId> ids;  // calibrated anchors with truth, over all runs
+  std::set<SensorId> ids;  // estimated anchors (calibrated or refined online) with truth, over all runs
   for (const auto& e : entries)
     if (e.ev.anchors)
       for (const auto& a : e.ev.anchors->anchors)

@@ -50,7 +50,10 @@ RunEvaluation evaluateRun(const std::string& dataset_dir, const std::string& run
   const fs::path setup_path = ds / "setup.yaml";
   if (fs::exists(setup_path)) {
     try {
-      known = loadSetup(setup_path.string()).abs_anchor_positions;
+      // Exactly known anchors only: those given with a σ are estimated (refined online).
+      const SystemSetup setup = loadSetup(setup_path.string());
+      for (const auto& [id, p] : setup.abs_anchor_positions)
+        if (!setup.abs_anchor_sigmas_m.count(id)) known[id] = p;
     } catch (const std::exception& ex) {
       note(ev, std::string("cannot read setup: ") + ex.what() + " (anchors are not marked known)");
     }

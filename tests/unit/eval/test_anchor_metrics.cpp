@@ -51,7 +51,7 @@ TEST(AnchorMetrics, InitialAndFinalErrorsAndInitialNees) {
   EXPECT_NEAR(a107.initial_error_m, 1.0, 1e-12);
   EXPECT_NEAR(*a107.initial_nees, 4.0, 1e-9);
   // Means over calibrated anchors only (101 is known).
-  EXPECT_EQ(m.n_calibrated, 2);
+  EXPECT_EQ(m.n_estimated, 2);
   EXPECT_NEAR(m.mean_initial_error_m, 0.75, 1e-12);
   EXPECT_NEAR(m.mean_final_error_m, 0.55, 1e-12);
 }
@@ -67,7 +67,7 @@ TEST(AnchorMetrics, CalibrationOverrideAndMissingTruth) {
   EXPECT_NEAR(m.anchors[0].final_error_m, 0.2, 1e-12);
   EXPECT_FALSE(m.anchors[1].has_truth);
   EXPECT_EQ(diag.get("eval:anchor_without_truth"), 1);
-  EXPECT_EQ(m.n_calibrated, 1);
+  EXPECT_EQ(m.n_estimated, 1);
 }
 
 TEST(AnchorMetrics, NoAnchorsGivesNaNMeans) {

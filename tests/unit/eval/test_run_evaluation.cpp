@@ -34,7 +34,7 @@ class RunEvaluationTest : public ::testing::Test {
 
   /// 10 s of ground truth at 60 Hz (circle), estimates at 20 Hz with a constant 0.2 m x offset and
   /// σ = 0.2 m (NEES 1 per sample), two calibrated anchors and a known one.
-  void writeAll(bool with_truth = true) {
+  void writeAll(bool with_truth = true, bool anchor_106_in_setup_with_sigma = false) {
     std::vector<PoseSample> gt;
     for (int k = 0; k <= 600; ++k) {
       const double t = k / 60.0;
@@ -47,6 +47,10 @@ class RunEvaluationTest : public ::testing::Test {
     SystemSetup setup;
     setup.rel_tag_positions[100] = Eigen::Vector3d(0.1, 0, 0);
     setup.abs_anchor_positions[101] = Eigen::Vector3d(0, 0, 0);
+    if (anchor_106_in_setup_with_sigma) {  // known-but-uncertain: refined online, so "estimated"
+      setup.abs_anchor_positions[106] = Eigen::Vector3d(1, 1, 1.4);
+      setup.abs_anchor_sigmas_m[106] = 0.2;
+    }
     saveSetup(setup, (ds_ / "setup.yaml").string());
     if (with_truth) {
       Truth truth;
@@ -99,7 +103,7 @@ TEST_F(RunEvaluationTest, MetricsTablesAndFiles) {
   EXPECT_NEAR(ev.trajectory.position.anees, 1.0, 2e-3);
   EXPECT_NEAR(ev.trajectory.orientation.rmse, 0.0, 1e-3);
   ASSERT_TRUE(ev.anchors);
-  EXPECT_EQ(ev.anchors->n_calibrated, 2);
+  EXPECT_EQ(ev.anchors->n_estimated, 2);
   EXPECT_NEAR(ev.anchors->mean_initial_error_m, 0.35, 1e-6);
   EXPECT_NEAR(ev.anchors->mean_final_error_m, 0.2, 1e-6);
   EXPECT_NEAR(*ev.anchors->anchors[1].initial_nees, 4.0, 1e-4);
@@ -132,6 +136,20 @@ TEST_F(RunEvaluationTest, MetricsTablesAndFiles) {
   int lines = 1;
   while (std::getline(f, first)) ++lines;
   EXPECT_EQ(lines, 200);
+}
+
+TEST_F(RunEvaluationTest, AnchorGivenWithSigmaCountsAsEstimated) {
+  writeAll(true, true);
+  const RunEvaluation ev = evaluateRun(ds_.string(), run_.string(), {});
+  ASSERT_TRUE(ev.anchors);
+  EXPECT_EQ(ev.anchors->n_estimated, 2);  // 106 (setup with σ) and 107 (calibrated); 101 known
+  for (const auto& a : ev.anchors->anchors) EXPECT_EQ(a.known, a.id == 101) << a.id;
+  EXPECT_NEAR(ev.anchors->mean_final_error_m, 0.2, 1e-6);
+  EXPECT_NE(formatRunReport(ev).find("estimated"), std::string::npos);
+  std::vector<BatchEntry> entries;
+  entries.push_back({"seed01", ev});
+  const std::string table = makeBatchTable(entries).plain();
+  EXPECT_NE(table.find("A106★ [m]"), std::string::npos) << table;
 }
 
 TEST_F(RunEvaluationTest, BatchTableHasMeanRow) {
