@@ -52,6 +52,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
   if (!strategyImplemented(options_.strategy))
     throw std::invalid_argument("strategy '" + options_.strategy + "' is not implemented yet (next issue)");
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
+  skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
   if (options_.baro.gate_probability > 0) baro_gate_ = chi2Quantile(1, options_.baro.gate_probability);
   resetAll();
 }
@@ -340,8 +341,8 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
       event(first, RangeModel::statusName(status));
     return;
   }
-  if (options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs &&
-      cur_.filter->state().anchor_p_AinG.count(z.a) && cur_.filter->state().anchor_p_AinG.count(z.b)) {
+  if (skip_estimated_anchor_pairs_ && cur_.filter->state().anchor_p_AinG.count(z.a) &&
+      cur_.filter->state().anchor_p_AinG.count(z.b)) {
     event(first, "range_dah_anchor_pair_skipped");  // a policy, not bad input (see UwbOptions)
     return;
   }

@@ -120,6 +120,8 @@ class EstimatorNode {
   BaroModel baro_model_;
   ZuptModel zupt_model_;
   double range_gate_ = 0.0, baro_gate_ = 0.0;
+  /// dah without uwb.dah_fuse_estimated_anchor_pairs: ranges between two estimated anchors are left out.
+  bool skip_estimated_anchor_pairs_ = false;
 
   Snapshot cur_;
   std::deque<Entry> history_;
