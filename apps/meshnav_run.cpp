@@ -42,6 +42,7 @@ Usage: meshnav_run --dataset DIR --out DIR [--strategy centralized|dp|dah] [--co
   --no-calibration known anchors only: ranges to unknown anchors are ignored (and counted)
   --calib-config FILE  calibrator options YAML (default: built-in = config/calibrator.yaml);
                    calibration results are written to calibration.yaml in --out
+  --allow-lost     exit 0 even if the estimate ends lost or never initialized (default: exit 3)
   --print-config   print the estimator options (defaults or --config) as YAML and exit
   --help           this text
 )";
@@ -56,6 +57,8 @@ void writeTimings(const StepTimings& timings, const std::string& path) {
 void writeStatus(const EstimatorStatus& st, double wall_s, double data_s, const std::string& path) {
   std::ofstream out(path);
   out << "strategy: " << st.strategy << "\ninitialized: " << (st.initialized ? "true" : "false")
+      << "\nhealth: " << st.health << "\nhealth_reason: \"" << st.health_reason << "\""
+      << "\nsigma_p_max_m: " << st.sigma_p_max_m << "\nsigma_yaw_deg: " << st.sigma_yaw_deg
       << "\nfilter_time_s: " << formatSeconds(st.t) << "\nwall_time_s: " << wall_s << "\ndata_duration_s: " << data_s
       << "\nrealtime_factor: " << (wall_s > 0 ? data_s / wall_s : 0.0) << "\ncounters:\n";
   for (const auto& [k, v] : st.counters) out << "  " << k << ": " << v << '\n';
@@ -74,7 +77,7 @@ int main(int argc, char** argv) {
   Cli cli("meshnav_run", kUsage);
   cli.option("dataset").option("out").option("strategy").option("config").option("mission");
   cli.option("no-calibration", false).option("calib-config");
-  cli.option("print-config", false);
+  cli.option("print-config", false).option("allow-lost", false);
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   if (cli.has("print-config")) {
@@ -180,7 +183,7 @@ int main(int argc, char** argv) {
     const EstimatorStatus st = node.status();
     writeStatus(st, wall_s, data_s, (out_dir / "status.txt").string());
 
-    if (!node.initialized()) spdlog::error("the estimator never initialized");
+    if (!node.initialized()) spdlog::error("the estimator never initialized: {}", node.waitingFor());
     if (auto pose = node.pose())
       spdlog::info("final: p_IinG [{:.3f}, {:.3f}, {:.3f}] m, b_gyro [{:.5f}, {:.5f}, {:.5f}] rad/s, "
                    "b_acc [{:.4f}, {:.4f}, {:.4f}] m/s^2",
@@ -195,7 +198,16 @@ int main(int argc, char** argv) {
                    s.median_us, s.max_us);
     spdlog::info("processed {:.1f} s of data in {:.3f} s wall (real-time factor {:.0f}x); results in {}", data_s,
                  wall_s, wall_s > 0 ? data_s / wall_s : 0.0, out_dir.string());
-    return node.initialized() ? 0 : 1;
+    // A run that ends lost (no usable aiding, or runaway the recovery could not fix) is not healthy.
+    const int64_t lost_events = st.counters.count("health_lost") ? st.counters.at("health_lost") : 0;
+    if (node.initialized() && node.health() == Health::Lost)
+      spdlog::error("the estimate ends LOST ({}); {} lost events, {} recoveries", st.health_reason, lost_events,
+                    st.counters.count("recovery") ? st.counters.at("recovery") : 0);
+    else if (lost_events > 0)
+      spdlog::warn("the estimate was lost {} times during the run and recovered", lost_events);
+    const bool healthy = node.initialized() && node.health() != Health::Lost;
+    if (healthy || cli.has("allow-lost")) return 0;
+    return 3;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

@@ -32,6 +32,13 @@ struct EstimatorStatus {
   std::map<std::string, int64_t> counters;
   /// Mean step durations [µs] by step type: "propagate", "range_update", "baro_update", "zupt".
   std::map<std::string, double> mean_step_us;
+  /// "initializing", "ok", "degraded" or "lost" (estimator/health/health_monitor.h).
+  std::string health = "initializing";
+  /// Why the health is not ok, or what initialization waits for.
+  std::string health_reason;
+  double sigma_p_max_m = 0.0;                            ///< largest principal position σ [m]
+  Eigen::Vector3d weak_axis_G = Eigen::Vector3d::Zero(); ///< its direction (unit, G)
+  double sigma_yaw_deg = 0.0;                            ///< yaw σ [deg]
 };
 
 /// ESTIMATOR_CMD: run-time control of the instance set.

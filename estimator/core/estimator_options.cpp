@@ -25,11 +25,13 @@ void forEachField(Opt& o, Visitor&& v) {
   v("imu.gyro_noise_density", o.imu.gyro_noise_density, "[rad/s/sqrt(Hz)]");
   v("imu.acc_bias_rw", o.imu.acc_bias_rw, "[m/s^3/sqrt(Hz)]");
   v("imu.gyro_bias_rw", o.imu.gyro_bias_rw, "[rad/s^2/sqrt(Hz)]");
-  v("imu.max_dt_s", o.imu.max_dt_s, "longer IMU gaps are counted as imu_gap [s]");
+  v("imu.max_dt_s", o.imu.max_dt_s, "longer IMU gaps are counted as imu_gap and inflated [s]");
+  v("imu.gap_sigma_acc_m_s2", o.imu.gap_sigma_acc_m_s2, "held-reading error during a gap [m/s^2/sqrt(s)]");
+  v("imu.gap_sigma_gyro_rad_s", o.imu.gap_sigma_gyro_rad_s, "held-reading error during a gap [rad/s/sqrt(s)]");
   v("init.duration_s", o.init.duration_s, "landed data before initializing [s]");
   v("init.min_ranges", o.init.min_ranges, "tag-anchor ranges needed without initial_pose [-]");
   v("init.assume_landed_without_flight_state", o.init.assume_landed_without_flight_state,
-    "no FLIGHT_STATE received yet: treat as landed");
+    "no FLIGHT_STATE received yet: treat as landed (else IMU stillness decides)");
   v("init.sigma_v_m_s", o.init.sigma_v_m_s, "[m/s]");
   v("init.sigma_roll_pitch_deg", o.init.sigma_roll_pitch_deg, "[deg]");
   v("init.sigma_bias_gyro_rad_s", o.init.sigma_bias_gyro_rad_s, "[rad/s]");
@@ -37,6 +39,13 @@ void forEachField(Opt& o, Visitor&& v) {
   v("init.range_init_min_sigma_p_m", o.init.range_init_min_sigma_p_m, "floor of position sigma from ranges [m]");
   v("init.range_init_sigma_yaw_deg", o.init.range_init_sigma_yaw_deg, "yaw sigma when initialized from ranges [deg]");
   v("init.range_init_outlier_m", o.init.range_init_outlier_m, "init range residual treated as outlier [m]");
+  v("init.static_max_sigma_yaw_deg", o.init.static_max_sigma_yaw_deg, "static range fit refused above [deg]");
+  v("init.ambiguity_chi2", o.init.ambiguity_chi2, "second fit minimum within this cost: ambiguous, refused [-]");
+  v("init.motion_window_s", o.init.motion_window_s, "in-motion alignment window [s]");
+  v("init.motion_min_span_s", o.init.motion_min_span_s, "in-motion alignment shortest window [s]");
+  v("init.motion_min_ranges", o.init.motion_min_ranges, "in-motion alignment ranges needed [-]");
+  v("init.motion_max_sigma_yaw_deg", o.init.motion_max_sigma_yaw_deg, "in-motion alignment refused above [deg]");
+  v("init.motion_max_sigma_p_m", o.init.motion_max_sigma_p_m, "in-motion alignment refused above [m]");
   v("baro.enabled", o.baro.enabled, "");
   v("baro.pressure_sigma_pa", o.baro.pressure_sigma_pa, "[Pa]");
   v("baro.bias_rw_m_per_sqrt_s", o.baro.bias_rw_m_per_sqrt_s, "height bias random walk [m/sqrt(s)]");
@@ -55,6 +64,20 @@ void forEachField(Opt& o, Visitor&& v) {
   v("zupt.sigma_acc_m_s2", o.zupt.sigma_acc_m_s2, "sigma of a = 0 [m/s^2]");
   v("zupt.sigma_gyro_rad_s", o.zupt.sigma_gyro_rad_s, "sigma of omega = 0 [rad/s]");
   v("zupt.sigma_vel_m_s", o.zupt.sigma_vel_m_s, "sigma of v = 0 [m/s]");
+  v("zupt.detect_stillness", o.zupt.detect_stillness, "without FLIGHT_STATE: ZUPT while the IMU shows rest");
+  v("zupt.stillness_gate_probability", o.zupt.stillness_gate_probability, "chi^2 gate of those ZUPTs [-]");
+  v("health.window_s", o.health.window_s, "innovation statistics window [s]");
+  v("health.min_ranges", o.health.min_ranges, "ranges in the window before gating can mean lost [-]");
+  v("health.min_anchors", o.health.min_anchors, "anchors gated alike before it means lost [-]");
+  v("health.degraded_gated_fraction", o.health.degraded_gated_fraction, "[-]");
+  v("health.lost_gated_fraction", o.health.lost_gated_fraction, "[-]");
+  v("health.degraded_mean_nis", o.health.degraded_mean_nis, "mean NIS of accepted ranges, 1 if consistent [-]");
+  v("health.degraded_no_aiding_s", o.health.degraded_no_aiding_s, "no accepted range for this long: degraded [s]");
+  v("health.lost_no_aiding_s", o.health.lost_no_aiding_s, "no accepted range for this long: lost [s]");
+  v("health.lost_sigma_p_m", o.health.lost_sigma_p_m, "largest position sigma beyond which the pose is lost [m]");
+  v("health.hold_s", o.health.hold_s, "a better health must hold this long [s]");
+  v("recovery.enabled", o.recovery.enabled, "re-initialize from ranges and IMU when lost");
+  v("recovery.retry_s", o.recovery.retry_s, "between two attempts while lost [s]");
 }
 
 std::vector<std::string> splitKey(const std::string& key) {
@@ -161,6 +184,19 @@ void EstimatorOptions::validate() const {
   need(imu.acc_noise_density > 0 && imu.gyro_noise_density > 0 && imu.acc_bias_rw >= 0 && imu.gyro_bias_rw >= 0,
        "imu noise densities > 0");
   need(imu.max_dt_s > 0.0, "imu.max_dt_s > 0");
+  need(imu.gap_sigma_acc_m_s2 >= 0.0 && imu.gap_sigma_gyro_rad_s >= 0.0, "imu.gap_sigma_* >= 0");
+  need(init.static_max_sigma_yaw_deg > 0 && init.ambiguity_chi2 > 0 && init.motion_window_s >= init.motion_min_span_s &&
+           init.motion_min_span_s > 0 && init.motion_min_ranges >= 8 && init.motion_max_sigma_yaw_deg > 0 &&
+           init.motion_max_sigma_p_m > 0,
+       "init.motion_* (window >= min span > 0, min_ranges >= 8, sigmas > 0)");
+  need(health.window_s > 0 && health.min_ranges >= 1 && health.min_anchors >= 1 &&
+           health.degraded_gated_fraction > 0 && health.degraded_gated_fraction <= health.lost_gated_fraction &&
+           health.lost_gated_fraction <= 1 && health.degraded_mean_nis > 0 && health.degraded_no_aiding_s > 0 &&
+           health.lost_no_aiding_s >= health.degraded_no_aiding_s && health.lost_sigma_p_m > 0 && health.hold_s >= 0,
+       "health.* (0 < degraded <= lost fractions <= 1, positive times)");
+  need(recovery.retry_s > 0, "recovery.retry_s > 0");
+  need(zupt.stillness_gate_probability > 0 && zupt.stillness_gate_probability < 1,
+       "zupt.stillness_gate_probability in (0, 1)");
   need(init.duration_s >= 0.0 && init.min_ranges >= 4, "init.duration_s >= 0, init.min_ranges >= 4");
   need(init.sigma_v_m_s > 0 && init.sigma_roll_pitch_deg > 0 && init.sigma_bias_gyro_rad_s > 0 &&
            init.sigma_bias_acc_m_s2 > 0 && init.range_init_min_sigma_p_m > 0 && init.range_init_sigma_yaw_deg > 0 &&

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "common/setup.h"
+#include "estimator/health/health_monitor.h"
 
 namespace meshnav::estimator {
 
@@ -16,14 +17,23 @@ struct ImuNoiseOptions {
   double gyro_noise_density = 0.002;  ///< σ_ω [rad/s/√Hz]
   double acc_bias_rw = 0.002;         ///< σ_ba [m/s³/√Hz]
   double gyro_bias_rw = 0.0002;       ///< σ_bω [rad/s²/√Hz]
-  double max_dt_s = 0.1;              ///< a longer IMU gap is propagated but counted ("imu_gap") [s]
+  double max_dt_s = 0.1;              ///< a longer IMU gap is counted ("imu_gap") and inflated [s]
+  /// Beyond `max_dt_s` after the last IMU sample the filter runs on held readings; their error is
+  /// modelled as white noise of these densities (docs/robustness.md, "IMU gaps").
+  double gap_sigma_acc_m_s2 = 1.0;    ///< [m/s²/√s]
+  /// Attitude is not inflated by default: with no accelerometer data in the gap, an inflated tilt
+  /// lets range updates explain position innovations by tilt, which leaks gravity afterwards
+  /// (measured on a 3 s dropout: 15 m with 0.1 rad/s/√s, 7 m with 0; the recovery then fixes it).
+  double gap_sigma_gyro_rad_s = 0.0;  ///< [rad/s/√s]
 };
 
 /// Static initialization while landed.
 struct InitOptions {
   double duration_s = 1.0;              ///< landed data needed before initializing [s]
   int min_ranges = 12;                  ///< tag–known-anchor ranges needed without initial_pose
-  bool assume_landed_without_flight_state = true;  ///< no FLIGHT_STATE yet: treat as landed
+  /// No FLIGHT_STATE yet: treat as landed. Off by default: without a flight state the IMU's own
+  /// stillness (zupt.detect_stillness) is the evidence of rest.
+  bool assume_landed_without_flight_state = false;
   double sigma_v_m_s = 0.05;            ///< initial velocity σ [m/s]
   double sigma_roll_pitch_deg = 2.0;    ///< initial roll/pitch σ [deg]
   double sigma_bias_gyro_rad_s = 0.005; ///< initial gyro bias σ [rad/s]
@@ -31,6 +41,16 @@ struct InitOptions {
   double range_init_min_sigma_p_m = 0.2;   ///< floor of the position σ from range least squares [m]
   double range_init_sigma_yaw_deg = 30.0;  ///< yaw σ when initialized from ranges (large) [deg]
   double range_init_outlier_m = 0.6;       ///< residual beyond which an init range is dropped [m]
+  /// Static range fit: refuse (and wait for motion) while yaw is less certain than this [deg].
+  double static_max_sigma_yaw_deg = 20.0;
+  /// Range fits (static and in motion): a second minimum elsewhere whose cost is within this of
+  /// the best makes the pose ambiguous (refused) [-]
+  double ambiguity_chi2 = 16.0;
+  double motion_window_s = 12.0;            ///< in-motion alignment: data window [s]
+  double motion_min_span_s = 3.0;          ///< in-motion alignment: shortest window [s]
+  int motion_min_ranges = 20;              ///< in-motion alignment: tag–anchor ranges needed [-]
+  double motion_max_sigma_yaw_deg = 25.0;  ///< in-motion alignment: refuse above [deg]
+  double motion_max_sigma_p_m = 0.5;       ///< in-motion alignment: refuse above [m]
 };
 
 struct BaroOptions {
@@ -65,6 +85,17 @@ struct ZuptOptions {
   double sigma_acc_m_s2 = 0.2;           ///< σ of a = 0 [m/s²]
   double sigma_gyro_rad_s = 0.01;        ///< σ of ω = 0 [rad/s]
   double sigma_vel_m_s = 0.02;           ///< σ of v = 0 [m/s]
+  /// Without FLIGHT_STATE: zero-velocity updates while the IMU itself shows rest (StillnessDetector).
+  /// An IMU cannot tell rest from constant velocity, so these updates are χ²-gated against the
+  /// filter's own velocity (probability `stillness_gate_probability`); flight-state ZUPTs are not.
+  bool detect_stillness = true;
+  double stillness_gate_probability = 0.999;  ///< [-]
+};
+
+/// Re-initialization when the health monitor reports `lost`.
+struct RecoveryOptions {
+  bool enabled = true;
+  double retry_s = 1.0;                  ///< between two alignment attempts while lost [s]
 };
 
 struct EstimatorOptions {
@@ -80,6 +111,8 @@ struct EstimatorOptions {
   BaroOptions baro;
   UwbOptions uwb;
   ZuptOptions zupt;
+  HealthOptions health;
+  RecoveryOptions recovery;
 
   /// Loads every key from `path`; throws std::runtime_error("<path>: missing key 'a.b'") etc.
   static EstimatorOptions fromYaml(const std::string& path);

@@ -85,6 +85,11 @@ void CentralizedEkf::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vec
   checkInvariants("propagate");
 }
 
+void CentralizedEkf::addImuNoise(const ImuMatrix& Q) {
+  P_.topLeftCorner<ImuErr::kDim, ImuErr::kDim>() += 0.5 * (Q + Q.transpose());  // the IMU block is first
+  checkInvariants("addImuNoise");
+}
+
 UpdateResult CentralizedEkf::update(const Linearization& lin, double nis_gate) {
   const DenseUpdateOutput out = denseEkfUpdate(P_, layout_, lin, nis_gate, joseph_form_);
   UpdateResult res;

@@ -28,6 +28,7 @@ class CentralizedEkf final : public FusionStrategy {
   bool removeInstance(SensorId id) override;
 
   void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) override;
+  void addImuNoise(const ImuMatrix& Q) override;
   UpdateResult update(const Linearization& lin, double nis_gate) override;
 
   const NominalState& state() const override { return x_; }

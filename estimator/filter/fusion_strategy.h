@@ -42,6 +42,9 @@ class FusionStrategy {
 
   /// Propagates to `t_to` with IMU readings held constant since the state's time.
   virtual void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) = 0;
+  /// Adds Q to the IMU instance's covariance (Σ_II ← Σ_II + Q; cross-covariances unchanged, so
+  /// the full matrix stays positive definite). Used for IMU gaps (held readings).
+  virtual void addImuNoise(const ImuMatrix& Q) = 0;
   /// EKF update with a linearized measurement; gated when `nis_gate` > 0 and NIS > `nis_gate`.
   virtual UpdateResult update(const Linearization& lin, double nis_gate) = 0;
 

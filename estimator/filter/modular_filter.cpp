@@ -64,6 +64,11 @@ void ModularFilter::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vect
   checkAfter("propagate");
 }
 
+void ModularFilter::addImuNoise(const ImuMatrix& Q) {
+  cov_.addNoise(x_.imu_id, 0.5 * (Q + Q.transpose()), x_.t);
+  checkAfter("addImuNoise");
+}
+
 UpdateResult ModularFilter::update(const Linearization& lin, double nis_gate) {
   const FactorizedCovariance::Result r = cov_.update(lin, nis_gate, x_.t);
   UpdateResult res;

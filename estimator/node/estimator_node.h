@@ -17,6 +17,14 @@
 ///   updates propagate to their own time with the latest reading held. While landed a
 ///   zero-velocity update runs at `zupt.rate_hz` with the latest IMU reading.
 /// - ANCHOR_INIT and ESTIMATOR_CMD apply at max(their time, newest time).
+/// - Initialization: while at rest (flight state, else IMU stillness) from the landed data
+///   (StaticInitializer); in motion, or when the landed data cannot fix the pose (one tag,
+///   coplanar anchors), from ranges and strapdown increments over a window (MotionAligner).
+/// - IMU gaps are detected on the IMU's own time line; beyond `imu.max_dt_s` the filter runs on
+///   held readings with inflated process noise ("imu_gap").
+/// - Health (HealthMonitor): windowed gating and NIS; `lost` triggers a re-initialization of the
+///   IMU instance from the MotionAligner that keeps anchors, baro and tag bias states
+///   ("recovery"); see docs/robustness.md.
 /// Poses are published per in-order IMU step (decimated to `pose_output_rate_hz`), anchors
 /// and status at their rates in data time. Not thread-safe: call from one thread.
 
@@ -35,7 +43,10 @@
 #include "estimator/core/estimator_options.h"
 #include "estimator/filter/fusion_strategy.h"
 #include "estimator/node/estimator_input.h"
+#include "estimator/health/health_monitor.h"
+#include "estimator/node/motion_aligner.h"
 #include "estimator/node/static_initializer.h"
+#include "estimator/zupt/stillness_detector.h"
 #include "estimator/node/step_timings.h"
 #include "estimator/uwb/uwb_network.h"
 #include "estimator/zupt/zupt_model.h"
@@ -77,6 +88,13 @@ class EstimatorNode {
   const FusionStrategy* filter() const { return cur_.filter.get(); }
   /// Inputs currently held for out-of-sequence handling.
   size_t historySize() const { return history_.size(); }
+  Health health() const { return initialized() ? health_.health() : Health::Initializing; }
+  const HealthMonitor& healthMonitor() const { return health_; }
+  /// Why the node is not initialized yet (empty once it is).
+  std::string waitingFor() const;
+  /// Fault injection for tests and drills: moves the pose estimate by `dp_m` (G) and turns it by
+  /// `dyaw_rad` about z, keeping its covariance, as a corrupted state would look to the filter.
+  void injectPoseError(const Eigen::Vector3d& dp_m, double dyaw_rad);
 
  private:
   /// Everything a rewind restores.
@@ -105,6 +123,19 @@ class EstimatorNode {
   void applyAnchorInit(const AnchorInit& a, bool first);
   void applyCommand(const EstimatorCommand& c, bool first);
   void propagateTo(Timestamp t);
+  /// Propagation with held readings; the part beyond `imu.max_dt_s` after the last IMU sample
+  /// gets the gap noise.
+  void propagateFilter(const Eigen::Vector3d& acc, const Eigen::Vector3d& gyro, Timestamp t);
+  /// Feeds the aligner (and stillness) with an input in arrival order.
+  void feedAligner(const EstimatorInput& in);
+  void tryMotionInitialization(Timestamp t);
+  InitialBelief beliefFromAlignment(const AlignmentResult& r) const;
+  void updateHealth(Timestamp t);
+  void tryRecover(Timestamp t);
+  /// Replaces the IMU instance (state, covariance, time); every other instance keeps its mean and
+  /// marginal covariance (cross-covariances dropped). History before `t` is forgotten.
+  void replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu);
+  bool landedAt(Timestamp t) const;
   void event(bool first, const std::string& kind, const std::string& message = "");
   void publishPeriodic();
   void resetAll();
@@ -122,6 +153,14 @@ class EstimatorNode {
   double range_gate_ = 0.0, baro_gate_ = 0.0;
   /// dah without uwb.dah_fuse_estimated_anchor_pairs: ranges between two estimated anchors are left out.
   bool skip_estimated_anchor_pairs_ = false;
+
+  MotionAligner aligner_;
+  StillnessDetector still_detector_;
+  std::map<int64_t, bool> still_at_;   ///< stillness per IMU time [µs] (arrival order), pruned
+  bool have_flight_state_ = false;
+  std::optional<double> last_pressure_pa_;
+  HealthMonitor health_;
+  std::optional<Timestamp> last_align_try_, last_recovery_try_, last_health_eval_;
 
   Snapshot cur_;
   std::deque<Entry> history_;

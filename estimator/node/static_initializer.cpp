@@ -19,7 +19,16 @@ StaticInitializer::StaticInitializer(const EstimatorOptions& options, const Syst
     : options_(options), setup_(setup), network_(setup, options.uwb.sigma_range_m) {}
 
 bool StaticInitializer::isStatic() const {
-  return landed_.value_or(options_.init.assume_landed_without_flight_state);
+  if (landed_) return *landed_;
+  return still_ || options_.init.assume_landed_without_flight_state;
+}
+
+void StaticInitializer::addStillness(bool still) {
+  if (landed_) return;  // a flight state, once received, decides
+  const bool was_static = isStatic();
+  still_ = still;
+  if (was_static && !isStatic()) took_off_ = true;
+  if (!was_static && isStatic()) restart();
 }
 
 void StaticInitializer::restart() {
@@ -112,12 +121,17 @@ std::optional<InitialBelief> StaticInitializer::build(const Eigen::Matrix3d& R_r
     }
     Eigen::Matrix4d cov;
     if (!fitPoseToRanges(R_rp, p, yaw, cov, b.range_fit_rms_m, b.n_ranges_used)) {
-      waiting_for_ = "a converging range fit";
+      if (waiting_for_.empty()) waiting_for_ = "a converging range fit";
       return std::nullopt;
     }
     b.from_ranges = true;
     sigma_p = std::max(options_.init.range_init_min_sigma_p_m, std::sqrt(cov.topLeftCorner<3, 3>().diagonal().maxCoeff()));
     sigma_yaw = std::max(options_.init.range_init_sigma_yaw_deg * kDeg, std::sqrt(cov(3, 3)));
+    if (std::sqrt(cov(3, 3)) > options_.init.static_max_sigma_yaw_deg * kDeg) {
+      waiting_for_ = "motion: yaw is not observable at rest with this tag geometry (range fit σ_yaw " +
+                     std::to_string(std::sqrt(cov(3, 3)) / kDeg) + " deg)";
+      return std::nullopt;
+    }
   }
   const Eigen::Matrix3d R = rotZ(yaw) * R_rp;
   b.imu.p_IinG = p;
@@ -154,7 +168,8 @@ std::optional<InitialBelief> StaticInitializer::build(const Eigen::Matrix3d& R_r
 }
 
 bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p_out, double& yaw_out,
-                                        Eigen::Matrix4d& cov_out, double& rms_out, int& n_used) const {
+                                        Eigen::Matrix4d& cov_out, double& rms_out, int& n_used) {
+  waiting_for_.clear();
   std::set<SensorId> anchors;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const auto& r : ranges_) anchors.insert(r.anchor);
@@ -188,6 +203,7 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
         cost += w * res * res;
       }
       A.diagonal().array() += 1e-9;
+      A(3, 3) += 1.0 / (M_PI * M_PI);  // weak yaw prior: one tag leaves yaw (nearly) unobservable
       const Eigen::Vector4d step = -A.ldlt().solve(g);
       p += step.head<3>();
       yaw = std::remainder(yaw + step(3), 2.0 * M_PI);
@@ -200,6 +216,7 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
   double best_cost = std::numeric_limits<double>::infinity();
   Eigen::Vector3d best_p = centroid;
   double best_yaw = 0.0;
+  std::vector<std::pair<double, Eigen::Vector3d>> minima;
   for (int sx = -1; sx <= 1; ++sx)
     for (int sy = -1; sy <= 1; ++sy)
       for (int k = 0; k < 4; ++k) {
@@ -207,13 +224,23 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
         p.z() = 0.5;
         double yaw = k * 0.5 * M_PI;
         const double c = solve(p, yaw, nullptr);
-        if (std::isfinite(c) && c < best_cost) {
+        if (!std::isfinite(c)) continue;
+        minima.emplace_back(c, p);
+        if (c < best_cost) {
           best_cost = c;
           best_p = p;
           best_yaw = yaw;
         }
       }
   if (!std::isfinite(best_cost)) return false;
+  // A second minimum elsewhere that fits about as well: the anchors cannot fix the position
+  // (nearly coplanar anchors mirror it). Refuse rather than pick one.
+  for (const auto& [c, p] : minima)
+    if ((p - best_p).norm() > 0.5 && c - best_cost < options_.init.ambiguity_chi2) {
+      waiting_for_ = "motion: two positions " + std::to_string((p - best_p).norm()) +
+                     " m apart fit the landed ranges alike (known anchors nearly coplanar?)";
+      return false;
+    }
   // Drop outliers and refine.
   const Eigen::Matrix3d R = rotZ(best_yaw) * R_rp;
   n_used = 0;

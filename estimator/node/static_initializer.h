@@ -7,7 +7,11 @@
 ///  - position and yaw from setup.initial_pose (σ_p, σ_yaw) when given, otherwise from a
 ///    least-squares fit of [p_IinG, yaw] to the bias-corrected tag ranges to known anchors
 ///    ((z − γ)/β = ‖p_A − p_IinG − R(yaw) p_TinI‖, Gauss–Newton from several seeds, residuals
-///    beyond `range_init_outlier_m` dropped) with a large yaw σ;
+///    beyond `range_init_outlier_m` dropped, a weak yaw prior of σ π keeps the normal matrix
+///    regular). Refused while the fit cannot fix the pose: yaw σ above
+///    `static_max_sigma_yaw_deg` (one tag: only its lever arm shows yaw at rest), or a second
+///    local minimum as good as the best (nearly coplanar anchors mirror the position); the node
+///    then waits for motion (MotionAligner);
 ///  - baro reference pressure from setup or the mean landed pressure; bias so that the mean
 ///    height matches the initial baro height.
 /// The orientation covariance is local (I): Σ_θ = σ_rp² (I − n nᵀ) + σ_yaw² n nᵀ, n = R̂ᵀ e_z.
@@ -43,6 +47,10 @@ class StaticInitializer {
   StaticInitializer(const EstimatorOptions& options, const SystemSetup& setup);
 
   void addFlightState(const FlightStateSample& s);
+  /// IMU stillness (StillnessDetector): the evidence of rest while no flight state was received.
+  void addStillness(bool still);
+  /// Whether the data says the body rests (flight state, else stillness, else the option).
+  bool isStatic() const;
   void addImu(const ImuSample& s);
   void addBaro(const BaroSample& s);
   /// Ranges between a tag and a known anchor (from setup) are kept; others are ignored.
@@ -60,17 +68,17 @@ class StaticInitializer {
     double d_m = 0.0;      // bias-corrected distance
     double sigma_m = 0.1;
   };
-  bool isStatic() const;
   void restart();
   std::optional<InitialBelief> build(const Eigen::Matrix3d& R_rp);
   /// Least-squares [p, yaw]; returns false when it does not converge.
   bool fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p, double& yaw, Eigen::Matrix4d& cov,
-                       double& rms, int& n_used) const;
+                       double& rms, int& n_used);
 
   EstimatorOptions options_;
   SystemSetup setup_;
   UwbNetwork network_;
   std::optional<bool> landed_;
+  bool still_ = false;
   bool took_off_ = false;
   std::optional<Timestamp> static_since_;
   std::optional<ImuSample> last_imu_;

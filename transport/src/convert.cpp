@@ -316,6 +316,11 @@ estimator_status_t toLcm(const EstimatorStatus& s) {
     m.timings.push_back(t);
   }
   m.num_timings = static_cast<int16_t>(m.timings.size());
+  m.health = s.health;
+  m.health_reason = s.health_reason;
+  m.sigma_p_max_m = s.sigma_p_max_m;
+  for (int i = 0; i < 3; ++i) m.weak_axis_G[i] = s.weak_axis_G[i];
+  m.sigma_yaw_deg = s.sigma_yaw_deg;
   return m;
 }
 EstimatorStatus fromLcm(const estimator_status_t& m) {
@@ -334,6 +339,11 @@ EstimatorStatus fromLcm(const estimator_status_t& m) {
   }
   s.counters = countersFromLcm(m.counters);
   for (const auto& t : m.timings) s.mean_step_us[t.name] = t.mean_us;
+  s.health = m.health;
+  s.health_reason = m.health_reason;
+  s.sigma_p_max_m = m.sigma_p_max_m;
+  s.weak_axis_G = Eigen::Vector3d(m.weak_axis_G[0], m.weak_axis_G[1], m.weak_axis_G[2]);
+  s.sigma_yaw_deg = m.sigma_yaw_deg;
   return s;
 }
 

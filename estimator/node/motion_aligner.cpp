@@ -1,0 +1,382 @@
+#include "estimator/node/motion_aligner.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "estimator/core/so3.h"
+
+namespace meshnav::estimator {
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kHuberK = 2.0;  ///< Huber threshold in σ
+constexpr size_t kMaxObservations = 400;
+constexpr int kDim = 15;
+using Vec15 = Eigen::Matrix<double, kDim, 1>;
+using Mat15 = Eigen::Matrix<double, kDim, kDim>;
+
+Eigen::Matrix3d rotZ(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+
+/// Increments advanced by δ seconds with held body readings f, ω.
+MotionAligner::Increments advance(const MotionAligner::Increments& a, const Eigen::Vector3d& f,
+                                  const Eigen::Vector3d& w, double dt) {
+  MotionAligner::Increments b;
+  const Eigen::Matrix3d Cm = a.C * so3::expMap(0.5 * dt * w);  // attitude at mid-step
+  b.V = a.V + Cm * f * dt;
+  b.S = a.S + a.V * dt + 0.5 * Cm * f * dt * dt;
+  b.N = a.N + Cm * dt;
+  b.M = a.M + a.N * dt + 0.5 * Cm * dt * dt;
+  b.C = a.C * so3::expMap(dt * w);
+  // Sensitivities to the gyro bias (ω = ω_m − b_ω): δφ' = Exp(ω dt)ᵀ δφ − J_r(ω dt) dt δb_ω,
+  // δV' = δV − Ĉ[f]× δφ dt, δS' = δS + δV dt − ½ Ĉ[f]× δφ dt².
+  const Eigen::Matrix3d Cf = a.C * so3::skew(f);
+  b.JV = a.JV - Cf * a.JC * dt;
+  b.JS = a.JS + a.JV * dt - 0.5 * Cf * a.JC * dt * dt;
+  b.JC = so3::expMap(dt * w).transpose() * a.JC - so3::rightJacobian(dt * w) * dt;
+  b.tau_s = a.tau_s + dt;
+  return b;
+}
+
+/// Huber cost of a normalized residual e = r/σ.
+double huber(double e) {
+  const double a = std::abs(e);
+  return a <= kHuberK ? e * e : 2.0 * kHuberK * a - kHuberK * kHuberK;
+}
+
+double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
+}  // namespace
+
+MotionAligner::Unknowns MotionAligner::Unknowns::plus(const Vec15& d) const {
+  Unknowns x = *this;
+  x.p0 += d.segment<3>(0);
+  x.v0 += d.segment<3>(3);
+  x.R0 = R0 * so3::expMap(d.segment<3>(6));
+  x.ba += d.segment<3>(9);
+  x.dbg += d.segment<3>(12);
+  return x;
+}
+
+Eigen::Vector3d MotionAligner::bodyTerm(const Increments& inc, const Unknowns& x, const Eigen::Vector3d& p_TinI) const {
+  const Eigen::Matrix3d C = inc.C * so3::expMap(inc.JC * x.dbg);
+  return inc.S + inc.JS * x.dbg - inc.M * x.ba + C * p_TinI;
+}
+
+MotionAligner::MotionAligner(const MotionAlignerOptions& options, std::map<SensorId, Eigen::Vector3d> tags_p_TinI)
+    : options_(options), tags_p_TinI_(std::move(tags_p_TinI)) {}
+
+void MotionAligner::addImu(const ImuSample& s) {
+  if (!imu_.empty() && s.t <= imu_.back().t) return;
+  imu_.push_back(s);
+  const Timestamp oldest = s.t - Duration::fromSec(options_.window_s);
+  while (!imu_.empty() && imu_.front().t < oldest) imu_.pop_front();
+  while (!ranges_.empty() && ranges_.front().t < oldest) ranges_.pop_front();
+}
+
+void MotionAligner::addRange(const AlignRange& r) {
+  if (!tags_p_TinI_.count(r.tag)) return;
+  auto pos = std::upper_bound(ranges_.begin(), ranges_.end(), r.t,
+                              [](Timestamp t, const AlignRange& x) { return t < x.t; });
+  ranges_.insert(pos, r);
+}
+
+void MotionAligner::clear() {
+  imu_.clear();
+  ranges_.clear();
+}
+
+double MotionAligner::spanSeconds() const { return imu_.size() < 2 ? 0.0 : (imu_.back().t - imu_.front().t).sec(); }
+
+std::vector<MotionAligner::Obs> MotionAligner::buildObservations(const Eigen::Vector3d& bias_gyro,
+                                                                 Increments* end) const {
+  std::vector<Obs> obs;
+  Increments inc;
+  auto r = ranges_.begin();
+  while (r != ranges_.end() && r->t < imu_.front().t) ++r;
+  for (size_t k = 0; k + 1 < imu_.size(); ++k) {
+    const ImuSample &a = imu_[k], &b = imu_[k + 1];
+    const Eigen::Vector3d f = 0.5 * (a.acc_m_s2 + b.acc_m_s2);
+    const Eigen::Vector3d w = 0.5 * (a.gyro_rad_s + b.gyro_rad_s) - bias_gyro;
+    for (; r != ranges_.end() && r->t < b.t; ++r) obs.push_back({*r, advance(inc, f, w, (r->t - a.t).sec()), true});
+    inc = advance(inc, f, w, (b.t - a.t).sec());
+  }
+  *end = inc;
+  if (obs.size() > kMaxObservations) {  // evenly thinned: the cost of a fit stays bounded
+    std::vector<Obs> thin;
+    const double step = static_cast<double>(obs.size()) / kMaxObservations;
+    for (size_t i = 0; i < kMaxObservations; ++i) thin.push_back(obs[static_cast<size_t>(i * step)]);
+    obs.swap(thin);
+  }
+  return obs;
+}
+
+double MotionAligner::residual(const Obs& o, const Unknowns& x) const {
+  const Eigen::Vector3d g(0.0, 0.0, -options_.gravity_m_s2);
+  const double tau = o.inc.tau_s;
+  const Eigen::Vector3d p_TinG =
+      x.p0 + x.v0 * tau + 0.5 * g * tau * tau + x.R0 * bodyTerm(o.inc, x, tags_p_TinI_.at(o.r.tag));
+  return o.r.d_m - (o.r.p_AinG - p_TinG).norm();
+}
+
+Eigen::Matrix<double, 1, 15> MotionAligner::jacobian(const Obs& o, const Unknowns& x) const {
+  // r = d − ‖p_A − p_T‖: ∂r/∂p_T = uᵀ with u the unit vector from the tag to the anchor;
+  // ∂p_T/∂[p₀, v₀, δθ, b_a, δb_ω] = [I, τ I, −R₀[w]×, −R₀ M, R₀ (J_S − C[p_TinI]× J_C)],
+  // w = S − M b_a + C p_TinI (the J_C term to first order around the current δb_ω).
+  const Eigen::Vector3d g(0.0, 0.0, -options_.gravity_m_s2);
+  const double tau = o.inc.tau_s;
+  const Eigen::Vector3d& lever = tags_p_TinI_.at(o.r.tag);
+  const Eigen::Vector3d w = bodyTerm(o.inc, x, lever);
+  const Eigen::Vector3d p_TinG = x.p0 + x.v0 * tau + 0.5 * g * tau * tau + x.R0 * w;
+  const Eigen::Vector3d u = (o.r.p_AinG - p_TinG).normalized();
+  const Eigen::Matrix3d C = o.inc.C * so3::expMap(o.inc.JC * x.dbg);
+  Eigen::Matrix<double, 1, 15> J;
+  J.segment<3>(0) = u.transpose();
+  J.segment<3>(3) = tau * u.transpose();
+  J.segment<3>(6) = -u.transpose() * x.R0 * so3::skew(w);
+  J.segment<3>(9) = -u.transpose() * x.R0 * o.inc.M;
+  J.segment<3>(12) = u.transpose() * x.R0 * (o.inc.JS - C * so3::skew(lever) * o.inc.JC);
+  return J;
+}
+
+double MotionAligner::fit(const std::vector<Obs>& obs, Unknowns& x, Mat15* info) const {
+  const double prior_ba = 1.0 / (options_.sigma_bias_acc_m_s2 * options_.sigma_bias_acc_m_s2);
+  const double prior_bg = 1.0 / (options_.sigma_bias_gyro_rad_s * options_.sigma_bias_gyro_rad_s);
+  auto cost = [&](const Unknowns& u) {
+    double c = prior_ba * u.ba.squaredNorm() + prior_bg * u.dbg.squaredNorm();
+    for (const Obs& o : obs)
+      if (o.use) c += huber(residual(o, u) / o.r.sigma_m);
+    return c;
+  };
+  double c = cost(x), lambda = 1e-3;
+  Mat15 H;
+  for (int it = 0; it < 25; ++it) {
+    H.setZero();
+    Vec15 g = Vec15::Zero();
+    for (const Obs& o : obs) {
+      if (!o.use) continue;
+      const double r = residual(o, x);
+      const double e = std::abs(r) / o.r.sigma_m;
+      const double w = (e <= kHuberK ? 1.0 : kHuberK / e) / (o.r.sigma_m * o.r.sigma_m);
+      const Eigen::Matrix<double, 1, 15> J = jacobian(o, x);
+      H += w * J.transpose() * J;
+      g += w * J.transpose() * r;
+    }
+    H.block<3, 3>(9, 9).diagonal().array() += prior_ba;
+    g.segment<3>(9) += prior_ba * x.ba;
+    H.block<3, 3>(12, 12).diagonal().array() += prior_bg;
+    g.segment<3>(12) += prior_bg * x.dbg;
+    bool improved = false;
+    for (int tries = 0; tries < 6 && !improved; ++tries) {
+      Mat15 A = H;
+      A.diagonal() += lambda * H.diagonal().cwiseMax(1e-9);
+      const Vec15 step = -A.ldlt().solve(g);
+      const Unknowns xn = x.plus(step);
+      const double cn = cost(xn);
+      if (std::isfinite(cn) && cn < c) {
+        improved = true;
+        const bool small = step.norm() < 1e-7 || c - cn < 1e-9 * (1.0 + c);
+        x = xn;
+        c = cn;
+        lambda = std::max(lambda / 4.0, 1e-9);
+        if (small) it = 1000;
+      } else {
+        lambda *= 8.0;
+      }
+    }
+    if (!improved) break;
+  }
+  if (info) *info = H;
+  return c;
+}
+
+ImuState MotionAligner::endState(const Unknowns& x, const Increments& end, const Eigen::Vector3d& bias_gyro) const {
+  const Eigen::Vector3d g(0.0, 0.0, -options_.gravity_m_s2);
+  const double T = end.tau_s;
+  ImuState s;
+  s.p_IinG = x.p0 + x.v0 * T + 0.5 * g * T * T + x.R0 * (end.S + end.JS * x.dbg - end.M * x.ba);
+  s.v_IinG = x.v0 + g * T + x.R0 * (end.V + end.JV * x.dbg - end.N * x.ba);
+  s.q_ItoG = Eigen::Quaterniond(x.R0 * end.C * so3::expMap(end.JC * x.dbg)).normalized();
+  s.bias_gyro_rad_s = bias_gyro + x.dbg;
+  s.bias_acc_m_s2 = x.ba;
+  return s;
+}
+
+std::vector<MotionAligner::Unknowns> MotionAligner::starts(const std::vector<Obs>& obs) const {
+  std::map<SensorId, Eigen::Vector3d> anchors;
+  for (const Obs& o : obs) anchors[o.r.anchor] = o.r.p_AinG;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& [id, p] : anchors) centroid += p;
+  centroid /= static_cast<double>(anchors.size());
+  // Static position fit (the window's mean position), multi-start.
+  auto staticCost = [&](const Eigen::Vector3d& p) {
+    double c = 0.0;
+    for (const Obs& o : obs) c += huber((o.r.d_m - (o.r.p_AinG - p).norm()) / o.r.sigma_m);
+    return c;
+  };
+  auto staticFit = [&](Eigen::Vector3d p) {
+    for (int it = 0; it < 20; ++it) {
+      Eigen::Matrix3d A = Eigen::Matrix3d::Identity() * 1e-6;
+      Eigen::Vector3d b = Eigen::Vector3d::Zero();
+      for (const Obs& o : obs) {
+        const Eigen::Vector3d d = o.r.p_AinG - p;
+        const double n = std::max(d.norm(), 1e-6);
+        const Eigen::Vector3d J = d / n;  // ∂r/∂p
+        const double r = o.r.d_m - n;
+        A += J * J.transpose();
+        b += J * r;
+      }
+      p -= A.ldlt().solve(b);
+    }
+    return p;
+  };
+  Eigen::Vector3d best = centroid;
+  double best_c = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& off : {Eigen::Vector3d(0, 0, -1.5), Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(-2, 0, 0),
+                                     Eigen::Vector3d(0, 2, 0), Eigen::Vector3d(0, -2, 0), Eigen::Vector3d(0, 0, 1.5)}) {
+    const Eigen::Vector3d p = staticFit(centroid + off);
+    const double c = staticCost(p);
+    if (p.allFinite() && c < best_c) best_c = c, best = p;
+  }
+  std::vector<Eigen::Vector3d> positions{best};
+  // Nearly coplanar anchors: the mirror image across their plane fits the ranges as well.
+  Eigen::MatrixXd D(3, anchors.size());
+  int i = 0;
+  for (const auto& [id, p] : anchors) D.col(i++) = p - centroid;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(D, Eigen::ComputeFullU);
+  if (svd.singularValues()(2) / std::sqrt(static_cast<double>(anchors.size())) < 0.3) {
+    const Eigen::Vector3d n = svd.matrixU().col(2);
+    positions.push_back(best - 2.0 * n.dot(best - centroid) * n);
+  }
+  // Roll and pitch from the mean specific force (gravity dominates over a few seconds).
+  Eigen::Vector3d f = Eigen::Vector3d::Zero();
+  for (const ImuSample& s : imu_) f += s.acc_m_s2;
+  const double roll = std::atan2(f.y(), f.z()), pitch = std::atan2(-f.x(), std::hypot(f.y(), f.z()));
+  const Eigen::Matrix3d R_rp =
+      (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+  std::vector<Unknowns> out;
+  for (const Eigen::Vector3d& p : positions)
+    for (int k = 0; k < options_.yaw_starts; ++k) {
+      Unknowns x;
+      x.p0 = p;
+      x.R0 = rotZ(2.0 * M_PI * k / options_.yaw_starts) * R_rp;
+      out.push_back(x);
+    }
+  return out;
+}
+
+std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_gyro_rad_s) {
+  if (spanSeconds() < options_.min_span_s) {
+    reason_ = "motion alignment: " + std::to_string(spanSeconds()) + " s of IMU data, need " +
+              std::to_string(options_.min_span_s) + " s";
+    return std::nullopt;
+  }
+  Increments end;
+  std::vector<Obs> obs = buildObservations(bias_gyro_rad_s, &end);
+  std::set<SensorId> anchor_ids;
+  for (const Obs& o : obs) anchor_ids.insert(o.r.anchor);
+  if (static_cast<int>(obs.size()) < options_.min_ranges || static_cast<int>(anchor_ids.size()) < options_.min_anchors) {
+    reason_ = "motion alignment: " + std::to_string(obs.size()) + " tag ranges to " + std::to_string(anchor_ids.size()) +
+              " known anchors in the window, need " + std::to_string(options_.min_ranges) + " to " +
+              std::to_string(options_.min_anchors);
+    return std::nullopt;
+  }
+  // Multi-start, then keep the distinct local minima.
+  struct Candidate {
+    Unknowns x;
+    double cost;
+    ImuState end;
+  };
+  std::vector<Candidate> cands;
+  for (Unknowns x : starts(obs)) {
+    const double c = fit(obs, x, nullptr);
+    if (std::isfinite(c)) cands.push_back({x, c, endState(x, end, bias_gyro_rad_s)});
+  }
+  if (cands.empty()) {
+    reason_ = "motion alignment: no fit converged";
+    return std::nullopt;
+  }
+  std::sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
+  auto distinct = [&](const ImuState& a, const ImuState& b) {
+    const double dyaw = std::remainder(yawOf(a.q_ItoG.toRotationMatrix()) - yawOf(b.q_ItoG.toRotationMatrix()), 2 * M_PI);
+    return (a.p_IinG - b.p_IinG).norm() > 0.5 || std::abs(dyaw) > 15.0 * kDeg;
+  };
+  // Outliers by the best candidate, then refit the best and the best distinct rival on the inliers.
+  Unknowns best = cands.front().x;
+  int n_used = 0;
+  for (Obs& o : obs) {
+    o.use = std::abs(residual(o, best)) <= std::max(options_.outlier_m, 4.0 * o.r.sigma_m);
+    n_used += o.use;
+  }
+  Mat15 info;
+  const double best_cost = fit(obs, best, &info);
+  const ImuState best_end = endState(best, end, bias_gyro_rad_s);
+  for (size_t k = 1; k < cands.size(); ++k) {
+    if (!distinct(cands[k].end, best_end)) continue;
+    Unknowns rival = cands[k].x;
+    const double c = fit(obs, rival, nullptr);
+    if (c - best_cost < options_.ambiguity_chi2 && distinct(endState(rival, end, bias_gyro_rad_s), best_end)) {
+      reason_ = "motion alignment: ambiguous (two poses " +
+                std::to_string((endState(rival, end, bias_gyro_rad_s).p_IinG - best_end.p_IinG).norm()) +
+                " m apart fit the ranges within " + std::to_string(c - best_cost) +
+                "): anchor geometry or motion cannot fix the pose yet";
+      return std::nullopt;
+    }
+    break;  // candidates are sorted: the first distinct one is the closest rival
+  }
+  (void)n_used;
+  return finish(obs, best, info, end, bias_gyro_rad_s);
+}
+
+std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs, const Unknowns& x,
+                                                     const Mat15& info, const Increments& end,
+                                                     const Eigen::Vector3d& bias_gyro) {
+  const Mat15 Sigma = options_.cov_inflation * info.ldlt().solve(Mat15::Identity());
+  const ImuState e0 = endState(x, end, bias_gyro);
+  Eigen::Matrix<double, 15, kDim> J;
+  for (int j = 0; j < kDim; ++j) {
+    Vec15 d = Vec15::Zero();
+    d(j) = 1e-6;
+    J.col(j) = (endState(x.plus(d), end, bias_gyro).boxminus(e0) - endState(x.plus(-d), end, bias_gyro).boxminus(e0)) / 2e-6;
+  }
+  AlignmentResult res;
+  res.imu = e0;
+  res.cov = J * Sigma * J.transpose();
+  res.cov = (0.5 * (res.cov + res.cov.transpose())).eval();
+  for (int i = 0; i < 3; ++i) {  // floors: the fit's model is not exact
+    res.cov(ImuErr::kP + i, ImuErr::kP + i) += 0.02 * 0.02;
+    res.cov(ImuErr::kV + i, ImuErr::kV + i) += 0.05 * 0.05;
+    res.cov(ImuErr::kTheta + i, ImuErr::kTheta + i) += std::pow(0.5 * kDeg, 2);
+  }
+  res.t = imu_.back().t;
+  res.last_imu = imu_.back();
+  std::set<SensorId> used_anchors;
+  double sq = 0.0;
+  for (const Obs& o : obs) {
+    if (!o.use) continue;
+    ++res.n_ranges;
+    used_anchors.insert(o.r.anchor);
+    const double r = residual(o, x);
+    sq += r * r;
+  }
+  res.n_anchors = static_cast<int>(used_anchors.size());
+  res.rms_m = res.n_ranges ? std::sqrt(sq / res.n_ranges) : 0.0;
+  const Eigen::Vector3d n = e0.q_ItoG.conjugate() * Eigen::Vector3d::UnitZ();
+  res.sigma_yaw_deg = std::sqrt(n.dot(res.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) * n)) / kDeg;
+  res.sigma_p_m = std::sqrt(res.cov.block<3, 3>(ImuErr::kP, ImuErr::kP).diagonal().maxCoeff());
+  if (!res.cov.allFinite() || res.sigma_yaw_deg > options_.max_sigma_yaw_deg || res.sigma_p_m > options_.max_sigma_p_m) {
+    reason_ = "motion alignment: pose not determined yet (σ_yaw " + std::to_string(res.sigma_yaw_deg) + " deg, σ_p " +
+              std::to_string(res.sigma_p_m) + " m; needs horizontal acceleration and spread anchors)";
+    return std::nullopt;
+  }
+  if (res.n_ranges < options_.min_ranges || res.n_anchors < options_.min_anchors) {
+    reason_ = "motion alignment: too few inlier ranges (" + std::to_string(res.n_ranges) + ")";
+    return std::nullopt;
+  }
+  reason_.clear();
+  return res;
+}
+
+}  // namespace meshnav::estimator
