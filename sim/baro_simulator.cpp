@@ -22,7 +22,7 @@ double BaroSimulator::idealPressure(const TrajectoryState& st) const {
   return atmosphere::pressureFromHeight(p_PinG.z(), options_.reference_pressure_pa);
 }
 
-std::vector<BaroSample> BaroSimulator::simulate(const SpiralTrajectory& trajectory, double t_end_s) const {
+std::vector<BaroSample> BaroSimulator::simulate(const Trajectory& trajectory, double t_end_s) const {
   RandomStream rng(RandomStream::deriveSeed(seed_, "baro_noise"));
   const double dt = 1.0 / options_.rate_hz;
   const auto n = static_cast<int64_t>(std::floor(t_end_s / dt + 1e-9)) + 1;

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common/types.h"
-#include "sim/spiral_trajectory.h"
+#include "sim/trajectory.h"
 
 namespace meshnav::sim {
 
@@ -29,7 +29,7 @@ class BaroSimulator {
   /// Noise-free pressure [Pa] for a state.
   double idealPressure(const TrajectoryState& state) const;
   /// Readings at t_k = k/rate for t_k ∈ [0, t_end_s].
-  std::vector<BaroSample> simulate(const SpiralTrajectory& trajectory, double t_end_s) const;
+  std::vector<BaroSample> simulate(const Trajectory& trajectory, double t_end_s) const;
 
  private:
   BaroOptions options_;

@@ -1,7 +1,9 @@
 #include "sim/imu_simulator.h"
 
+#include <array>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "sim/random_stream.h"
 
@@ -13,6 +15,29 @@ ImuNoiseOptions ImuNoiseOptions::noiseless() {
   o.acc_bias_rw = o.gyro_bias_rw = 0.0;
   o.acc_bias_initial_sigma = o.gyro_bias_initial_sigma = 0.0;
   return o;
+}
+
+ImuNoiseOptions ImuNoiseOptions::forGrade(const std::string& grade) {
+  struct Grade {
+    const char* name;
+    double acc_nd, gyro_nd, acc_rw, gyro_rw, acc_b0, gyro_b0;
+  };
+  // See the table in imu_simulator.h; "fc" equals the defaults.
+  static constexpr std::array<Grade, 3> kGrades{{{"consumer", 6e-3, 6e-4, 1e-2, 1e-4, 0.1, 0.01},
+                                                 {"fc", 2e-3, 2e-4, 3e-3, 2e-5, 0.05, 0.005},
+                                                 {"tactical", 5e-4, 3e-5, 3e-4, 1e-6, 0.01, 0.0005}}};
+  for (const Grade& g : kGrades) {
+    if (grade != g.name) continue;
+    ImuNoiseOptions o;
+    o.acc_noise_density = g.acc_nd;
+    o.gyro_noise_density = g.gyro_nd;
+    o.acc_bias_rw = g.acc_rw;
+    o.gyro_bias_rw = g.gyro_rw;
+    o.acc_bias_initial_sigma = g.acc_b0;
+    o.gyro_bias_initial_sigma = g.gyro_b0;
+    return o;
+  }
+  throw std::invalid_argument("unknown IMU grade '" + grade + "' (consumer|fc|tactical)");
 }
 
 std::string ImuNoiseOptions::toString() const {
@@ -29,13 +54,13 @@ ImuSimulator::ImuSimulator(const ImuNoiseOptions& options, uint64_t seed) : opti
 ImuSample ImuSimulator::ideal(const TrajectoryState& st) {
   ImuSample s;
   s.t = Timestamp::fromSec(st.t_s);
-  const Eigen::Vector3d g_G(0.0, 0.0, -SpiralTrajectory::kGravity_m_s2);
+  const Eigen::Vector3d g_G(0.0, 0.0, -Trajectory::kGravity_m_s2);
   s.acc_m_s2 = st.R_ItoG.transpose() * (st.a_IinG - g_G);
   s.gyro_rad_s = st.w_IinI;
   return s;
 }
 
-std::vector<ImuSample> ImuSimulator::simulate(const SpiralTrajectory& trajectory, double t_end_s) {
+std::vector<ImuSample> ImuSimulator::simulate(const Trajectory& trajectory, double t_end_s) {
   RandomStream rng_noise(RandomStream::deriveSeed(seed_, "imu_noise"));
   RandomStream rng_bias(RandomStream::deriveSeed(seed_, "imu_bias"));
   const double dt = 1.0 / options_.rate_hz;

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "common/types.h"
-#include "sim/spiral_trajectory.h"
+#include "sim/trajectory.h"
 
 namespace meshnav::sim {
 
@@ -28,6 +28,13 @@ struct ImuNoiseOptions {
 
   /// All noise and biases zero (ideal IMU).
   static ImuNoiseOptions noiseless();
+  /// Figures of an IMU grade (`--imu-grade`), 200 Hz:
+  ///   grade     acc σ_c       gyro σ_c      acc bias rw   gyro bias rw   b_a(0) σ   b_g(0) σ
+  ///   consumer  6e-3          6e-4          1e-2          1e-4           0.1        0.01
+  ///   fc        2e-3          2e-4          3e-3          2e-5           0.05       0.005   (the defaults)
+  ///   tactical  5e-4          3e-5          3e-4          1e-6           0.01       0.0005
+  /// Throws std::invalid_argument for another name.
+  static ImuNoiseOptions forGrade(const std::string& grade);
   std::string toString() const;
 };
 
@@ -40,7 +47,7 @@ class ImuSimulator {
   static ImuSample ideal(const TrajectoryState& state);
 
   /// Readings at t_k = k/rate for t_k ∈ [0, t_end_s].
-  std::vector<ImuSample> simulate(const SpiralTrajectory& trajectory, double t_end_s);
+  std::vector<ImuSample> simulate(const Trajectory& trajectory, double t_end_s);
 
   /// Bias at the first sample (after `simulate`) [m/s², rad/s].
   const Eigen::Vector3d& initialAccBias() const { return bias_acc0_; }

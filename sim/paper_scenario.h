@@ -9,10 +9,12 @@
 #include <vector>
 
 #include "common/types.h"
+#include "sim/hall.h"
 
 namespace meshnav::sim {
 
-/// The hardware of the paper's experiment. Frames: G = hall (z up, floor at z = 0), I = IMU.
+/// The hardware of the paper's experiment (`paper()`), or of a generated scenario with the same
+/// structure (`scenario_builder.h`). Frames: G = hall (z up, floor at z = 0), I = IMU.
 struct PaperScenario {
   SensorId imu_id = 1;
   SensorId baro_id = 2;
@@ -27,6 +29,8 @@ struct PaperScenario {
   /// Hall extent (axis-aligned box, G) [m]; the UAV flies well inside it.
   Eigen::Vector3d hall_min_m{-2.5, -4.2, 0.0};
   Eigen::Vector3d hall_max_m{3.0, 4.2, 8.2};
+
+  Hall hall() const { return Hall{hall_min_m, hall_max_m}; }
 
   /// The paper's values.
   static PaperScenario paper();

@@ -1,11 +1,17 @@
 #include "sim/scenario_simulator.h"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
+#include <string>
 #include <numbers>
 
 #include "sim/baro_simulator.h"
 #include "sim/imu_simulator.h"
 #include "sim/random_stream.h"
+#include "sim/scenario_builder.h"
+#include "sim/trajectory_factory.h"
 #include "sim/tdma_schedule.h"
 #include "sim/uwb_hardware_biases.h"
 #include "sim/uwb_range_simulator.h"
@@ -24,70 +30,47 @@ int64_t sampleCount(double rate_hz, double t_end_s) {
 }
 }  // namespace
 
-ScenarioSimulator::ScenarioSimulator(SimulationOptions options, PaperScenario scenario)
-    : options_(std::move(options)), scenario_(std::move(scenario)) {
+ScenarioSimulator::ScenarioSimulator(SimulationOptions options, std::optional<PaperScenario> scenario)
+    : options_(std::move(options)) {
   options_.validate();
+  scenario_ = scenario ? std::move(*scenario) : buildScenario(options_);
 }
 
-SimulationResult ScenarioSimulator::run() const {
-  const SimulationOptions& o = options_;
-  SimulationResult result;
-  result.trajectory = o.trajectory ? *o.trajectory : TrajectoryOptions::randomized(o.seed, o.duration_scale);
-  const SpiralTrajectory trajectory(result.trajectory);
-  const double t_end = trajectory.duration();
-  Dataset& ds = result.dataset;
+namespace {
 
-  // IMU.
-  ImuSimulator imu(o.imu, o.seed);
-  ds.imu = imu.simulate(trajectory, t_end);
+/// What truth.yaml records beyond the dataset itself.
+struct RunFacts {
+  double t_end_s = 0.0;
+  double tdma_t0_s = 0.0;
+  double max_height_m = 0.0;
+  size_t n_ranges = 0;
+  const ImuSimulator* imu = nullptr;
+  const UwbRangeSimulator* uwb = nullptr;
+  BaroOptions baro;
+};
 
-  // Barometer with a seeded reference pressure at z = 0.
-  RandomStream rng_ref(RandomStream::deriveSeed(o.seed, "baro_reference"));
-  BaroOptions baro_options = o.baro;
-  baro_options.reference_pressure_pa =
-      o.reference_pressure_mean_pa + rng_ref.uniform(-o.reference_pressure_spread_pa, o.reference_pressure_spread_pa);
-  baro_options.p_IP = scenario_.baro_p_IP;
-  ds.baro = BaroSimulator(baro_options, o.seed).simulate(trajectory, t_end);
-
-  // UWB: meshed TDMA, fixed hardware biases, seeded noise/outliers/drops; seeded TDMA phase (µs grid).
-  RandomStream rng_tdma(RandomStream::deriveSeed(o.seed, "tdma_phase"));
-  const double tdma_t0 = std::round(rng_tdma.uniform(0.0, o.uwb.slot_s) * 1e6) * 1e-6;
-  const TdmaSchedule schedule(scenario_.uwbDeviceIds(), o.uwb.slot_s, tdma_t0);
-  const UwbHardwareBiases biases(scenario_.uwbDeviceIds(), o.hardware);
-  UwbRangeSimulator uwb(scenario_, biases, o.uwb, o.seed);
-  result.ranges = uwb.simulate(trajectory, schedule, t_end);
-  ds.ranges.reserve(result.ranges.size());
-  for (const auto& r : result.ranges) ds.ranges.push_back(r.sample);
-
-  // Flight state and ground truth.
-  for (int64_t k = 0, n = sampleCount(o.flight_state_rate_hz, t_end); k < n; ++k) {
-    const double t = static_cast<double>(k) / o.flight_state_rate_hz;
-    ds.flight_states.push_back({Timestamp::fromSec(t), trajectory.isLanded(t)});
-  }
-  double max_height = -1e9;
-  for (int64_t k = 0, n = sampleCount(o.ground_truth_rate_hz, t_end); k < n; ++k) {
-    const double t = static_cast<double>(k) / o.ground_truth_rate_hz;
-    const TrajectoryState st = trajectory.evaluate(t);
-    ds.ground_truth.push_back({Timestamp::fromSec(t), st.p_IinG, st.q_ItoG});
-    max_height = std::max(max_height, st.p_IinG.z());
-  }
-
-  // setup.yaml: what a user knows.
-  SystemSetup& setup = ds.setup;
-  setup.imu_id = scenario_.imu_id;
-  setup.baro_id = scenario_.baro_id;
-  setup.rel_tag_positions = scenario_.tags_p_TinI;
-  for (SensorId id : scenario_.known_anchor_ids) setup.abs_anchor_positions[id] = scenario_.anchors_p_AinG.at(id);
+/// setup.yaml: what a user knows.
+SystemSetup makeSetup(const SimulationOptions& o, const PaperScenario& scenario, const Trajectory& trajectory,
+                      const UwbHardwareBiases& biases, const BaroOptions& baro_options) {
+  SystemSetup setup;
+  setup.imu_id = scenario.imu_id;
+  setup.baro_id = scenario.baro_id;
+  setup.rel_tag_positions = scenario.tags_p_TinI;
+  for (SensorId id : scenario.known_anchor_ids) setup.abs_anchor_positions[id] = scenario.anchors_p_AinG.at(id);
   std::vector<SensorId> calibrated_ids;
-  for (const auto& [id, p] : scenario_.tags_p_TinI) calibrated_ids.push_back(id);
-  for (SensorId id : scenario_.known_anchor_ids) calibrated_ids.push_back(id);
+  for (const auto& [id, p] : scenario.tags_p_TinI) calibrated_ids.push_back(id);
+  for (SensorId id : scenario.known_anchor_ids) calibrated_ids.push_back(id);
   std::sort(calibrated_ids.begin(), calibrated_ids.end());
   for (size_t i = 0; i < calibrated_ids.size(); ++i)
     for (size_t j = i + 1; j < calibrated_ids.size(); ++j)
       setup.pair_biases.push_back(biases.calibrated(calibrated_ids[i], calibrated_ids[j], o.uwb.sigma_range_m));
-  setup.baro_p_IP = scenario_.baro_p_IP;
-  setup.baro_reference_pressure_pa.reset();  // taken on the ground at start
-  if (o.with_initial_pose) {
+  setup.baro_p_IP = scenario.baro_p_IP;
+  // Taken on the ground at start when the flight starts landed; a flight starting in the air
+  // cannot, so its reference is given.
+  setup.baro_reference_pressure_pa.reset();
+  if (!trajectory.hasLandedPhase() && trajectory.hasBarometer())
+    setup.baro_reference_pressure_pa = baro_options.reference_pressure_pa;
+  if (o.with_initial_pose && trajectory.hasLandedPhase()) {
     RandomStream rng_pose(RandomStream::deriveSeed(o.seed, "initial_pose"));
     const TrajectoryState st0 = trajectory.evaluate(0.0);
     InitialPose pose;
@@ -103,44 +86,128 @@ SimulationResult ScenarioSimulator::run() const {
   setup.noise.imu_acc_bias_rw = o.imu.acc_bias_rw;
   setup.noise.imu_gyro_bias_rw = o.imu.gyro_bias_rw;
   setup.noise.baro_pressure_sigma_pa = o.baro.pressure_sigma_pa;
+  return setup;
+}
 
-  // truth.yaml: evaluation only.
+/// The generator's choices, recorded only for scenarios other than the paper's (whose
+/// truth.yaml stays as it always was).
+void addScenarioScalars(const SimulationOptions& o, const Trajectory& trajectory, std::map<std::string, double>& sc) {
+  if (o.isPaperScenario()) return;
+  const Eigen::Vector3d hall = o.hall().size();
+  sc["scenario_trajectory_kind"] = static_cast<double>(o.trajectory_kind);
+  sc["scenario_anchor_layout"] = static_cast<double>(o.anchor_layout);
+  sc["scenario_hall_x_m"] = hall.x();
+  sc["scenario_hall_y_m"] = hall.y();
+  sc["scenario_hall_z_m"] = hall.z();
+  sc["scenario_n_tags"] = o.n_tags;
+  sc["scenario_n_known_anchors"] = o.n_known_anchors;
+  sc["scenario_n_unknown_anchors"] = o.n_unknown_anchors;
+  sc["scenario_has_landed_phase"] = trajectory.hasLandedPhase() ? 1.0 : 0.0;
+  sc["scenario_has_barometer"] = trajectory.hasBarometer() ? 1.0 : 0.0;
+  sc["hardware_gamma_max_m"] = o.hardware.gamma_max_m;
+}
+
+/// truth.yaml: evaluation only.
+Truth makeTruth(const SimulationOptions& o, const PaperScenario& scenario, const Trajectory& trajectory,
+                const UwbHardwareBiases& biases, const RunFacts& f) {
   Truth truth;
-  truth.anchor_positions = scenario_.anchors_p_AinG;
+  truth.anchor_positions = scenario.anchors_p_AinG;
   truth.pair_biases = biases.allTrue(o.uwb.sigma_range_m);
   auto& sc = truth.scalars;
   sc["seed"] = static_cast<double>(o.seed);
   sc["hardware_seed"] = static_cast<double>(o.hardware.hardware_seed);
-  sc["duration_s"] = t_end;
+  sc["duration_s"] = f.t_end_s;
   sc["duration_scale"] = o.duration_scale;
   sc["takeoff_time_s"] = trajectory.takeoffTime();
   sc["touchdown_time_s"] = trajectory.touchdownTime();
-  sc["max_height_m"] = max_height;
+  sc["max_height_m"] = f.max_height_m;
   sc["sigma_range_m"] = o.uwb.sigma_range_m;
   sc["outlier_fraction"] = o.uwb.outlier_fraction;
   sc["drop_fraction"] = o.uwb.drop_fraction;
   sc["tdma_slot_s"] = o.uwb.slot_s;
-  sc["tdma_t0_s"] = tdma_t0;
-  sc["n_range_slots"] = static_cast<double>(uwb.slotCount());
-  sc["n_ranges"] = static_cast<double>(ds.ranges.size());
-  sc["n_dropped"] = static_cast<double>(uwb.droppedCount());
-  sc["n_outliers"] = static_cast<double>(uwb.outlierCount());
-  sc["baro_reference_pressure_pa"] = baro_options.reference_pressure_pa;
-  sc["baro_pressure_sigma_pa"] = baro_options.pressure_sigma_pa;
+  sc["tdma_t0_s"] = f.tdma_t0_s;
+  sc["n_range_slots"] = static_cast<double>(f.uwb->slotCount());
+  sc["n_ranges"] = static_cast<double>(f.n_ranges);
+  sc["n_dropped"] = static_cast<double>(f.uwb->droppedCount());
+  sc["n_outliers"] = static_cast<double>(f.uwb->outlierCount());
+  sc["baro_reference_pressure_pa"] = f.baro.reference_pressure_pa;
+  sc["baro_pressure_sigma_pa"] = f.baro.pressure_sigma_pa;
   const char* axes[3] = {"x", "y", "z"};
   for (int i = 0; i < 3; ++i) {
-    sc[std::string("imu_acc_bias0_") + axes[i]] = imu.initialAccBias()[i];
-    sc[std::string("imu_gyro_bias0_") + axes[i]] = imu.initialGyroBias()[i];
-    sc[std::string("imu_acc_bias_end_") + axes[i]] = imu.finalAccBias()[i];
-    sc[std::string("imu_gyro_bias_end_") + axes[i]] = imu.finalGyroBias()[i];
+    sc[std::string("imu_acc_bias0_") + axes[i]] = f.imu->initialAccBias()[i];
+    sc[std::string("imu_gyro_bias0_") + axes[i]] = f.imu->initialGyroBias()[i];
+    sc[std::string("imu_acc_bias_end_") + axes[i]] = f.imu->finalAccBias()[i];
+    sc[std::string("imu_gyro_bias_end_") + axes[i]] = f.imu->finalGyroBias()[i];
   }
-  ds.truth = truth;
+  addScenarioScalars(o, trajectory, sc);
+  return truth;
+}
+
+}  // namespace
+
+SimulationResult ScenarioSimulator::run() const {
+  const SimulationOptions& o = options_;
+  SimulationResult result;
+  const std::unique_ptr<Trajectory> trajectory_owner = makeTrajectory(o);
+  const Trajectory& trajectory = *trajectory_owner;
+  result.trajectory_kind = trajectory.kind();
+  result.trajectory_description = trajectory.toString();
+  result.has_landed_phase = trajectory.hasLandedPhase();
+  result.takeoff_time_s = trajectory.takeoffTime();
+  result.touchdown_time_s = trajectory.touchdownTime();
+  const double t_end = trajectory.duration();
+  Dataset& ds = result.dataset;
+  RunFacts facts;
+  facts.t_end_s = t_end;
+
+  ImuSimulator imu(o.imu, o.seed);
+  ds.imu = imu.simulate(trajectory, t_end);
+
+  // Barometer (not on a hand-held rig) with a seeded reference pressure at z = 0.
+  RandomStream rng_ref(RandomStream::deriveSeed(o.seed, "baro_reference"));
+  facts.baro = o.baro;
+  facts.baro.reference_pressure_pa =
+      o.reference_pressure_mean_pa + rng_ref.uniform(-o.reference_pressure_spread_pa, o.reference_pressure_spread_pa);
+  facts.baro.p_IP = scenario_.baro_p_IP;
+  if (trajectory.hasBarometer()) ds.baro = BaroSimulator(facts.baro, o.seed).simulate(trajectory, t_end);
+
+  // UWB: meshed TDMA over every device, fixed hardware biases, seeded noise/outliers/drops; seeded
+  // TDMA phase (µs grid).
+  RandomStream rng_tdma(RandomStream::deriveSeed(o.seed, "tdma_phase"));
+  facts.tdma_t0_s = std::round(rng_tdma.uniform(0.0, o.uwb.slot_s) * 1e6) * 1e-6;
+  const TdmaSchedule schedule(scenario_.uwbDeviceIds(), o.uwb.slot_s, facts.tdma_t0_s);
+  const UwbHardwareBiases biases(scenario_.uwbDeviceIds(), o.hardware);
+  UwbRangeSimulator uwb(scenario_, biases, o.uwb, o.seed);
+  result.ranges = uwb.simulate(trajectory, schedule, t_end);
+  ds.ranges.reserve(result.ranges.size());
+  for (const auto& r : result.ranges) ds.ranges.push_back(r.sample);
+  facts.n_ranges = ds.ranges.size();
+
+  // Flight state (only for motions that rest on the ground) and ground truth.
+  if (trajectory.hasLandedPhase()) {
+    for (int64_t k = 0, n = sampleCount(o.flight_state_rate_hz, t_end); k < n; ++k) {
+      const double t = static_cast<double>(k) / o.flight_state_rate_hz;
+      ds.flight_states.push_back({Timestamp::fromSec(t), trajectory.isLanded(t)});
+    }
+  }
+  facts.max_height_m = -1e9;
+  for (int64_t k = 0, n = sampleCount(o.ground_truth_rate_hz, t_end); k < n; ++k) {
+    const double t = static_cast<double>(k) / o.ground_truth_rate_hz;
+    const TrajectoryState st = trajectory.evaluate(t);
+    ds.ground_truth.push_back({Timestamp::fromSec(t), st.p_IinG, st.q_ItoG});
+    facts.max_height_m = std::max(facts.max_height_m, st.p_IinG.z());
+  }
+
+  ds.setup = makeSetup(o, scenario_, trajectory, biases, facts.baro);
+  facts.imu = &imu;
+  facts.uwb = &uwb;
+  ds.truth = makeTruth(o, scenario_, trajectory, biases, facts);
 
   result.stats.duration_s = t_end;
   result.stats.n_range_slots = uwb.slotCount();
   result.stats.n_dropped = uwb.droppedCount();
   result.stats.n_outliers = uwb.outlierCount();
-  result.stats.max_height_m = max_height;
+  result.stats.max_height_m = facts.max_height_m;
   return result;
 }
 

@@ -1,7 +1,10 @@
 #pragma once
 /// @file scenario_simulator.h
-/// @brief Simulates one sequence of the paper's scenario (DESIGN §7): analytic flight, IMU,
-/// barometer, meshed-TDMA UWB ranges, flight state, ground truth, setup.yaml and truth.yaml.
+/// @brief Simulates one sequence (DESIGN §7 by default, or a generated scenario): analytic motion,
+/// IMU, barometer (flights only), meshed-TDMA UWB ranges over every tag and anchor, flight state
+/// (motions with a landed phase only), ground truth, setup.yaml and truth.yaml.
+
+#include <optional>
 
 #include "sim/paper_scenario.h"
 #include "sim/simulation_options.h"
@@ -11,10 +14,12 @@ namespace meshnav::sim {
 
 class ScenarioSimulator {
  public:
-  explicit ScenarioSimulator(SimulationOptions options, PaperScenario scenario = PaperScenario::paper());
+  /// `scenario`: the hardware geometry; nullopt: `buildScenario(options)` (the paper's by default).
+  explicit ScenarioSimulator(SimulationOptions options, std::optional<PaperScenario> scenario = std::nullopt);
   /// Deterministic for given options: the same seed gives the same result.
   SimulationResult run() const;
   const SimulationOptions& options() const { return options_; }
+  const PaperScenario& scenario() const { return scenario_; }
 
  private:
   SimulationOptions options_;

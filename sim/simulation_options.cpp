@@ -19,6 +19,22 @@ void SimulationOptions::validate() const {
   require(ground_truth_rate_hz > 0.0 && flight_state_rate_hz > 0.0, "output rates must be > 0");
   require(initial_pose_sigma_p_m >= 0.0 && initial_pose_sigma_yaw_deg >= 0.0, "initial pose sigmas must be >= 0");
   if (trajectory) trajectory->validate();
+  require(n_tags >= 1 && n_tags <= 3, "n_tags (--tags) must be 1, 2 or 3");
+  require(n_known_anchors >= 3 && n_known_anchors <= 5, "n_known_anchors (--known) must be 3, 4 or 5");
+  require(n_unknown_anchors >= 0 && n_unknown_anchors <= 20, "n_unknown_anchors (--unknown) must be in [0, 20]");
+  require(anchor_layout != AnchorLayoutKind::Paper || n_known_anchors + n_unknown_anchors <= 9,
+          "the paper anchor layout (--anchor-layout paper) has 9 anchors: --known + --unknown must be <= 9");
+  if (hall_size_m) {
+    const Eigen::Vector3d& s = *hall_size_m;
+    require(s.x() >= 3.0 && s.y() >= 3.0 && s.x() <= 100.0 && s.y() <= 100.0, "hall (--hall) X and Y must be in [3, 100] m");
+    require(s.z() >= 2.5 && s.z() <= 30.0, "hall (--hall) Z must be in [2.5, 30] m");
+  }
+  if (duration_s) require(*duration_s >= 30.0 && *duration_s <= 3600.0, "duration_s (--duration) must be in [30, 3600] s");
+}
+
+bool SimulationOptions::isPaperScenario() const {
+  return trajectory_kind == TrajectoryKind::Spiral && !hall_size_m && anchor_layout == AnchorLayoutKind::Paper &&
+         n_tags == 2 && n_known_anchors == 4 && n_unknown_anchors == 5;
 }
 
 std::string SimulationOptions::toString() const {
@@ -33,6 +49,11 @@ std::string SimulationOptions::toString() const {
     << uwb.toString() << "\n"
     << hardware.toString();
   if (trajectory) s << "\n" << trajectory->toString();
+  s << "\nscenario: trajectory " << sim::toString(trajectory_kind) << ", " << hall().toString() << ", anchor layout "
+    << sim::toString(anchor_layout) << ", " << n_tags << " tags, " << n_known_anchors << " known + " << n_unknown_anchors
+    << " unknown anchors, duration ";
+  if (duration_s) s << *duration_s << " s";
+  else s << "140 s x duration scale";
   return s.str();
 }
 

@@ -1,14 +1,20 @@
 #pragma once
 /// @file simulation_options.h
-/// @brief Everything that defines one simulated sequence of the paper's scenario.
+/// @brief Everything that defines one simulated sequence: the paper's scenario by default, or a
+/// generated one (trajectory kind, hall, anchor layout, tags, known/unknown anchors, duration).
 
 #include <cstdint>
 #include <optional>
 #include <string>
 
+#include <Eigen/Core>
+
 #include "sim/baro_simulator.h"
+#include "sim/anchor_layout.h"
+#include "sim/hall.h"
 #include "sim/imu_simulator.h"
 #include "sim/spiral_trajectory.h"
+#include "sim/trajectory_kind.h"
 #include "sim/uwb_hardware_biases.h"
 #include "sim/uwb_range_simulator.h"
 
@@ -28,8 +34,22 @@ struct SimulationOptions {
   BaroOptions baro;                          ///< `reference_pressure_pa` is replaced by the seeded value
   UwbRangeOptions uwb;
   UwbHardwareOptions hardware;
-  /// Flight shape; nullopt: `TrajectoryOptions::randomized(seed, duration_scale)`.
+  /// Spiral flight shape; nullopt: `TrajectoryOptions::randomized(seed, duration_scale)`.
   std::optional<TrajectoryOptions> trajectory;
+  // Scenario generator (defaults: the paper's scenario, DESIGN §7).
+  TrajectoryKind trajectory_kind = TrajectoryKind::Spiral;  ///< --trajectory
+  std::optional<Eigen::Vector3d> hall_size_m;   ///< --hall X,Y,Z [m]; nullopt: the paper's hall
+  AnchorLayoutKind anchor_layout = AnchorLayoutKind::Paper;  ///< --anchor-layout
+  int n_tags = 2;                               ///< --tags: 1 (100), 2 (+105), 3 (+99)
+  int n_known_anchors = 4;                      ///< --known: anchors written to setup.yaml (3–5)
+  int n_unknown_anchors = 5;                    ///< --unknown: further anchors, truth.yaml only
+  std::optional<double> duration_s;             ///< --duration [s]; nullopt: 140 s × duration_scale
+
+  /// The hall box: `Hall::ofSize(*hall_size_m)` or the paper's.
+  Hall hall() const { return hall_size_m ? Hall::ofSize(*hall_size_m) : Hall::paper(); }
+  /// True for the paper's geometry (spiral, paper hall, paper anchors, two tags, 101–104 known,
+  /// 106–110 unknown): then the outputs are those of the paper-scenario simulator.
+  bool isPaperScenario() const;
 
   /// Throws std::invalid_argument naming the offending option.
   void validate() const;

@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "common/dataset.h"
-#include "sim/spiral_trajectory.h"
 #include "sim/uwb_range_simulator.h"
 
 namespace meshnav::sim {
@@ -24,7 +23,11 @@ struct SimulationStats {
 struct SimulationResult {
   Dataset dataset;                     ///< files of DESIGN §6 (setup.yaml, truth.yaml included)
   std::vector<SimulatedRange> ranges;  ///< same order as dataset.ranges, with outlier flags
-  TrajectoryOptions trajectory;        ///< the flight that was simulated
+  std::string trajectory_kind;         ///< "spiral", "walk", ...
+  std::string trajectory_description; ///< the motion's parameters (Trajectory::toString)
+  bool has_landed_phase = true;        ///< false: no flight_state.csv (walk, hover)
+  double takeoff_time_s = 0.0;         ///< end of the initial landed phase [s]
+  double touchdown_time_s = 0.0;       ///< start of the final landed phase [s]
   SimulationStats stats;
   /// One paragraph for the user: duration, counts, outliers.
   std::string summary() const;

@@ -1,59 +1,19 @@
 #include "sim/spiral_trajectory.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
 
 #include "sim/random_stream.h"
-#include "sim/taylor_jet.h"
+#include "sim/trajectory_jets.h"
 
 namespace meshnav::sim {
 
 namespace {
-
 constexpr double kPi = std::numbers::pi;
-constexpr int kPosOrder = 4;  ///< p, v, a, jerk, snap
-constexpr int kAttOrder = 2;  ///< R, Ṙ, R̈ (from a, ȧ, ä)
-using JetP = TaylorJet<kPosOrder>;
-using JetR = TaylorJet<kAttOrder>;
-
-/// Smootherstep S(u), clamped: 0 for u ≤ 0, 1 for u ≥ 1.
-JetP smoothStep(const JetP& u) {
-  if (u.value() <= 0.0) return JetP::constant(0.0);
-  if (u.value() >= 1.0) return JetP::constant(1.0);
-  const JetP u2 = u * u;
-  const JetP u5 = u2 * u2 * u;
-  const JetP poly = 126.0 + u * (-420.0 + u * (540.0 + u * (-315.0 + 70.0 * u)));
-  return u5 * poly;
-}
-
-/// I(u) = ∫₀ᵘ S(s) ds: 0 for u ≤ 0, u − ½ for u ≥ 1.
-JetP smoothStepIntegral(const JetP& u) {
-  if (u.value() <= 0.0) return JetP::constant(0.0);
-  if (u.value() >= 1.0) return u - 0.5;
-  const JetP u3 = u * u * u;
-  const JetP u6 = u3 * u3;
-  const JetP poly = 21.0 + u * (-60.0 + u * (67.5 + u * (-35.0 + 7.0 * u)));
-  return u6 * poly;
-}
-
-template <int N>
-std::array<TaylorJet<N>, 3> cross(const std::array<TaylorJet<N>, 3>& a, const std::array<TaylorJet<N>, 3>& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-
-template <int N>
-std::array<TaylorJet<N>, 3> normalized(const std::array<TaylorJet<N>, 3>& a) {
-  const TaylorJet<N> n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
-  return {a[0] / n, a[1] / n, a[2] / n};
-}
-
-Eigen::Vector3d vee(const Eigen::Matrix3d& S) {
-  // Skew part only: robust against round-off in the symmetric part.
-  return 0.5 * Eigen::Vector3d(S(2, 1) - S(1, 2), S(0, 2) - S(2, 0), S(1, 0) - S(0, 1));
-}
-
+using JetP = PositionJet;
 }  // namespace
 
 TrajectoryOptions TrajectoryOptions::randomized(uint64_t seed, double duration_scale) {
@@ -95,6 +55,22 @@ TrajectoryOptions TrajectoryOptions::randomized(uint64_t seed, double duration_s
                     &o.landing_start_s, &o.landing_duration_s, &o.duration_s, &o.z_wobble_period_s, &o.radial_wobble_period_s,
                     &o.yaw_wobble_period_s})
     *t *= duration_scale;
+  o.validate();
+  return o;
+}
+
+TrajectoryOptions TrajectoryOptions::fittedTo(const Hall& hall) const {
+  const Hall paper = Hall::paper();
+  const Eigen::Vector3d scale = hall.size().cwiseQuotient(paper.size());
+  const double height_scale = (hall.size().z() - 0.5) / (paper.size().z() - 0.5);
+  TrajectoryOptions o = *this;
+  o.center_x_m = hall.min_m.x() + (center_x_m - paper.min_m.x()) * scale.x();
+  o.center_y_m = hall.min_m.y() + (center_y_m - paper.min_m.y()) * scale.y();
+  o.semi_axis_x_m = semi_axis_x_m * scale.x();
+  o.semi_axis_y_m = semi_axis_y_m * scale.y();
+  o.hover_height_m = std::max(pad_height_m + 0.5, hover_height_m * height_scale);
+  o.top_height_m = std::max(o.hover_height_m + 0.3, top_height_m * height_scale);
+  o.z_wobble_amplitude_m = z_wobble_amplitude_m * std::min(1.0, height_scale);
   o.validate();
   return o;
 }
@@ -180,40 +156,7 @@ TrajectoryState SpiralTrajectory::evaluate(double t_s) const {
                    o.yaw_wobble_amplitude_rad *
                        (envelope * sin(t * (2.0 * kPi / o.yaw_wobble_period_s) + o.yaw_wobble_phase_rad));
 
-  TrajectoryState st;
-  st.t_s = t_s;
-  const std::array<JetP, 3> p{x, y, z};
-  for (int i = 0; i < 3; ++i) {
-    st.p_IinG[i] = p[i].derivative(0);
-    st.v_IinG[i] = p[i].derivative(1);
-    st.a_IinG[i] = p[i].derivative(2);
-  }
-  st.yaw_rad = psi.value();
-
-  // Attitude from the thrust direction and the heading, as jets of order 2 in t.
-  std::array<JetR, 3> thrust{p[0].derived<2>(), p[1].derived<2>(), p[2].derived<2>()};
-  thrust[2] = thrust[2] + kGravity_m_s2;  // a − g_G
-  const std::array<JetR, 3> z_I = normalized(thrust);
-  JetR sin_psi, cos_psi;
-  sincos(psi.truncated<kAttOrder>(), sin_psi, cos_psi);
-  const std::array<JetR, 3> x_c{cos_psi, sin_psi, JetR::constant(0.0)};
-  const std::array<JetR, 3> y_I = normalized(cross(z_I, x_c));
-  const std::array<JetR, 3> x_I = cross(y_I, z_I);
-
-  Eigen::Matrix3d R, R_dot, R_ddot;
-  const std::array<const std::array<JetR, 3>*, 3> cols{&x_I, &y_I, &z_I};
-  for (int c = 0; c < 3; ++c) {
-    for (int r = 0; r < 3; ++r) {
-      R(r, c) = (*cols[c])[r].derivative(0);
-      R_dot(r, c) = (*cols[c])[r].derivative(1);
-      R_ddot(r, c) = (*cols[c])[r].derivative(2);
-    }
-  }
-  st.R_ItoG = R;
-  st.q_ItoG = Eigen::Quaterniond(R).normalized();
-  st.w_IinI = vee(R.transpose() * R_dot);
-  st.alpha_IinI = vee(R_dot.transpose() * R_dot + R.transpose() * R_ddot);
-  return st;
+  return quadrotorState(t_s, {x, y, z}, psi);
 }
 
 }  // namespace meshnav::sim

@@ -20,12 +20,13 @@
 ///   y_I = (z_I × x_c)/‖z_I × x_c‖,  x_I = y_I × z_I,  R_ItoG = [x_I y_I z_I].
 /// Position is C⁴ everywhere (also where the landed phases join), hence a is C²,
 /// ω (which needs the jerk) C¹ and α (needs the snap) C⁰. All derivatives come from Taylor jets
-/// (`taylor_jet.h`): ω_I = vee(Rᵀ Ṙ), α_I = vee(Ṙᵀ Ṙ + Rᵀ R̈) (skew part).
+/// (`taylor_jet.h`); smooth steps and the quadrotor attitude are shared (`trajectory_jets.h`).
 
 #include <cstdint>
 #include <string>
 
-#include "sim/trajectory_state.h"
+#include "sim/hall.h"
+#include "sim/trajectory.h"
 
 namespace meshnav::sim {
 
@@ -69,6 +70,10 @@ struct TrajectoryOptions {
   /// timing (seeds 1–12: twelve similar but different flights). All times are multiplied by
   /// `duration_scale` (1 = ~140 s).
   static TrajectoryOptions randomized(uint64_t seed, double duration_scale = 1.0);
+  /// The same flight mapped from the paper's hall into `hall`: the ellipse centre moves with the
+  /// hall (affine per axis), the semi-axes and the radial wobble scale with the hall's width and
+  /// depth, the heights with (H − 0.5 m)/(H_paper − 0.5 m) (the pad height stays).
+  TrajectoryOptions fittedTo(const Hall& hall) const;
   /// Throws std::invalid_argument naming the inconsistent field.
   void validate() const;
   /// Multi-line human-readable listing with units.
@@ -76,19 +81,20 @@ struct TrajectoryOptions {
 };
 
 /// Evaluates the flight at any time t ∈ ℝ (before 0 / after the end it stays on the pad).
-class SpiralTrajectory {
+class SpiralTrajectory : public Trajectory {
  public:
-  static constexpr double kGravity_m_s2 = 9.81;  ///< g_G = [0, 0, −9.81]
-
   explicit SpiralTrajectory(const TrajectoryOptions& options);
 
   /// Exact state at `t_s`.
-  TrajectoryState evaluate(double t_s) const;
+  TrajectoryState evaluate(double t_s) const override;
   /// True while the UAV rests on the pad (before take-off and after touch-down).
-  bool isLanded(double t_s) const;
-  double duration() const { return options_.duration_s; }
-  double takeoffTime() const { return options_.takeoff_start_s; }
-  double touchdownTime() const { return options_.landing_start_s + options_.landing_duration_s; }
+  bool isLanded(double t_s) const override;
+  double duration() const override { return options_.duration_s; }
+  double takeoffTime() const override { return options_.takeoff_start_s; }
+  double touchdownTime() const override { return options_.landing_start_s + options_.landing_duration_s; }
+  bool hasLandedPhase() const override { return true; }
+  std::string kind() const override { return "spiral"; }
+  std::string toString() const override { return options_.toString(); }
   /// IMU position on the pad (start = end).
   Eigen::Vector3d padPosition() const;
   const TrajectoryOptions& options() const { return options_; }

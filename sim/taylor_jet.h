@@ -9,6 +9,7 @@
 ///   h = f/g:     h_k = (f_k − Σ_{i=1..k} g_i h_{k−i}) / g_0
 ///   h = √f:      h_k = (f_k − Σ_{i=1..k−1} h_i h_{k−i}) / (2 h_0)
 ///   s = sin f, c = cos f:  s_k = (1/k) Σ_{i=1..k} i f_i c_{k−i},  c_k = −(1/k) Σ_{i=1..k} i f_i s_{k−i}
+///   h = atan2(y, x):  h′ = (x y′ − y x′)/(x² + y²) =: q,  h_k = q_{k−1} / k
 /// Derivatives are read back as f^(k)(t0) = k! · c_k (`derivative(k)`).
 
 #include <array>
@@ -161,6 +162,22 @@ TaylorJet<N> cos(const TaylorJet<N>& f) {
   TaylorJet<N> s, c;
   sincos(f, s, c);
   return c;
+}
+
+/// Four-quadrant arc tangent of y/x (the value in (−π, π]; derivatives from h′ = (x y′ − y x′)/(x² + y²)).
+template <int N>
+TaylorJet<N> atan2(const TaylorJet<N>& y, const TaylorJet<N>& x) {
+  // Jets of y′ and x′; their top coefficient would need c_{N+1} and only feeds h_{N+1}: left 0.
+  TaylorJet<N> dy, dx;
+  for (int k = 0; k < N; ++k) {
+    dy.c[k] = (k + 1) * y.c[k + 1];
+    dx.c[k] = (k + 1) * x.c[k + 1];
+  }
+  const TaylorJet<N> q = (x * dy - y * dx) / (x * x + y * y);
+  TaylorJet<N> h;
+  h.c[0] = std::atan2(y.c[0], x.c[0]);
+  for (int k = 1; k <= N; ++k) h.c[k] = q.c[k - 1] / k;
+  return h;
 }
 
 }  // namespace meshnav::sim

@@ -25,7 +25,7 @@ Eigen::Vector3d UwbRangeSimulator::devicePosition(SensorId id, const TrajectoryS
   throw std::out_of_range("UwbRangeSimulator: unknown device " + std::to_string(id));
 }
 
-std::vector<SimulatedRange> UwbRangeSimulator::simulate(const SpiralTrajectory& trajectory,
+std::vector<SimulatedRange> UwbRangeSimulator::simulate(const Trajectory& trajectory,
                                                         const TdmaSchedule& schedule, double t_end_s) {
   RandomStream rng(RandomStream::deriveSeed(seed_, "uwb_ranges"));
   n_slots_ = n_dropped_ = n_outliers_ = 0;

@@ -17,7 +17,7 @@
 
 #include "common/types.h"
 #include "sim/paper_scenario.h"
-#include "sim/spiral_trajectory.h"
+#include "sim/trajectory.h"
 #include "sim/tdma_schedule.h"
 #include "sim/uwb_hardware_biases.h"
 
@@ -48,7 +48,7 @@ class UwbRangeSimulator {
   /// Position of a device in G for the UAV state (tags move with I, anchors are fixed) [m].
   Eigen::Vector3d devicePosition(SensorId id, const TrajectoryState& state) const;
   /// Ranges of every non-dropped slot of `schedule` up to `t_end_s`.
-  std::vector<SimulatedRange> simulate(const SpiralTrajectory& trajectory, const TdmaSchedule& schedule,
+  std::vector<SimulatedRange> simulate(const Trajectory& trajectory, const TdmaSchedule& schedule,
                                        double t_end_s);
 
   int64_t slotCount() const { return n_slots_; }

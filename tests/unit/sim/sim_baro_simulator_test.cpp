@@ -4,6 +4,7 @@
 
 #include "common/atmosphere.h"
 #include "sim/baro_simulator.h"
+#include "sim/spiral_trajectory.h"
 
 using namespace meshnav::sim;
 namespace atm = meshnav::atmosphere;

@@ -5,58 +5,11 @@
 
 #include "sim/imu_simulator.h"
 #include "sim/spiral_trajectory.h"
+#include "trajectory_checks.h"
 
 using namespace meshnav::sim;
 
-namespace {
-
-/// Navigation state for the strapdown check.
-struct NavState {
-  Eigen::Vector3d p, v;
-  Eigen::Vector4d q;  ///< (w, x, y, z) of q_ItoG
-};
-
-Eigen::Quaterniond toQuat(const Eigen::Vector4d& q) { return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).normalized(); }
-
-/// ṗ = v, v̇ = R(q) f + g, q̇ = ½ q ⊗ [0, ω].
-NavState derivative(const NavState& x, const Eigen::Vector3d& f, const Eigen::Vector3d& w) {
-  const Eigen::Vector3d g(0, 0, -SpiralTrajectory::kGravity_m_s2);
-  NavState d;
-  d.p = x.v;
-  d.v = toQuat(x.q) * f + g;
-  const Eigen::Quaterniond q(x.q[0], x.q[1], x.q[2], x.q[3]);
-  const Eigen::Quaterniond qw = q * Eigen::Quaterniond(0, w.x(), w.y(), w.z());
-  d.q = 0.5 * Eigen::Vector4d(qw.w(), qw.x(), qw.y(), qw.z());
-  return d;
-}
-
-NavState axpy(const NavState& x, double h, const NavState& d) {
-  return {x.p + h * d.p, x.v + h * d.v, x.q + h * d.q};
-}
-
-/// Integrates the IMU samples [k0, k1] with RK4 (inputs linearly interpolated at mid-steps).
-NavState integrate(const std::vector<meshnav::ImuSample>& imu, size_t k0, size_t k1, NavState x) {
-  for (size_t k = k0; k < k1; ++k) {
-    const double h = (imu[k + 1].t - imu[k].t).sec();
-    const Eigen::Vector3d f0 = imu[k].acc_m_s2, f1 = imu[k + 1].acc_m_s2, fm = 0.5 * (f0 + f1);
-    const Eigen::Vector3d w0 = imu[k].gyro_rad_s, w1 = imu[k + 1].gyro_rad_s, wm = 0.5 * (w0 + w1);
-    const NavState d1 = derivative(x, f0, w0);
-    const NavState d2 = derivative(axpy(x, h / 2, d1), fm, wm);
-    const NavState d3 = derivative(axpy(x, h / 2, d2), fm, wm);
-    const NavState d4 = derivative(axpy(x, h, d3), f1, w1);
-    x.p += h / 6 * (d1.p + 2 * d2.p + 2 * d3.p + d4.p);
-    x.v += h / 6 * (d1.v + 2 * d2.v + 2 * d3.v + d4.v);
-    x.q += h / 6 * (d1.q + 2 * d2.q + 2 * d3.q + d4.q);
-    x.q.normalize();
-  }
-  return x;
-}
-
-NavState trueState(const TrajectoryState& s) {
-  return {s.p_IinG, s.v_IinG, Eigen::Vector4d(s.q_ItoG.w(), s.q_ItoG.x(), s.q_ItoG.y(), s.q_ItoG.z())};
-}
-
-}  // namespace
+using namespace meshnav::sim::test;
 
 TEST(SimImuSimulator, NoiseFreeImuIntegratesBackToTheTrajectory) {
   const SpiralTrajectory tr(TrajectoryOptions::randomized(2));

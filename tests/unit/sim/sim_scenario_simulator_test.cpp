@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <set>
 
 #include "common/dataset.h"
 #include "sim/scenario_simulator.h"
@@ -150,5 +151,96 @@ TEST(SimScenarioSimulator, RejectsInvalidOptions) {
   EXPECT_THROW(ScenarioSimulator{o}, std::invalid_argument);
   o = SimulationOptions{};
   o.uwb.sigma_range_m = -0.1;
+  EXPECT_THROW(ScenarioSimulator{o}, std::invalid_argument);
+}
+
+namespace {
+SimulationOptions generated(TrajectoryKind kind, uint64_t seed = 4) {
+  SimulationOptions o;
+  o.seed = seed;
+  o.trajectory_kind = kind;
+  o.hall_size_m = Eigen::Vector3d(10.0, 8.0, 4.0);
+  o.anchor_layout = AnchorLayoutKind::Walls;
+  o.n_tags = 3;
+  o.n_known_anchors = 5;
+  o.n_unknown_anchors = 3;
+  o.duration_s = 40.0;
+  return o;
+}
+}  // namespace
+
+TEST(SimScenarioSimulator, WalkWritesNoBaroNoFlightStateNoInitialPoseAndReadsBack) {
+  const auto r = ScenarioSimulator(generated(TrajectoryKind::Walk)).run();
+  const auto& ds = r.dataset;
+  EXPECT_TRUE(ds.baro.empty());
+  EXPECT_TRUE(ds.flight_states.empty());
+  EXPECT_FALSE(ds.setup.initial_pose.has_value());
+  EXPECT_FALSE(r.has_landed_phase);
+  const fs::path dir = fs::temp_directory_path() / ("meshnav_sim_walk_" + std::to_string(::getpid()));
+  meshnav::writeDataset(ds, dir.string());
+  EXPECT_FALSE(fs::exists(dir / "baro.csv"));
+  EXPECT_FALSE(fs::exists(dir / "flight_state.csv"));
+  meshnav::Diagnostics diag;
+  const auto back = meshnav::readDataset(dir.string(), diag, true);
+  EXPECT_EQ(diag.total(), 0) << diag.summary();
+  EXPECT_TRUE(back.baro.empty());
+  EXPECT_TRUE(back.flight_states.empty());
+  EXPECT_EQ(back.imu.size(), ds.imu.size());
+  EXPECT_EQ(back.ranges.size(), ds.ranges.size());
+  fs::remove_all(dir);
+}
+
+TEST(SimScenarioSimulator, GeneratedScenarioHasTheRequestedDevicesInTheTdma) {
+  const auto r = ScenarioSimulator(generated(TrajectoryKind::Figure8)).run();
+  const auto& ds = r.dataset;
+  EXPECT_EQ(ds.setup.rel_tag_positions.size(), 3u);
+  EXPECT_EQ(ds.setup.abs_anchor_positions.size(), 5u);
+  EXPECT_EQ(ds.truth->anchor_positions.size(), 8u);
+  EXPECT_EQ(ds.setup.pair_biases.size(), 28u);  // 8 tags and known anchors choose 2
+  EXPECT_EQ(ds.truth->pair_biases.size(), 55u);  // 11 devices choose 2
+  std::set<std::pair<meshnav::SensorId, meshnav::SensorId>> pairs;
+  for (const auto& range : ds.ranges) pairs.insert({range.id_initiator, range.id_responder});
+  EXPECT_EQ(pairs.size(), 110u);  // every ordered pair of the 11 devices is ranged
+  EXPECT_TRUE(ds.setup.initial_pose.has_value());
+  EXPECT_FALSE(ds.baro.empty());
+  EXPECT_FALSE(ds.flight_states.empty());
+  EXPECT_EQ(ds.truth->scalars.at("scenario_n_tags"), 3.0);
+}
+
+TEST(SimScenarioSimulator, HoverStartsInTheAirWithAGivenBaroReference) {
+  const auto r = ScenarioSimulator(generated(TrajectoryKind::Hover)).run();
+  const auto& ds = r.dataset;
+  EXPECT_TRUE(ds.flight_states.empty());
+  EXPECT_FALSE(ds.setup.initial_pose.has_value());
+  ASSERT_TRUE(ds.setup.baro_reference_pressure_pa.has_value());
+  EXPECT_EQ(*ds.setup.baro_reference_pressure_pa, ds.truth->scalars.at("baro_reference_pressure_pa"));
+  EXPECT_GT(ds.ground_truth.front().p_IinG.z(), 1.0);
+}
+
+TEST(SimScenarioSimulator, ImuGradeIsWrittenToTheSetup) {
+  SimulationOptions o = generated(TrajectoryKind::Helix);
+  o.imu = ImuNoiseOptions::forGrade("tactical");
+  const auto r = ScenarioSimulator(o).run();
+  EXPECT_EQ(*r.dataset.setup.noise.imu_acc_noise_density, 5e-4);
+  EXPECT_EQ(*r.dataset.setup.noise.imu_gyro_bias_rw, 1e-6);
+  EXPECT_THROW(ImuNoiseOptions::forGrade("navigation"), std::invalid_argument);
+  EXPECT_EQ(ImuNoiseOptions::forGrade("fc").acc_noise_density, ImuNoiseOptions{}.acc_noise_density);
+}
+
+TEST(SimScenarioSimulator, RejectsBadScenarioOptions) {
+  SimulationOptions o;
+  o.n_tags = 0;
+  EXPECT_THROW(ScenarioSimulator{o}, std::invalid_argument);
+  o = SimulationOptions{};
+  o.n_known_anchors = 6;
+  EXPECT_THROW(ScenarioSimulator{o}, std::invalid_argument);
+  o = SimulationOptions{};
+  o.n_unknown_anchors = 6;  // paper layout: 4 + 6 > 9
+  EXPECT_THROW(ScenarioSimulator{o}, std::invalid_argument);
+  o = SimulationOptions{};
+  o.hall_size_m = Eigen::Vector3d(2.0, 8.0, 4.0);
+  EXPECT_THROW(ScenarioSimulator{o}, std::invalid_argument);
+  o = SimulationOptions{};
+  o.duration_s = 10.0;
   EXPECT_THROW(ScenarioSimulator{o}, std::invalid_argument);
 }

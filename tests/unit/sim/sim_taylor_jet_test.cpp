@@ -39,3 +39,22 @@ TEST(SimTaylorJet, DerivedShiftsTheCoefficients) {
   EXPECT_DOUBLE_EQ(a.derivative(1), 48.0);
   EXPECT_DOUBLE_EQ(a.derivative(2), 24.0);
 }
+
+TEST(SimTaylorJet, Atan2MatchesTheAnalyticDerivativesInEveryQuadrant) {
+  // h(t) = atan2(sin(ωt + φ), cos(ωt + φ)) = ωt + φ (mod 2π): h′ = ω, higher derivatives zero;
+  // and for the ellipse y = b sin t, x = a cos t: h′ = ab / (a² cos² t + b² sin² t).
+  const double w = 1.7, a = 2.0, b = 0.5;
+  for (double t0 : {0.3, 1.9, 3.5, 5.2}) {
+    const TaylorJet<4> t = TaylorJet<4>::variable(t0);
+    const TaylorJet<4> h = atan2(sin(w * t + 0.4), cos(w * t + 0.4));
+    EXPECT_NEAR(std::remainder(h.value() - (w * t0 + 0.4), 2.0 * M_PI), 0.0, 1e-12);
+    EXPECT_NEAR(h.derivative(1), w, 1e-12);
+    for (int k = 2; k <= 4; ++k) EXPECT_NEAR(h.derivative(k), 0.0, 1e-10) << "k " << k;
+    const TaylorJet<4> e = atan2(b * sin(t), a * cos(t));
+    const double c = std::cos(t0), s = std::sin(t0);
+    EXPECT_NEAR(e.derivative(1), a * b / (a * a * c * c + b * b * s * s), 1e-12);
+    // Second derivative: d/dt of ab / D with D = a²c² + b²s², D′ = 2(b² − a²) s c.
+    const double D = a * a * c * c + b * b * s * s;
+    EXPECT_NEAR(e.derivative(2), -a * b * 2.0 * (b * b - a * a) * s * c / (D * D), 1e-12);
+  }
+}

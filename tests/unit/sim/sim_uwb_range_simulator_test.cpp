@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "sim/paper_scenario.h"
+#include "sim/spiral_trajectory.h"
 #include "sim/uwb_hardware_biases.h"
 #include "sim/uwb_range_simulator.h"
 

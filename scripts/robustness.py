@@ -1,0 +1,340 @@
+#!/usr/bin/python3
+"""Robustness sweep (issue 8, item 2): random or listed scenarios through the whole pipeline.
+
+Every scenario is simulated with meshnav_sim (docs/scenarios.md), flown with
+`meshnav_run --no-calibration` (known anchors only) and evaluated with `meshnav_eval --json`.
+Per run: position RMSE [m], max position error after the first 10 s [m], orientation RMSE [deg],
+position ANEES, diverged (max error after 10 s > 1 m) and recoveries (the `recovery` counter of
+the run's status.txt, 0 when absent). Writes robustness.csv and error_cdf.png into --out, prints
+a table, and exits 1 when any run diverged or a process failed (2 on usage errors).
+
+  robustness.py --runs N --seed S [--jobs 2] [--out DIR] [--strategy S] [--duration SEC]
+  robustness.py --scenarios FILE [--jobs 2] [--out DIR] [--strategy S]
+"""
+
+import argparse
+import concurrent.futures
+import csv
+import json
+import math
+import os
+import random
+import subprocess
+import sys
+import threading
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TRAJECTORIES = ["spiral", "figure8", "lawnmower", "helix", "hover", "walk"]
+LAYOUTS = ["paper", "walls", "one-wall", "ceiling", "random"]
+IMU_GRADES = ["consumer", "fc", "tactical"]
+DIVERGENCE_M = 1.0      # max position error after SKIP_S that counts as diverged [m]
+SKIP_S = 10.0           # initial transient left out of the max error [s]
+SCENARIO_KEYS = {"name", "seed", "trajectory", "hall", "anchor_layout", "tags", "known", "unknown",
+                 "sigma_range", "outliers", "drop", "imu_grade", "duration", "bias_max"}
+
+
+def pick(rng, items):
+    """One of `items`, from one uniform draw (independent of the random module's choice())."""
+    return items[min(int(rng.random() * len(items)), len(items) - 1)]
+
+
+def uniform(rng, lo, hi, digits):
+    return round(lo + (hi - lo) * rng.random(), digits)
+
+
+def draw_scenarios(runs, seed, duration_s):
+    """`runs` scenarios drawn deterministically from `seed` over the sweep's space."""
+    rng = random.Random(seed)
+    out = []
+    for i in range(runs):
+        layout = pick(rng, LAYOUTS)
+        known = 3 + int(rng.random() * 3)
+        sc = {
+            "name": "run%03d" % (i + 1),
+            "seed": 1 + int(rng.random() * 1_000_000),
+            "trajectory": pick(rng, TRAJECTORIES),
+            "hall": [uniform(rng, 6.0, 12.0, 1), uniform(rng, 6.0, 12.0, 1), uniform(rng, 3.0, 8.0, 1)],
+            "anchor_layout": layout,
+            "tags": 1 + int(rng.random() * 3),
+            "known": known,
+            "unknown": min(int(rng.random() * 5), 9 - known),
+            "sigma_range": uniform(rng, 0.10, 0.20, 3),
+            "outliers": uniform(rng, 0.0, 0.15, 3),
+            "drop": uniform(rng, 0.0, 0.05, 3),
+            "imu_grade": pick(rng, IMU_GRADES),
+            "duration": duration_s,
+        }
+        out.append(sc)
+    return out
+
+
+def load_scenarios(path):
+    """Scenarios of a YAML file: `defaults: {...}` and `scenarios: [{name: ..., ...}, ...]`."""
+    import yaml
+    with open(path) as f:
+        doc = yaml.safe_load(f)
+    if not isinstance(doc, dict) or not isinstance(doc.get("scenarios"), list):
+        raise ValueError("%s: expected a mapping with a 'scenarios' list" % path)
+    defaults = doc.get("defaults") or {}
+    out = []
+    for k, entry in enumerate(doc["scenarios"]):
+        sc = dict(defaults)
+        sc.update(entry)
+        unknown = set(sc) - SCENARIO_KEYS
+        if unknown:
+            raise ValueError("%s: scenario %d: unknown keys %s" % (path, k + 1, sorted(unknown)))
+        if "name" not in sc:
+            raise ValueError("%s: scenario %d has no name" % (path, k + 1))
+        out.append(sc)
+    names = [s["name"] for s in out]
+    if len(set(names)) != len(names):
+        raise ValueError("%s: scenario names must be unique" % path)
+    return out
+
+
+def sim_args(sc):
+    """meshnav_sim options of a scenario."""
+    flags = [("seed", "seed"), ("trajectory", "trajectory"), ("anchor_layout", "anchor-layout"), ("tags", "tags"),
+             ("known", "known"), ("unknown", "unknown"), ("sigma_range", "sigma-range"), ("outliers", "outliers"),
+             ("drop", "drop"), ("imu_grade", "imu-grade"), ("duration", "duration"), ("bias_max", "bias-max")]
+    args = []
+    for key, flag in flags:
+        if key in sc and sc[key] is not None:
+            args += ["--" + flag, str(sc[key])]
+    if sc.get("hall"):
+        args += ["--hall", ",".join(str(v) for v in sc["hall"])]
+    return args
+
+
+def read_errors(path):
+    """(t, position error norm) of every evaluated sample of meshnav_eval's errors.csv."""
+    rows = []
+    with open(path) as f:
+        for r in csv.DictReader(f):
+            rows.append((float(r["t"]), float(r["ep_norm_m"])))
+    return rows
+
+
+def read_recoveries(path):
+    """The `recovery` counter of status.txt (counters: block), 0 when absent."""
+    if not os.path.exists(path):
+        return 0
+    in_counters = False
+    with open(path) as f:
+        for line in f:
+            if line.startswith("counters:"):
+                in_counters = True
+                continue
+            if in_counters and not line.startswith("  "):
+                in_counters = False
+            if in_counters and line.strip().startswith("recovery:"):
+                return int(float(line.split(":", 1)[1]))
+    return 0
+
+
+def metrics_of(metrics_json, errors_csv, status_txt):
+    """The sweep's figures of one evaluated run; raises when the run has no pose metrics."""
+    with open(metrics_json) as f:
+        m = json.load(f)
+    pose = m.get("pose")
+    if not pose:
+        raise RuntimeError("meshnav_eval found no pose estimates to evaluate")
+    errors = read_errors(errors_csv)
+    t0 = errors[0][0] if errors else 0.0
+    late = [e for t, e in errors if t - t0 >= SKIP_S]
+    max_late = max(late) if late else float("nan")
+    return {
+        "pos_rmse_m": pose["position"]["rmse_m"],
+        "max_err_after_10s_m": max_late,
+        "ori_rmse_deg": pose["orientation"]["rmse_deg"],
+        "pos_anees": pose["position"].get("anees", float("nan")),
+        "diverged": not (max_late <= DIVERGENCE_M),
+        "recoveries": read_recoveries(status_txt),
+        "errors": late,
+    }
+
+
+def run_command(cmd, log_path):
+    with open(log_path, "w") as log:
+        log.write("$ " + " ".join(cmd) + "\n")
+        log.flush()
+        return subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT)
+
+
+def run_scenario(sc, out_root, bin_dir, strategy):
+    """Simulate, run, evaluate one scenario; returns a result dict (never raises)."""
+    base = os.path.join(out_root, sc["name"])
+    dataset, run = os.path.join(base, "dataset"), os.path.join(base, "run")
+    os.makedirs(base, exist_ok=True)
+    start = time.time()
+    result = {"scenario": sc, "ok": False, "error": "", "wall_s": 0.0}
+    steps = [
+        ("meshnav_sim", [os.path.join(bin_dir, "meshnav_sim"), "--out", dataset] + sim_args(sc)),
+        ("meshnav_run", [os.path.join(bin_dir, "meshnav_run"), "--dataset", dataset, "--out", run, "--no-calibration"]
+         + (["--strategy", strategy] if strategy else [])),
+        ("meshnav_eval", [os.path.join(bin_dir, "meshnav_eval"), "--dataset", dataset, "--run", run, "--no-plots",
+                          "--json", os.path.join(run, "metrics.json")]),
+    ]
+    for name, cmd in steps:
+        rc = run_command(cmd, os.path.join(base, name + ".log"))
+        if rc != 0:
+            result["error"] = "%s exited %d (see %s)" % (name, rc, os.path.join(base, name + ".log"))
+            break
+    else:
+        try:
+            result.update(metrics_of(os.path.join(run, "metrics.json"), os.path.join(run, "errors.csv"),
+                                     os.path.join(run, "status.txt")))
+            result["ok"] = True
+        except (OSError, ValueError, KeyError, RuntimeError) as e:
+            result["error"] = "evaluation: %s" % e
+    result["wall_s"] = time.time() - start
+    return result
+
+
+def hall_text(sc):
+    return "x".join("%g" % v for v in sc["hall"]) if sc.get("hall") else "paper"
+
+
+def fmt(v, digits):
+    return "nan" if v is None or (isinstance(v, float) and math.isnan(v)) else ("%.*f" % (digits, v))
+
+
+COLUMNS = ["name", "trajectory", "hall_m", "layout", "tags", "known", "unknown", "sigma_m", "outliers", "drop",
+           "imu", "pos_rmse_m", "max_err_10s_m", "ori_rmse_deg", "pos_anees", "diverged", "recoveries", "status"]
+
+
+def row_of(r):
+    sc = r["scenario"]
+    ok = r["ok"]
+    return [sc["name"], sc.get("trajectory", "spiral"), hall_text(sc), sc.get("anchor_layout", "paper"),
+            str(sc.get("tags", 2)), str(sc.get("known", 4)), str(sc.get("unknown", 5)),
+            fmt(sc.get("sigma_range", 0.1), 3), fmt(sc.get("outliers", 0.05), 3), fmt(sc.get("drop", 0.02), 3),
+            sc.get("imu_grade", "fc"),
+            fmt(r["pos_rmse_m"], 3) if ok else "-", fmt(r["max_err_after_10s_m"], 3) if ok else "-",
+            fmt(r["ori_rmse_deg"], 2) if ok else "-", fmt(r["pos_anees"], 1) if ok else "-",
+            ("yes" if r["diverged"] else "no") if ok else "-", str(r["recoveries"]) if ok else "-",
+            "ok" if ok else "FAILED: " + r["error"]]
+
+
+def print_table(results):
+    rows = [COLUMNS] + [row_of(r) for r in results]
+    widths = [max(len(row[i]) for row in rows) for i in range(len(COLUMNS))]
+    text_columns = {0, 1, 2, 3, 10, len(COLUMNS) - 1}  # left-aligned; numbers right-aligned
+    for k, row in enumerate(rows):
+        cells = [c.ljust(w) if i in text_columns else c.rjust(w) for i, (c, w) in enumerate(zip(row, widths))]
+        print("  ".join(cells).rstrip())
+        if k == 0:
+            print("  ".join("-" * w for w in widths))
+
+
+def write_csv(results, path):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(COLUMNS + ["seed", "duration_s", "wall_s"])
+        for r in results:
+            sc = r["scenario"]
+            w.writerow(row_of(r) + [sc.get("seed", 1), sc.get("duration", ""), "%.1f" % r["wall_s"]])
+
+
+def write_cdf_png(results, path):
+    """CDF of the position error norm after the first 10 s: one thin line per run, all runs pooled bold."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("robustness: matplotlib is missing, %s not written" % path, file=sys.stderr)
+        return False
+    fig, ax = plt.subplots(figsize=(8, 5))
+    pooled = []
+    for r in results:
+        if not r["ok"] or not r["errors"]:
+            continue
+        e = sorted(r["errors"])
+        pooled += e
+        ax.plot(e, [(i + 1) / len(e) for i in range(len(e))], lw=0.8, alpha=0.6,
+                label="%s (%s)" % (r["scenario"]["name"], r["scenario"].get("trajectory", "spiral")))
+    if pooled:
+        pooled.sort()
+        ax.plot(pooled, [(i + 1) / len(pooled) for i in range(len(pooled))], "k", lw=2.2, label="all runs")
+    ax.axvline(DIVERGENCE_M, color="r", ls="--", lw=1, label="divergence threshold %.0f m" % DIVERGENCE_M)
+    ax.set_xscale("log")
+    ax.set_xlabel("position error after the first %.0f s [m]" % SKIP_S)
+    ax.set_ylabel("fraction of samples")
+    ax.set_title("meshnav robustness sweep: position error CDF")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2, loc="lower right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(prog="meshnav robustness", description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--runs", type=int, help="number of random scenarios (with --seed)")
+    p.add_argument("--seed", type=int, default=1, help="seed of the scenario draw (default 1)")
+    p.add_argument("--scenarios", help="YAML file with a fixed list of scenarios (instead of --runs)")
+    p.add_argument("--jobs", type=int, default=2, help="runs in parallel (default 2)")
+    p.add_argument("--out", default=os.path.join(ROOT, "out", "robustness"), help="output folder (default out/robustness)")
+    p.add_argument("--strategy", choices=["centralized", "dp", "dah"], help="meshnav_run --strategy (default: its own)")
+    p.add_argument("--duration", type=float, default=90.0, help="sequence length of drawn scenarios [s] (default 90)")
+    p.add_argument("--bin", default=os.path.join(os.environ.get("MESHNAV_BUILD_DIR", os.path.join(ROOT, "build")), "bin"),
+                   help="folder of meshnav_sim, meshnav_run, meshnav_eval (default build/bin)")
+    p.add_argument("--list", action="store_true", help="print the scenarios as YAML and exit")
+    a = p.parse_args(argv)
+    if (a.runs is None) == (a.scenarios is None):
+        p.error("give either --runs N (with --seed S) or --scenarios FILE")
+    if a.runs is not None and a.runs < 1:
+        p.error("--runs must be >= 1")
+    if a.jobs < 1:
+        p.error("--jobs must be >= 1")
+    return a
+
+
+def main(argv):
+    a = parse_args(argv)
+    try:
+        scenarios = load_scenarios(a.scenarios) if a.scenarios else draw_scenarios(a.runs, a.seed, a.duration)
+    except (OSError, ValueError) as e:
+        print("robustness: %s" % e, file=sys.stderr)
+        return 2
+    if a.list:
+        import yaml
+        print(yaml.safe_dump({"scenarios": scenarios}, sort_keys=False, default_flow_style=None), end="")
+        return 0
+    for b in ("meshnav_sim", "meshnav_run", "meshnav_eval"):
+        if not os.access(os.path.join(a.bin, b), os.X_OK):
+            print("robustness: %s is missing (build first: ./meshnav build)" % os.path.join(a.bin, b), file=sys.stderr)
+            return 2
+    os.makedirs(a.out, exist_ok=True)
+    print("robustness: %d scenarios, %d in parallel, results in %s" % (len(scenarios), a.jobs, a.out), flush=True)
+    results, lock = [None] * len(scenarios), threading.Lock()
+    with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
+        futures = {pool.submit(run_scenario, sc, a.out, a.bin, a.strategy): i for i, sc in enumerate(scenarios)}
+        for done, fut in enumerate(concurrent.futures.as_completed(futures), 1):
+            i = futures[fut]
+            r = results[i] = fut.result()
+            with lock:
+                state = (("DIVERGED" if r["diverged"] else "ok") if r["ok"] else "FAILED: " + r["error"])
+                figures = ("rmse %.3f m, max after 10 s %.3f m, " % (r["pos_rmse_m"], r["max_err_after_10s_m"])
+                           if r["ok"] else "")
+                print("[%d/%d] %s (%s): %s%s, %.0f s" % (done, len(scenarios), r["scenario"]["name"],
+                      r["scenario"].get("trajectory", "spiral"), figures, state, r["wall_s"]), flush=True)
+    print()
+    print_table(results)
+    write_csv(results, os.path.join(a.out, "robustness.csv"))
+    png = os.path.join(a.out, "error_cdf.png")
+    wrote_png = write_cdf_png(results, png)
+    n_failed = sum(not r["ok"] for r in results)
+    n_div = sum(r["ok"] and r["diverged"] for r in results)
+    print("\n%d runs: %d diverged (max position error after %.0f s > %.0f m), %d failed; wrote %s%s"
+          % (len(results), n_div, SKIP_S, DIVERGENCE_M, n_failed, os.path.join(a.out, "robustness.csv"),
+             " and " + png if wrote_png else ""))
+    return 1 if (n_div or n_failed) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

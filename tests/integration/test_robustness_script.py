@@ -1,0 +1,104 @@
+"""Unit tests of scripts/robustness.py (no binaries needed): the scenario draw, the fixed list,
+the meshnav_sim arguments, the metrics of one run, and usage errors."""
+
+import os
+import sys
+import tempfile
+import unittest
+
+ROOT = os.environ.get("MESHNAV_SOURCE_DIR", os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+import robustness  # noqa: E402
+
+
+class DrawTest(unittest.TestCase):
+    def test_same_seed_same_scenarios_other_seed_other_scenarios(self):
+        a, b, c = robustness.draw_scenarios(20, 7, 60), robustness.draw_scenarios(20, 7, 60), robustness.draw_scenarios(20, 8, 60)
+        self.assertEqual(a, b)
+        self.assertNotEqual(a, c)
+        self.assertEqual(robustness.draw_scenarios(5, 7, 60), a[:5])  # a prefix does not depend on N
+
+    def test_draws_stay_in_the_sweep_space(self):
+        scs = robustness.draw_scenarios(300, 3, 75)
+        for sc in scs:
+            self.assertIn(sc["trajectory"], robustness.TRAJECTORIES)
+            self.assertIn(sc["anchor_layout"], robustness.LAYOUTS)
+            self.assertIn(sc["imu_grade"], robustness.IMU_GRADES)
+            self.assertTrue(6.0 <= sc["hall"][0] <= 12.0 and 6.0 <= sc["hall"][1] <= 12.0 and 3.0 <= sc["hall"][2] <= 8.0)
+            self.assertTrue(1 <= sc["tags"] <= 3 and 3 <= sc["known"] <= 5 and sc["known"] + sc["unknown"] <= 9)
+            self.assertTrue(0.10 <= sc["sigma_range"] <= 0.20 and 0.0 <= sc["outliers"] <= 0.15 and 0.0 <= sc["drop"] <= 0.05)
+            self.assertEqual(sc["duration"], 75)
+        # Every value of every choice occurs.
+        for key, values in (("trajectory", robustness.TRAJECTORIES), ("anchor_layout", robustness.LAYOUTS),
+                            ("tags", [1, 2, 3]), ("known", [3, 4, 5])):
+            self.assertEqual({sc[key] for sc in scs}, set(values), key)
+
+
+class FixedListTest(unittest.TestCase):
+    def test_fixed12_covers_every_kind_layout_and_tag_count_with_outliers(self):
+        scs = robustness.load_scenarios(os.path.join(ROOT, "config", "robustness", "fixed12.yaml"))
+        self.assertEqual(len(scs), 12)
+        self.assertEqual({s["trajectory"] for s in scs}, set(robustness.TRAJECTORIES))
+        self.assertEqual({s["anchor_layout"] for s in scs}, set(robustness.LAYOUTS))
+        self.assertEqual({s["tags"] for s in scs}, {1, 2, 3})
+        self.assertTrue(all(s["outliers"] > 0 for s in scs))
+        self.assertTrue(all(60 <= s["duration"] <= 90 for s in scs))
+
+    def test_unknown_keys_and_duplicate_names_are_rejected(self):
+        with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as f:
+            f.write("scenarios:\n  - {name: a, trajectroy: walk}\n")
+        with self.assertRaisesRegex(ValueError, "trajectroy"):
+            robustness.load_scenarios(f.name)
+        with open(f.name, "w") as g:
+            g.write("scenarios:\n  - {name: a}\n  - {name: a}\n")
+        with self.assertRaisesRegex(ValueError, "unique"):
+            robustness.load_scenarios(f.name)
+        os.unlink(f.name)
+
+    def test_sim_arguments(self):
+        args = robustness.sim_args({"name": "x", "seed": 4, "trajectory": "walk", "hall": [10, 8, 3], "outliers": 0.1,
+                                    "anchor_layout": "one-wall", "imu_grade": "consumer"})
+        self.assertEqual(args, ["--seed", "4", "--trajectory", "walk", "--anchor-layout", "one-wall", "--outliers", "0.1",
+                                "--imu-grade", "consumer", "--hall", "10,8,3"])
+
+
+class MetricsTest(unittest.TestCase):
+    def write(self, d, name, text):
+        p = os.path.join(d, name)
+        with open(p, "w") as f:
+            f.write(text)
+        return p
+
+    def test_divergence_counts_only_after_the_first_ten_seconds(self):
+        with tempfile.TemporaryDirectory() as d:
+            m = self.write(d, "m.json", '{"pose": {"position": {"rmse_m": 0.5, "anees": 3.1}, "orientation": {"rmse_deg": 2.0}}}')
+            status = self.write(d, "status.txt", "strategy: dp\ncounters:\n  gated_range: 3\n  recovery: 2\nmean_step_us:\n  x: 1\n")
+            early_big = self.write(d, "e1.csv", "t,ep_norm_m\n5.0,0.1\n9.0,3.0\n15.0,0.9\n40.0,0.2\n")
+            r = robustness.metrics_of(m, early_big, status)
+            self.assertFalse(r["diverged"])
+            self.assertAlmostEqual(r["max_err_after_10s_m"], 0.9)
+            self.assertEqual(r["recoveries"], 2)
+            self.assertEqual(r["pos_rmse_m"], 0.5)
+            late_big = self.write(d, "e2.csv", "t,ep_norm_m\n5.0,0.1\n15.0,1.01\n")
+            self.assertTrue(robustness.metrics_of(m, late_big, os.path.join(d, "missing.txt"))["diverged"])
+            self.assertEqual(robustness.read_recoveries(os.path.join(d, "missing.txt")), 0)
+            nan = self.write(d, "e3.csv", "t,ep_norm_m\n5.0,0.1\n15.0,nan\n")
+            self.assertTrue(robustness.metrics_of(m, nan, status)["diverged"])  # a NaN estimate is not converged
+            empty_pose = self.write(d, "n.json", '{"pose": null}')
+            with self.assertRaises(RuntimeError):
+                robustness.metrics_of(empty_pose, early_big, status)
+
+
+class UsageTest(unittest.TestCase):
+    def test_usage_errors_and_missing_binaries(self):
+        with self.assertRaises(SystemExit) as e:
+            robustness.main([])
+        self.assertEqual(e.exception.code, 2)
+        with self.assertRaises(SystemExit):
+            robustness.main(["--runs", "2", "--scenarios", "x.yaml"])
+        with tempfile.TemporaryDirectory() as d:
+            self.assertEqual(robustness.main(["--runs", "1", "--bin", d, "--out", d]), 2)
+
+
+if __name__ == "__main__":
+    unittest.main()
