@@ -1,7 +1,8 @@
 #pragma once
 /// @file dataset.h
 /// @brief The dataset folder of DESIGN §6: imu.csv, baro.csv, ranges.csv, flight_state.csv,
-/// groundtruth.csv, setup.yaml, truth.yaml. Readers validate every row: bad rows are reported
+/// groundtruth.csv, setup.yaml, truth.yaml, and the optional height.csv (`t,range_m`, downward
+/// laser range [m], written by the MILUV importer). Readers validate every row: bad rows are reported
 /// (file:line), counted in `Diagnostics`, and dropped; they never reach an estimator.
 
 #include <optional>
@@ -19,6 +20,7 @@ struct Dataset {
   std::vector<BaroSample> baro;
   std::vector<RangeSample> ranges;
   std::vector<FlightStateSample> flight_states;
+  std::vector<HeightSample> heights;  ///< optional height.csv
   std::vector<PoseSample> ground_truth;
   SystemSetup setup;
   std::optional<Truth> truth;
@@ -38,6 +40,8 @@ std::vector<BaroSample> readBaroCsv(const std::string& path, Diagnostics& diag);
 std::vector<RangeSample> readRangesCsv(const std::string& path, Diagnostics& diag,
                                        const RangeLimits& limits = {});
 std::vector<FlightStateSample> readFlightStateCsv(const std::string& path, Diagnostics& diag);
+/// `t,range_m`; a range that is not finite, negative or beyond 100 m is reported and dropped.
+std::vector<HeightSample> readHeightCsv(const std::string& path, Diagnostics& diag);
 /// TUM format `#t,tx,ty,tz,qx,qy,qz,qw` (comma or space separated).
 std::vector<PoseSample> readTumCsv(const std::string& path, Diagnostics& diag);
 
@@ -45,6 +49,7 @@ void writeImuCsv(const std::vector<ImuSample>& v, const std::string& path);
 void writeBaroCsv(const std::vector<BaroSample>& v, const std::string& path);
 void writeRangesCsv(const std::vector<RangeSample>& v, const std::string& path);
 void writeFlightStateCsv(const std::vector<FlightStateSample>& v, const std::string& path);
+void writeHeightCsv(const std::vector<HeightSample>& v, const std::string& path);
 void writeTumCsv(const std::vector<PoseSample>& v, const std::string& path);
 
 /// Reads a whole dataset folder. setup.yaml is required; the sensor files are optional except

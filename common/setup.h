@@ -54,6 +54,10 @@ struct Truth {
   std::map<SensorId, Eigen::Vector3d> anchor_positions;  ///< all anchors [m]
   std::vector<PairBias> pair_biases;                      ///< true γ, β for every pair
   std::map<std::string, double> scalars;                  ///< anything else simulated (seed, σ_d, ...)
+  /// Frame of groundtruth.csv (key `truth_frame`); empty: the world frame G of the anchors.
+  std::string truth_frame;
+  /// True when groundtruth.csv is not in G (key `align_required`): evaluation aligns (se3).
+  bool align_required = false;
 };
 
 /// Load `setup.yaml`. Throws std::runtime_error naming the file and the key on a malformed file.

@@ -51,6 +51,13 @@ struct RangeSample {
   bool los = true;                      ///< line of sight flag (carries no information in real data)
 };
 
+/// Downward laser rangefinder reading (dataset file height.csv): distance along the sensor's
+/// beam to the floor, roughly the height above the floor when level.
+struct HeightSample {
+  Timestamp t;
+  double range_m = 0.0;  ///< measured distance [m]
+};
+
 /// Landed / flying state from the flight controller.
 struct FlightStateSample {
   Timestamp t;

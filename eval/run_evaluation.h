@@ -10,6 +10,7 @@
 
 #include "common/diagnostics.h"
 #include "eval/anchor_metrics.h"
+#include "eval/baseline_evaluation.h"
 #include "eval/trajectory_metrics.h"
 
 namespace meshnav::eval {
@@ -24,6 +25,10 @@ struct RunEvaluation {
   std::vector<std::string> notes;  ///< human-readable reasons for missing parts
   std::vector<PoseSample> ground_truth;
   std::vector<PoseEstimate> estimates;
+  AlignmentMode alignment = AlignmentMode::None;  ///< applied to the estimate (and the baseline)
+  std::string alignment_reason;                   ///< why this mode ("--align", truth.yaml, ...)
+  std::optional<RigidTransform> alignment_transform;  ///< estimate frame → truth frame, when fitted
+  std::optional<BaselineEvaluation> baseline;     ///< multilateration on the same ranges.csv
   std::vector<PoseError> errors;   ///< every associated estimate (selection flags via isSelected)
   TrajectoryMetrics trajectory;
   std::optional<AnchorMetrics> anchors;  ///< nullopt without anchors.csv or truth.yaml

@@ -23,6 +23,7 @@
 #include "common/types.h"
 #include "eval/chi_square.h"
 #include "eval/pose_error.h"
+#include "eval/trajectory_alignment.h"
 
 namespace meshnav::eval {
 
@@ -32,6 +33,11 @@ struct EvalOptions {
   bool only_flying = false;      ///< ignore estimates while landed (needs flight_state.csv)
   double max_gt_gap_s = 0.2;     ///< ground-truth samples further apart cannot be interpolated [s]
   double confidence = 0.95;      ///< of the ANEES acceptance interval
+  /// Alignment of the estimate to the truth (--align); nullopt: se3 when truth.yaml says
+  /// align_required, else none.
+  std::optional<AlignmentMode> align;
+  bool baseline = true;            ///< also evaluate the multilateration baseline
+  double baseline_window_s = 0.03;  ///< its epoch length [s]: one RTLS message of ISAS-Walk1 (51 ms apart)
 };
 
 /// Associates estimates with interpolated ground truth. `flight_states` may be empty (then every

@@ -67,6 +67,31 @@ std::ofstream openOut(const std::string& path) {
   return out;
 }
 
+/// Files `t,<column>` of one number per row; values outside [lo, hi] (or not finite) are reported
+/// as "<file>:bad_value" and dropped. T is a {Timestamp, double} sample.
+template <typename T>
+std::vector<T> readTimeValueCsv(const std::string& path, const char* column, double lo, double hi,
+                                const char* expected, Diagnostics& diag) {
+  CsvReader reader(path, {"t", column});
+  const std::string key = baseName(path);
+  std::vector<T> out;
+  reader.forEach(
+      [&](const CsvRow& r) {
+        auto t = rowTime(r, key, diag);
+        if (!t) return;
+        auto v = r.number(column);
+        if (!v || *v < lo || *v > hi) {
+          diag.report(key + ":bad_value", r.where() + ": " + column + " '" + r.text(column) + "' is not " + expected +
+                                              "; row skipped");
+          return;
+        }
+        out.push_back({*t, *v});
+      },
+      diag);
+  checkOrder(out, path, diag);
+  return out;
+}
+
 }  // namespace
 
 std::vector<ImuSample> readImuCsv(const std::string& path, Diagnostics& diag) {
@@ -101,24 +126,7 @@ std::vector<ImuSample> readImuCsv(const std::string& path, Diagnostics& diag) {
 }
 
 std::vector<BaroSample> readBaroCsv(const std::string& path, Diagnostics& diag) {
-  CsvReader reader(path, {"t", "pressure"});
-  const std::string key = baseName(path);
-  std::vector<BaroSample> out;
-  reader.forEach(
-      [&](const CsvRow& r) {
-        auto t = rowTime(r, key, diag);
-        if (!t) return;
-        auto p = r.number("pressure");
-        if (!p || *p < 1000.0 || *p > 200000.0) {
-          diag.report(key + ":bad_value", r.where() + ": pressure '" + r.text("pressure") +
-                                              "' is not a plausible pressure in Pa; row skipped");
-          return;
-        }
-        out.push_back({*t, *p});
-      },
-      diag);
-  checkOrder(out, path, diag);
-  return out;
+  return readTimeValueCsv<BaroSample>(path, "pressure", 1000.0, 200000.0, "a plausible pressure in Pa", diag);
 }
 
 std::vector<RangeSample> readRangesCsv(const std::string& path, Diagnostics& diag, const RangeLimits& limits) {
@@ -208,6 +216,10 @@ std::vector<FlightStateSample> readFlightStateCsv(const std::string& path, Diagn
   return out;
 }
 
+std::vector<HeightSample> readHeightCsv(const std::string& path, Diagnostics& diag) {
+  return readTimeValueCsv<HeightSample>(path, "range_m", 0.0, 100.0, "a height in [0, 100] m", diag);
+}
+
 std::vector<PoseSample> readTumCsv(const std::string& path, Diagnostics& diag) {
   const std::vector<std::string> cols = {"t", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
   CsvReader reader(path, cols);
@@ -279,6 +291,16 @@ void writeFlightStateCsv(const std::vector<FlightStateSample>& v, const std::str
   for (const auto& s : v) out << formatSeconds(s.t) << "," << (s.landed ? 1 : 0) << "\n";
 }
 
+void writeHeightCsv(const std::vector<HeightSample>& v, const std::string& path) {
+  auto out = openOut(path);
+  out << "t,range_m\n";
+  char buf[96];
+  for (const auto& s : v) {
+    std::snprintf(buf, sizeof(buf), "%s,%.9g\n", formatSeconds(s.t).c_str(), s.range_m);
+    out << buf;
+  }
+}
+
 void writeTumCsv(const std::vector<PoseSample>& v, const std::string& path) {
   auto out = openOut(path);
   out << "#t,tx,ty,tz,qx,qy,qz,qw\n";
@@ -301,6 +323,7 @@ Dataset readDataset(const std::string& dir, Diagnostics& diag, bool with_truth) 
   if (auto p = opt("ranges.csv")) ds.ranges = readRangesCsv(*p, diag);
   else throw std::runtime_error((d / "ranges.csv").string() + ": missing (a dataset needs ranges)");
   if (auto p = opt("flight_state.csv")) ds.flight_states = readFlightStateCsv(*p, diag);
+  if (auto p = opt("height.csv")) ds.heights = readHeightCsv(*p, diag);
   if (auto p = opt("groundtruth.csv")) ds.ground_truth = readTumCsv(*p, diag);
   if (with_truth) {
     if (auto p = opt("truth.yaml")) ds.truth = loadTruth(*p);
@@ -316,6 +339,7 @@ void writeDataset(const Dataset& ds, const std::string& dir) {
   if (!ds.baro.empty()) writeBaroCsv(ds.baro, (d / "baro.csv").string());
   writeRangesCsv(ds.ranges, (d / "ranges.csv").string());
   if (!ds.flight_states.empty()) writeFlightStateCsv(ds.flight_states, (d / "flight_state.csv").string());
+  if (!ds.heights.empty()) writeHeightCsv(ds.heights, (d / "height.csv").string());
   if (!ds.ground_truth.empty()) writeTumCsv(ds.ground_truth, (d / "groundtruth.csv").string());
   saveSetup(ds.setup, (d / "setup.yaml").string());
   if (ds.truth) saveTruth(*ds.truth, (d / "truth.yaml").string());

@@ -254,6 +254,17 @@ Truth loadTruth(const std::string& path) {
   if (const auto sc = root["scalars"]; sc && sc.IsMap()) {
     for (const auto& kv : sc) t.scalars[kv.first.as<std::string>()] = num(kv.second, path, "scalars." + kv.first.as<std::string>());
   }
+  if (const auto f = root["truth_frame"]; f && !f.IsNull()) {
+    if (!f.IsScalar()) fail(path, "key 'truth_frame' must be a frame name");
+    t.truth_frame = f.Scalar();
+  }
+  if (const auto a = root["align_required"]; a && !a.IsNull()) {
+    try {
+      t.align_required = a.as<bool>();
+    } catch (const YAML::Exception&) {
+      fail(path, "key 'align_required' must be true or false, got '" + (a.IsScalar() ? a.Scalar() : "?") + "'");
+    }
+  }
   return t;
 }
 
@@ -272,6 +283,8 @@ void saveTruth(const Truth& t, const std::string& path) {
   e << YAML::Key << "scalars" << YAML::Value << YAML::BeginMap;
   for (const auto& [k, v] : t.scalars) e << YAML::Key << k << YAML::Value << v;
   e << YAML::EndMap;
+  if (!t.truth_frame.empty()) e << YAML::Key << "truth_frame" << YAML::Value << t.truth_frame;
+  if (t.align_required) e << YAML::Key << "align_required" << YAML::Value << true;
   e << YAML::EndMap;
   writeText(path, "# meshnav simulated truth: evaluation only, never read by estimator or calibrator\n", e.c_str());
 }

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <stdexcept>
 
 #include "common/cli.h"
 #include "eval/plotting.h"
@@ -23,7 +24,9 @@ namespace {
 const char* kUsage = R"(meshnav_eval — metrics of a run against ground truth, and plots.
 
 Single run:
-  meshnav_eval --dataset DIR --run DIR [--out DIR] [--no-plots] [--json FILE]
+  meshnav_eval --dataset DIR --run DIR [--out DIR] [--no-plots] [--json FILE] [--align none|se3|yaw]
+Multilateration baseline only (no run):
+  meshnav_eval --dataset DIR [--align none|se3|yaw] [--out DIR]
 Many runs (paper-style table):
   meshnav_eval --batch ROOT [--table-md FILE] [--dataset-subdir NAME] [--run-subdir NAME] [--plots]
 
@@ -36,6 +39,14 @@ Options:
   --skip S              ignore the first S seconds after the first estimate [s] (default 0)
   --only-flying         evaluate only while not landed (flight_state.csv); default: all samples
   --max-gt-gap S        largest ground-truth gap that is interpolated [s] (default 0.2)
+  --align MODE          none | se3 | yaw: align the estimate (and the baseline, each with its own
+                        fit) to the ground truth before the errors are taken: se3 = rotation +
+                        translation (Umeyama, no scale), yaw = rotation about z + translation.
+                        Default: se3 when truth.yaml says align_required (truth in another frame,
+                        e.g. imported real recordings), else none. The table states the mode used.
+  --no-baseline         do not run the multilateration baseline on the dataset's ranges.csv
+  --baseline-window S   epoch length of the multilateration baseline [s] (default 0.03: shorter than
+                        the 51 ms between two RTLS messages of ISAS-Walk1, so one message = one epoch)
   --calibration FILE    calibration result YAML giving the initial anchor beliefs
                         (default: RUN/calibration.yaml if present, else first anchors.csv row)
   --batch ROOT          evaluate every ROOT/<name>/ holding <dataset-subdir>/ and <run-subdir>/
@@ -55,6 +66,13 @@ EvalOptions optionsFrom(const Cli& cli) {
   o.skip_first_s = cli.getDouble("skip", 0.0);
   o.only_flying = cli.has("only-flying");
   o.max_gt_gap_s = cli.getDouble("max-gt-gap", 0.2);
+  o.baseline = !cli.has("no-baseline");
+  o.baseline_window_s = cli.getDouble("baseline-window", 0.03);
+  if (cli.has("align")) {
+    o.align = parseAlignmentMode(cli.get("align"));
+    if (!o.align) throw std::invalid_argument("--align '" + cli.get("align") + "': expected none, se3 or yaw");
+  }
+  if (!(o.baseline_window_s > 0.0)) throw std::invalid_argument("--baseline-window must be > 0 [s]");
   return o;
 }
 
@@ -74,18 +92,41 @@ void writeOutputs(const RunEvaluation& ev, const fs::path& out, bool plots, cons
   if (runPlotScript("plot_run.py", args)) spdlog::info("plots written to {}", out.string());
 }
 
+/// No --run: the multilateration baseline of the dataset alone (metrics.yaml only with --out).
+int runBaselineOnly(const std::string& dataset, const EvalOptions& options, const Cli& cli) {
+  if (!fs::is_directory(dataset)) {
+    spdlog::error("{} is not a directory", dataset);
+    return 1;
+  }
+  const RunEvaluation ev = evaluateRun(dataset, "", options);
+  std::cout << formatRunReport(ev) << std::flush;
+  if (cli.has("out")) {
+    fs::create_directories(cli.get("out"));
+    writeMetricsYaml(ev, (fs::path(cli.get("out")) / "metrics.yaml").string());
+  }
+  return ev.baseline && ev.baseline->trajectory.n_selected > 0 ? 0 : 1;
+}
+
 int runSingle(const Cli& cli) {
-  if (!cli.has("dataset") || !cli.has("run")) {
-    std::cerr << "meshnav_eval: --dataset and --run are required (or --batch ROOT)\n\n" << cli.usage();
+  if (!cli.has("dataset")) {
+    std::cerr << "meshnav_eval: --dataset is required (or --batch ROOT)\n\n" << cli.usage();
+    return 2;
+  }
+  EvalOptions options;
+  try {
+    options = optionsFrom(cli);
+  } catch (const std::invalid_argument& ex) {
+    std::cerr << "meshnav_eval: " << ex.what() << "\n\n" << cli.usage();
     return 2;
   }
   const std::string dataset = cli.get("dataset"), run = cli.get("run");
+  if (run.empty()) return runBaselineOnly(dataset, options, cli);
   for (const auto& d : {dataset, run})
     if (!fs::is_directory(d)) {
       spdlog::error("{} is not a directory", d);
       return 1;
     }
-  RunEvaluation ev = evaluateRun(dataset, run, optionsFrom(cli), cli.get("calibration"));
+  RunEvaluation ev = evaluateRun(dataset, run, options, cli.get("calibration"));
   std::cout << formatRunReport(ev) << std::flush;
   const fs::path out = cli.has("out") ? fs::path(cli.get("out")) : fs::path(run);
   try {
@@ -116,7 +157,13 @@ int runBatch(const Cli& cli) {
     return 1;
   }
   std::vector<BatchEntry> entries;
-  const EvalOptions opt = optionsFrom(cli);
+  EvalOptions opt;
+  try {
+    opt = optionsFrom(cli);
+  } catch (const std::invalid_argument& ex) {
+    std::cerr << "meshnav_eval: " << ex.what() << "\n";
+    return 2;
+  }
   for (size_t i = 0; i < dirs.size(); ++i) {
     const auto& d = dirs[i];
     spdlog::info("[{}/{}] evaluating {}", i + 1, dirs.size(), d.filename().string());
@@ -155,9 +202,9 @@ int main(int argc, char** argv) {
   setupLogging("meshnav_eval");
   Cli cli("meshnav_eval", kUsage);
   for (const char* o : {"dataset", "run", "out", "json", "skip", "max-gt-gap", "calibration", "batch",
-                        "dataset-subdir", "run-subdir", "table-md"})
+                        "dataset-subdir", "run-subdir", "table-md", "align", "baseline-window"})
     cli.option(o, true);
-  for (const char* f : {"no-plots", "only-flying", "plots"}) cli.option(f, false);
+  for (const char* f : {"no-plots", "only-flying", "plots", "no-baseline"}) cli.option(f, false);
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   try {

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "eval/baseline_report.h"
 #include "eval/chi_square.h"
 
 namespace meshnav::eval {
@@ -185,7 +186,8 @@ std::string formatRunReport(const RunEvaluation& ev) {
      << " evaluated";
   if (m.n_selected > 0) os << " (t " << formatNumber(m.t_first_s, 2) << " – " << formatNumber(m.t_last_s, 2) << " s)";
   os << "; skip first " << formatNumber(ev.options.skip_first_s, 1) << " s; only flying: "
-     << (ev.options.only_flying && ev.has_flight_state ? "yes" : "no") << "\n\n";
+     << (ev.options.only_flying && ev.has_flight_state ? "yes" : "no") << "\n";
+  os << formatAlignmentAndBaseline(ev);
 
   if (m.n_selected > 0) {
     const std::string ci = formatNumber(100.0 * conf, 0) + " % bounds";
@@ -249,6 +251,7 @@ YAML::Node metricsNode(const RunEvaluation& ev) {
       "errors are truth minus estimate; orientation error dtheta = Log(R_est^T R_true) in the body frame; "
       "rmse = sqrt(mean(|e|^2)); armse = mean(|e|) (cnspy ARMSE); nees = e^T P^-1 e (3 dof); "
       "anees_bounds = two-sided chi2(3n)/n interval at the given confidence";
+  addAlignmentAndBaseline(root, ev);
   const auto& m = ev.trajectory;
   if (m.n_selected == 0) {
     root["pose"] = YAML::Node(YAML::NodeType::Null);

@@ -20,18 +20,8 @@ void note(RunEvaluation& ev, const std::string& msg) {
   ev.notes.push_back(msg);
 }
 
-}  // namespace
-
-RunEvaluation evaluateRun(const std::string& dataset_dir, const std::string& run_dir,
-                          const EvalOptions& options, const std::string& calibration_yaml) {
-  RunEvaluation ev;
-  Diagnostics diag;
-  ev.dataset_dir = dataset_dir;
-  ev.run_dir = run_dir;
-  ev.options = options;
-  const fs::path ds(dataset_dir), run(run_dir);
-
-  // Ground truth trajectory.
+/// groundtruth.csv of the dataset (at least 2 poses for pose metrics).
+void readGroundTruth(RunEvaluation& ev, const fs::path& ds, Diagnostics& diag) {
   const fs::path gt_path = ds / "groundtruth.csv";
   if (!fs::exists(gt_path)) {
     note(ev, "no ground truth: " + gt_path.string() + " does not exist; pose metrics skipped");
@@ -44,50 +34,48 @@ RunEvaluation evaluateRun(const std::string& dataset_dir, const std::string& run
       note(ev, std::string("cannot read ground truth: ") + ex.what());
     }
   }
+}
 
-  // Setup (known anchors) and truth.
-  std::map<SensorId, Eigen::Vector3d> known;
-  const fs::path setup_path = ds / "setup.yaml";
-  if (fs::exists(setup_path)) {
-    try {
-      // Exactly known anchors only: those given with a σ are estimated (refined online).
-      const SystemSetup setup = loadSetup(setup_path.string());
-      for (const auto& [id, p] : setup.abs_anchor_positions)
-        if (!setup.abs_anchor_sigmas_m.count(id)) known[id] = p;
-    } catch (const std::exception& ex) {
-      note(ev, std::string("cannot read setup: ") + ex.what() + " (anchors are not marked known)");
-    }
-  }
-  std::optional<Truth> truth;
-  const fs::path truth_path = ds / "truth.yaml";
-  if (!fs::exists(truth_path)) {
-    note(ev, "no truth: " + truth_path.string() + " does not exist; anchor errors skipped");
+/// The alignment of the estimate: --align if given, else se3 when truth.yaml says the ground truth
+/// is in another frame, else none.
+void chooseAlignment(RunEvaluation& ev, const std::optional<Truth>& truth) {
+  if (ev.options.align) {
+    ev.alignment = *ev.options.align;
+    ev.alignment_reason = "--align " + toString(ev.alignment);
+  } else if (truth && truth->align_required) {
+    ev.alignment = AlignmentMode::Se3;
+    ev.alignment_reason = "default: truth.yaml says groundtruth.csv is in frame '" + truth->truth_frame +
+                          "' (align_required), so the estimate is aligned (se3, Umeyama without scale)";
   } else {
-    try {
-      truth = loadTruth(truth_path.string());
-      ev.has_truth_yaml = true;
-    } catch (const std::exception& ex) {
-      note(ev, std::string("cannot read truth: ") + ex.what() + "; anchor errors skipped");
-    }
+    ev.alignment = AlignmentMode::None;
+    ev.alignment_reason = "default: ground truth in the estimate's frame (truth.yaml has no align_required)";
   }
+}
 
-  // Flight state (only needed for the flying selection; used for flags anyway).
-  std::vector<FlightStateSample> flight;
-  const fs::path fs_path = ds / "flight_state.csv";
-  if (fs::exists(fs_path)) {
-    try {
-      flight = readFlightStateCsv(fs_path.string(), diag);
-      ev.has_flight_state = !flight.empty();
-    } catch (const std::exception& ex) {
-      note(ev, std::string("cannot read flight state: ") + ex.what());
-    }
+/// Multilateration of the dataset's ranges with the same alignment and selection.
+void runBaseline(RunEvaluation& ev, const fs::path& ds, const std::optional<SystemSetup>& setup,
+                 const std::vector<FlightStateSample>& flight, Diagnostics& diag) {
+  if (!ev.options.baseline || !ev.has_ground_truth) return;
+  if (!setup) {
+    note(ev, "multilateration baseline skipped: no readable setup.yaml");
+    return;
   }
-  if (options.only_flying && !ev.has_flight_state)
-    note(ev, "--only-flying: no flight_state.csv in the dataset; evaluating all samples");
+  try {
+    Diagnostics range_diag;
+    const auto ranges = readRangesCsv((ds / "ranges.csv").string(), range_diag);
+    ev.baseline = evaluateBaseline(ranges, *setup, ev.ground_truth, flight, ev.alignment, ev.options, diag);
+    for (const auto& n : ev.baseline->notes) note(ev, n);
+  } catch (const std::exception& ex) {
+    note(ev, std::string("multilateration baseline skipped: ") + ex.what());
+  }
+}
 
-  // Estimates.
+/// Reads the run's estimate.csv, sorted by time (nothing when no run folder is given).
+void runEstimates(RunEvaluation& ev, const fs::path& run, Diagnostics& diag) {
   const fs::path est_path = run / "estimate.csv";
-  if (!fs::exists(est_path)) {
+  if (ev.run_dir.empty()) {
+    note(ev, "no run given: only the multilateration baseline is evaluated");
+  } else if (!fs::exists(est_path)) {
     note(ev, "no estimate: " + est_path.string() + " does not exist; pose metrics skipped");
   } else {
     try {
@@ -99,18 +87,12 @@ RunEvaluation evaluateRun(const std::string& dataset_dir, const std::string& run
       note(ev, std::string("cannot read estimates: ") + ex.what());
     }
   }
-  if (ev.has_ground_truth && !ev.estimates.empty()) {
-    ev.errors = associate(ev.estimates, ev.ground_truth, flight, options, diag);
-    if (ev.errors.empty())
-      note(ev, "no estimate lies within the ground-truth time span (check that both use dataset seconds)");
-  }
-  EvalOptions eff = options;
-  if (!ev.has_flight_state) eff.only_flying = false;
-  ev.trajectory = computeTrajectoryMetrics(ev.errors, eff);
-  if (eff.skip_first_s > 0.0 && ev.trajectory.n_selected == 0 && !ev.errors.empty())
-    note(ev, "--skip " + std::to_string(eff.skip_first_s) + " s leaves no sample");
+}
 
-  // Anchors.
+/// Anchor errors of the run's anchors.csv (and calibration results) against truth.yaml.
+void evaluateAnchors(RunEvaluation& ev, const fs::path& run, const std::string& calibration_yaml,
+                     const std::optional<Truth>& truth, const std::map<SensorId, Eigen::Vector3d>& known,
+                     Diagnostics& diag) {
   const fs::path anchors_path = run / "anchors.csv";
   std::map<SensorId, AnchorEstimate> initial;
   std::string calib = calibration_yaml;
@@ -136,6 +118,80 @@ RunEvaluation evaluateRun(const std::string& dataset_dir, const std::string& run
     }
     ev.anchors = computeAnchorMetrics(rows, truth->anchor_positions, known, initial, diag);
   }
+}
+
+}  // namespace
+
+RunEvaluation evaluateRun(const std::string& dataset_dir, const std::string& run_dir,
+                          const EvalOptions& options, const std::string& calibration_yaml) {
+  RunEvaluation ev;
+  Diagnostics diag;
+  ev.dataset_dir = dataset_dir;
+  ev.run_dir = run_dir;
+  ev.options = options;
+  const fs::path ds(dataset_dir), run(run_dir);
+
+  readGroundTruth(ev, ds, diag);
+
+  // Setup (known anchors) and truth.
+  std::map<SensorId, Eigen::Vector3d> known;
+  std::optional<SystemSetup> setup;
+  const fs::path setup_path = ds / "setup.yaml";
+  if (fs::exists(setup_path)) {
+    try {
+      // Exactly known anchors only: those given with a σ are estimated (refined online).
+      setup = loadSetup(setup_path.string());
+      for (const auto& [id, p] : setup->abs_anchor_positions)
+        if (!setup->abs_anchor_sigmas_m.count(id)) known[id] = p;
+    } catch (const std::exception& ex) {
+      note(ev, std::string("cannot read setup: ") + ex.what() + " (anchors are not marked known)");
+    }
+  }
+  std::optional<Truth> truth;
+  const fs::path truth_path = ds / "truth.yaml";
+  if (!fs::exists(truth_path)) {
+    note(ev, "no truth: " + truth_path.string() + " does not exist; anchor errors skipped");
+  } else {
+    try {
+      truth = loadTruth(truth_path.string());
+      ev.has_truth_yaml = true;
+    } catch (const std::exception& ex) {
+      note(ev, std::string("cannot read truth: ") + ex.what() + "; anchor errors skipped");
+    }
+  }
+  chooseAlignment(ev, truth);
+
+  // Flight state (only needed for the flying selection; used for flags anyway).
+  std::vector<FlightStateSample> flight;
+  const fs::path fs_path = ds / "flight_state.csv";
+  if (fs::exists(fs_path)) {
+    try {
+      flight = readFlightStateCsv(fs_path.string(), diag);
+      ev.has_flight_state = !flight.empty();
+    } catch (const std::exception& ex) {
+      note(ev, std::string("cannot read flight state: ") + ex.what());
+    }
+  }
+  if (options.only_flying && !ev.has_flight_state)
+    note(ev, "--only-flying: no flight_state.csv in the dataset; evaluating all samples");
+
+  runBaseline(ev, ds, setup, flight, diag);
+
+  runEstimates(ev, run, diag);
+  if (ev.has_ground_truth && !ev.estimates.empty()) {
+    ev.alignment_transform = alignToGroundTruth(ev.estimates, ev.ground_truth, ev.alignment, options.max_gt_gap_s);
+    if (!ev.alignment_transform) note(ev, "alignment " + toString(ev.alignment) + " could not be fitted; estimate not aligned");
+    ev.errors = associate(ev.estimates, ev.ground_truth, flight, options, diag);
+    if (ev.errors.empty())
+      note(ev, "no estimate lies within the ground-truth time span (check that both use dataset seconds)");
+  }
+  EvalOptions eff = options;
+  if (!ev.has_flight_state) eff.only_flying = false;
+  ev.trajectory = computeTrajectoryMetrics(ev.errors, eff);
+  if (eff.skip_first_s > 0.0 && ev.trajectory.n_selected == 0 && !ev.errors.empty())
+    note(ev, "--skip " + std::to_string(eff.skip_first_s) + " s leaves no sample");
+
+  if (!run_dir.empty()) evaluateAnchors(ev, run, calibration_yaml, truth, known, diag);
   ev.diagnostics = diag.snapshot();
   return ev;
 }

@@ -179,3 +179,26 @@ TEST(EstimateIo, RoundTripAndAutoDetection) {
   EXPECT_DOUBLE_EQ(a[0].cov_p_m2(1, 1), 0.09);
   EXPECT_EQ(diag.total(), 0);
 }
+
+TEST(Height, OptionalFileIsReadValidatedAndWrittenBack) {
+  auto d = test::tempDir("height");
+  test::writeFile(d / "setup.yaml", "imu_id: 1\n");
+  test::writeFile(d / "ranges.csv", "t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS\n");
+  Diagnostics diag;
+  EXPECT_TRUE(readDataset(d.string(), diag).heights.empty());  // optional: absent is fine
+  test::writeFile(d / "height.csv",
+                  "t,range_m\n0.103620767,0.29\n0.136620759,0.31\n0.2,nan\n0.3,-1\n0.4,250\n");
+  auto ds = readDataset(d.string(), diag);
+  ASSERT_EQ(ds.heights.size(), 2u);
+  EXPECT_EQ(ds.heights[0].t.us, 103621);
+  EXPECT_DOUBLE_EQ(ds.heights[1].range_m, 0.31);
+  EXPECT_EQ(diag.get("height.csv:bad_value"), 3);
+  auto out = test::tempDir("height_out");
+  writeDataset(ds, out.string());
+  Diagnostics diag2;
+  const auto back = readHeightCsv((out / "height.csv").string(), diag2);
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[1].t, ds.heights[1].t);
+  EXPECT_DOUBLE_EQ(back[1].range_m, 0.31);
+  EXPECT_EQ(diag2.total(), 0);
+}

@@ -93,3 +93,30 @@ TEST(Truth, RoundTrip) {
   EXPECT_DOUBLE_EQ(r.pair_biases[0].beta, 0.995);
   EXPECT_DOUBLE_EQ(r.scalars.at("seed"), 3);
 }
+
+TEST(Truth, FrameOfTheGroundTruthRoundTripsAndDefaultsToTheWorldFrame) {
+  auto d = test::tempDir("truth_frame");
+  Truth t;
+  t.truth_frame = "vive/reference";
+  t.align_required = true;
+  saveTruth(t, (d / "truth.yaml").string());
+  const auto r = loadTruth((d / "truth.yaml").string());
+  EXPECT_EQ(r.truth_frame, "vive/reference");
+  EXPECT_TRUE(r.align_required);
+  // A simulated truth.yaml (no keys): the world frame, no alignment.
+  const auto plain = loadTruth(test::writeFile(d / "plain.yaml", "anchor_positions: {101: [1, 2, 3]}\n"));
+  EXPECT_TRUE(plain.truth_frame.empty());
+  EXPECT_FALSE(plain.align_required);
+}
+
+TEST(Truth, AlignRequiredMustBeABoolean) {
+  auto d = test::tempDir("truth_frame_bad");
+  const auto f = test::writeFile(d / "truth.yaml", "truth_frame: vive\nalign_required: maybe\n");
+  try {
+    loadTruth(f);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& ex) {
+    EXPECT_NE(std::string(ex.what()).find("align_required"), std::string::npos) << ex.what();
+    EXPECT_NE(std::string(ex.what()).find(f), std::string::npos) << ex.what();
+  }
+}
