@@ -60,6 +60,7 @@ MotionAlignerOptions alignerOptions(const EstimatorOptions& o) {
   a.outlier_m = o.init.range_init_outlier_m;
   a.ambiguity_chi2 = o.init.ambiguity_chi2;
   a.gravity_m_s2 = o.gravity_m_s2;
+  a.max_imu_gap_s = o.imu.max_dt_s;
   return a;
 }
 

@@ -69,6 +69,7 @@ MotionAligner::MotionAligner(const MotionAlignerOptions& options, std::map<Senso
 
 void MotionAligner::addImu(const ImuSample& s) {
   if (!imu_.empty() && s.t <= imu_.back().t) return;
+  if (!imu_.empty() && (s.t - imu_.back().t).sec() > options_.max_imu_gap_s) clear();
   imu_.push_back(s);
   const Timestamp oldest = s.t - Duration::fromSec(options_.window_s);
   while (!imu_.empty() && imu_.front().t < oldest) imu_.pop_front();

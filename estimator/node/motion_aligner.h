@@ -55,6 +55,7 @@ struct MotionAlignerOptions {
   double gravity_m_s2 = 9.81;        ///< |g| [m/s²]
   int yaw_starts = 12;               ///< yaw grid of the multi-start [-]
   double sigma_bias_gyro_rad_s = 0.005;  ///< σ of the gyro bias in the result [rad/s]
+  double max_imu_gap_s = 0.1;        ///< increments cannot span a longer IMU gap: the window restarts [s]
 };
 
 /// The aligned state at the window's end.
