@@ -155,6 +155,22 @@ def metrics_of(metrics_json, errors_csv, status_txt):
     }
 
 
+def read_refusal(status_txt):
+    """The estimator's reason when it never initialized (status.txt `initialized: false`), else None.
+
+    A refusal is the designed answer when the data cannot fix the pose (one tag at rest, coplanar
+    anchors mirroring it, no motion): it is reported as REFUSED, not as a divergence."""
+    fields = {}
+    with open(status_txt) as f:
+        for line in f:
+            if ":" in line and not line.startswith(" "):
+                k, v = line.split(":", 1)
+                fields[k.strip()] = v.strip().strip('"')
+    if fields.get("initialized") == "false":
+        return fields.get("health_reason", "no reason given")
+    return None
+
+
 def run_command(cmd, log_path):
     with open(log_path, "w") as log:
         log.write("$ " + " ".join(cmd) + "\n")
@@ -168,10 +184,12 @@ def run_scenario(sc, out_root, bin_dir, strategy):
     dataset, run = os.path.join(base, "dataset"), os.path.join(base, "run")
     os.makedirs(base, exist_ok=True)
     start = time.time()
-    result = {"scenario": sc, "ok": False, "error": "", "wall_s": 0.0}
+    result = {"scenario": sc, "ok": False, "refused": False, "error": "", "wall_s": 0.0}
     steps = [
         ("meshnav_sim", [os.path.join(bin_dir, "meshnav_sim"), "--out", dataset] + sim_args(sc)),
-        ("meshnav_run", [os.path.join(bin_dir, "meshnav_run"), "--dataset", dataset, "--out", run, "--no-calibration"]
+        # --allow-lost: a run that ends lost is still evaluated (and counts as diverged by its error).
+        ("meshnav_run", [os.path.join(bin_dir, "meshnav_run"), "--dataset", dataset, "--out", run, "--no-calibration",
+                         "--allow-lost"]
          + (["--strategy", strategy] if strategy else [])),
         ("meshnav_eval", [os.path.join(bin_dir, "meshnav_eval"), "--dataset", dataset, "--run", run, "--no-plots",
                           "--json", os.path.join(run, "metrics.json")]),
@@ -181,6 +199,12 @@ def run_scenario(sc, out_root, bin_dir, strategy):
         if rc != 0:
             result["error"] = "%s exited %d (see %s)" % (name, rc, os.path.join(base, name + ".log"))
             break
+        if name == "meshnav_run":
+            refusal = read_refusal(os.path.join(run, "status.txt"))
+            if refusal is not None:
+                result["refused"] = True
+                result["error"] = "never initialized: " + refusal
+                break
     else:
         try:
             result.update(metrics_of(os.path.join(run, "metrics.json"), os.path.join(run, "errors.csv"),
@@ -214,7 +238,7 @@ def row_of(r):
             fmt(r["pos_rmse_m"], 3) if ok else "-", fmt(r["max_err_after_10s_m"], 3) if ok else "-",
             fmt(r["ori_rmse_deg"], 2) if ok else "-", fmt(r["pos_anees"], 1) if ok else "-",
             ("yes" if r["diverged"] else "no") if ok else "-", str(r["recoveries"]) if ok else "-",
-            "ok" if ok else "FAILED: " + r["error"]]
+            "ok" if ok else ("REFUSED: " if r.get("refused") else "FAILED: ") + r["error"]]
 
 
 def print_table(results):
@@ -318,7 +342,8 @@ def main(argv):
             i = futures[fut]
             r = results[i] = fut.result()
             with lock:
-                state = (("DIVERGED" if r["diverged"] else "ok") if r["ok"] else "FAILED: " + r["error"])
+                state = (("DIVERGED" if r["diverged"] else "ok") if r["ok"]
+                         else ("REFUSED: " if r["refused"] else "FAILED: ") + r["error"])
                 figures = ("rmse %.3f m, max after 10 s %.3f m, " % (r["pos_rmse_m"], r["max_err_after_10s_m"])
                            if r["ok"] else "")
                 print("[%d/%d] %s (%s): %s%s, %.0f s" % (done, len(scenarios), r["scenario"]["name"],
@@ -328,10 +353,12 @@ def main(argv):
     write_csv(results, os.path.join(a.out, "robustness.csv"))
     png = os.path.join(a.out, "error_cdf.png")
     wrote_png = write_cdf_png(results, png)
-    n_failed = sum(not r["ok"] for r in results)
+    n_refused = sum(r["refused"] for r in results)
+    n_failed = sum(not r["ok"] and not r["refused"] for r in results)
     n_div = sum(r["ok"] and r["diverged"] for r in results)
-    print("\n%d runs: %d diverged (max position error after %.0f s > %.0f m), %d failed; wrote %s%s"
-          % (len(results), n_div, SKIP_S, DIVERGENCE_M, n_failed, os.path.join(a.out, "robustness.csv"),
+    print("\n%d runs: %d diverged (max position error after %.0f s > %.0f m), %d failed, %d refused to "
+          "initialize (pose not determined by the data); wrote %s%s"
+          % (len(results), n_div, SKIP_S, DIVERGENCE_M, n_failed, n_refused, os.path.join(a.out, "robustness.csv"),
              " and " + png if wrote_png else ""))
     return 1 if (n_div or n_failed) else 0
 

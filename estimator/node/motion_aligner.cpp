@@ -314,18 +314,24 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
   Mat15 info;
   const double best_cost = fit(obs, best, &info);
   const ImuState best_end = endState(best, end, bias_gyro_rad_s);
-  for (size_t k = 1; k < cands.size(); ++k) {
+  // Every distinct rival (up to 4, by first-pass cost) is refitted on the same inliers: the
+  // first-pass order includes the outliers, so the closest rival need not come first (a mirror
+  // image across coplanar anchors was missed that way).
+  std::vector<ImuState> checked;
+  for (size_t k = 1; k < cands.size() && checked.size() < 4; ++k) {
     if (!distinct(cands[k].end, best_end)) continue;
+    if (std::any_of(checked.begin(), checked.end(), [&](const ImuState& c) { return !distinct(cands[k].end, c); }))
+      continue;
+    checked.push_back(cands[k].end);
     Unknowns rival = cands[k].x;
     const double c = fit(obs, rival, nullptr);
-    if (c - best_cost < options_.ambiguity_chi2 && distinct(endState(rival, end, bias_gyro_rad_s), best_end)) {
-      reason_ = "motion alignment: ambiguous (two poses " +
-                std::to_string((endState(rival, end, bias_gyro_rad_s).p_IinG - best_end.p_IinG).norm()) +
+    const ImuState rival_end = endState(rival, end, bias_gyro_rad_s);
+    if (c - best_cost < options_.ambiguity_chi2 && distinct(rival_end, best_end)) {
+      reason_ = "motion alignment: ambiguous (two poses " + std::to_string((rival_end.p_IinG - best_end.p_IinG).norm()) +
                 " m apart fit the ranges within " + std::to_string(c - best_cost) +
                 "): anchor geometry or motion cannot fix the pose yet";
       return std::nullopt;
     }
-    break;  // candidates are sorted: the first distinct one is the closest rival
   }
   (void)n_used;
   return finish(obs, best, info, end, bias_gyro_rad_s);

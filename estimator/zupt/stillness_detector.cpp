@@ -29,7 +29,8 @@ bool StillnessDetector::add(const ImuSample& s) {
   const double sf = std::sqrt(vf.maxCoeff() / (n - 1.0)), sw = std::sqrt(vw.maxCoeff() / (n - 1.0));
   const double max_f = std::max(options_.noise_factor * acc_nd_ * std::sqrt(rate_hz), options_.acc_floor_m_s2);
   const double max_w = std::max(options_.noise_factor * gyro_nd_ * std::sqrt(rate_hz), options_.gyro_floor_rad_s);
-  still_ = sf <= max_f && sw <= max_w && std::abs(mf.norm() - gravity_) <= options_.gravity_tolerance_m_s2;
+  still_ = sf <= max_f && sw <= max_w && std::abs(mf.norm() - gravity_) <= options_.gravity_tolerance_m_s2 &&
+           mw.norm() <= options_.max_mean_rate_rad_s;
   return still_;
 }
 

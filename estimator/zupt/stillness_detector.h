@@ -6,8 +6,9 @@
 /// Over a sliding window of `window_s` the sample standard deviations of the specific force and
 /// of the angular rate (per axis, the largest) must stay below
 ///   σ_f,max = max(k · σ_a √rate, acc_floor),   σ_ω,max = max(k · σ_ω √rate, gyro_floor)
-/// (σ_a, σ_ω the noise densities, rate the sample rate, k = `noise_factor`), and the mean specific
-/// force must be within `gravity_tolerance` of |g|. A hovering or walking body shakes far more.
+/// (σ_a, σ_ω the noise densities, rate the sample rate, k = `noise_factor`), the mean specific
+/// force must be within `gravity_tolerance` of |g| and the mean rate below `max_mean_rate`
+/// (a smooth turn has a small spread but is not rest). A real hovering or walking body shakes far more.
 
 #include <deque>
 
@@ -21,6 +22,7 @@ struct StillnessOptions {
   double acc_floor_m_s2 = 0.03;        ///< [m/s²]
   double gyro_floor_rad_s = 0.005;     ///< [rad/s]
   double gravity_tolerance_m_s2 = 0.3; ///< [m/s²]
+  double max_mean_rate_rad_s = 0.02;   ///< above any gyro bias worth flying with [rad/s]
 };
 
 class StillnessDetector {

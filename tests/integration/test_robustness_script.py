@@ -36,8 +36,12 @@ class DrawTest(unittest.TestCase):
 
 class FixedListTest(unittest.TestCase):
     def test_fixed12_covers_every_kind_layout_and_tag_count_with_outliers(self):
-        scs = robustness.load_scenarios(os.path.join(ROOT, "config", "robustness", "fixed12.yaml"))
+        # The twelve are split: fixed12.yaml must pass, open.yaml (disabled in CTest) does not yet.
+        fixed = robustness.load_scenarios(os.path.join(ROOT, "config", "robustness", "fixed12.yaml"))
+        still_open = robustness.load_scenarios(os.path.join(ROOT, "config", "robustness", "open.yaml"))
+        scs = fixed + still_open
         self.assertEqual(len(scs), 12)
+        self.assertEqual(len({s["name"] for s in scs}), 12)
         self.assertEqual({s["trajectory"] for s in scs}, set(robustness.TRAJECTORIES))
         self.assertEqual({s["anchor_layout"] for s in scs}, set(robustness.LAYOUTS))
         self.assertEqual({s["tags"] for s in scs}, {1, 2, 3})
@@ -100,5 +104,17 @@ class UsageTest(unittest.TestCase):
             self.assertEqual(robustness.main(["--runs", "1", "--bin", d, "--out", d]), 2)
 
 
-if __name__ == "__main__":
-    unittest.main()
+class RefusalTest(unittest.TestCase):
+    """A run that never initialized is REFUSED with the estimator's reason, not a divergence."""
+
+    def test_refusal_reason_comes_from_status_txt(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "status.txt")
+            with open(path, "w") as f:
+                f.write('strategy: centralized\ninitialized: false\nhealth: initializing\n'
+                        'health_reason: "motion alignment: ambiguous"\ncounters:\n  x: 1\n')
+            self.assertEqual(robustness.read_refusal(path), "motion alignment: ambiguous")
+            with open(path, "w") as f:
+                f.write('strategy: centralized\ninitialized: true\nhealth: ok\nhealth_reason: ""\n')
+            self.assertIsNone(robustness.read_refusal(path))
+

@@ -111,7 +111,10 @@ TEST(MotionAligner, RefusesWhileLandedWithOneTag) {
   std::mt19937_64 rng(1);
   feed(a, f, 0.0, 4.5, {101, 102, 103, 104}, 0.1, &rng);  // on the pad: yaw cannot be seen
   EXPECT_FALSE(a.solve(Eigen::Vector3d::Zero()));
-  EXPECT_NE(a.reason().find("not determined"), std::string::npos) << a.reason();
+  // Either reason says the same: headings far apart fit alike (ambiguous) or σ_yaw is too large.
+  EXPECT_TRUE(a.reason().find("not determined") != std::string::npos ||
+              a.reason().find("ambiguous") != std::string::npos)
+      << a.reason();
 }
 
 TEST(MotionAligner, RefusesWithTwoAnchorsOrAShortWindow) {

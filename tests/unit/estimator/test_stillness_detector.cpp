@@ -50,3 +50,8 @@ TEST(StillnessDetector, NeedsAFullWindow) {
     EXPECT_FALSE(d.add(s));
   }
 }
+
+TEST(StillnessDetector, ASmoothTurnIsNotStill) {
+  // Constant yaw rate of 0.07 rad/s: no spread at all, but the body turns.
+  EXPECT_FALSE(run([](double) { return 0.0; }, 0.07));
+}
