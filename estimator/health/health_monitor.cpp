@@ -18,6 +18,8 @@ HealthMonitor::HealthMonitor(const HealthOptions& options) : options_(options) {
 
 void HealthMonitor::reset(Timestamp t) {
   events_.clear();
+  by_type_.clear();
+  by_anchor_.clear();
   health_ = candidate_ = Health::Ok;
   reason_.clear();
   last_accepted_range_ = candidate_since_ = t;
@@ -25,31 +27,37 @@ void HealthMonitor::reset(Timestamp t) {
 
 void HealthMonitor::onUpdate(Timestamp t, const std::string& type, SensorId anchor, bool accepted, double nis) {
   events_.push_back({t, type, anchor, accepted, nis});
+  account(events_.back(), +1);
   if (type == "range" && accepted && t > last_accepted_range_) last_accepted_range_ = t;
+}
+
+void HealthMonitor::account(const Event& e, int sign) {
+  auto add = [&](HealthStats& h) {
+    h.n += sign;
+    if (e.accepted)
+      h.nis_sum += sign * e.nis;
+    else
+      h.n_gated += sign;
+  };
+  add(by_type_[e.type]);
+  if (e.anchor) add(by_anchor_[e.anchor]);
 }
 
 std::map<std::string, HealthStats> HealthMonitor::stats() const {
   std::map<std::string, HealthStats> s;
-  for (const Event& e : events_) {
-    for (const std::string& key : {e.type, e.anchor ? "anchor " + std::to_string(e.anchor) : std::string()}) {
-      if (key.empty()) continue;
-      HealthStats& h = s[key];
-      ++h.n;
-      if (e.accepted)
-        h.nis_sum += e.nis;
-      else
-        ++h.n_gated;
-    }
-  }
+  for (const auto& [type, h] : by_type_)
+    if (h.n > 0) s[type] = h;
+  for (const auto& [id, h] : by_anchor_)
+    if (h.n > 0) s["anchor " + std::to_string(id)] = h;
   return s;
 }
 
 Health HealthMonitor::assess(Timestamp t, double sigma_p, std::string* why) const {
-  const auto s = stats();
-  const HealthStats range = s.count("range") ? s.at("range") : HealthStats{};
+  const auto it = by_type_.find("range");
+  const HealthStats range = it != by_type_.end() ? it->second : HealthStats{};
   int gated_anchors = 0;
-  for (const auto& [key, h] : s)
-    if (key.rfind("anchor ", 0) == 0 && h.n >= 2 && h.gatedFraction() >= options_.lost_gated_fraction) ++gated_anchors;
+  for (const auto& [id, h] : by_anchor_)
+    if (h.n >= 2 && h.gatedFraction() >= options_.lost_gated_fraction) ++gated_anchors;
   const double no_aiding_s = (t - last_accepted_range_).sec();
   if (sigma_p > options_.lost_sigma_p_m) {
     *why = fmt::format("position sigma {:.2f} m > {:.2f} m", sigma_p, options_.lost_sigma_p_m);
@@ -83,7 +91,10 @@ Health HealthMonitor::assess(Timestamp t, double sigma_p, std::string* why) cons
 
 bool HealthMonitor::evaluate(Timestamp t, double sigma_p_max_m) {
   const Timestamp oldest = t - Duration::fromSec(options_.window_s);
-  while (!events_.empty() && events_.front().t < oldest) events_.pop_front();
+  while (!events_.empty() && events_.front().t < oldest) {
+    account(events_.front(), -1);
+    events_.pop_front();
+  }
   std::string why;
   const Health h = assess(t, sigma_p_max_m, &why);
   if (h != candidate_) {

@@ -69,10 +69,14 @@ class HealthMonitor {
     bool accepted;
     double nis;
   };
+  /// Adds (+1) or removes (−1) an event from the running statistics.
+  void account(const Event& e, int sign);
   Health assess(Timestamp t, double sigma_p_max_m, std::string* why) const;
 
   HealthOptions options_;
   std::deque<Event> events_;
+  std::map<std::string, HealthStats> by_type_;   ///< running, over `events_`
+  std::map<SensorId, HealthStats> by_anchor_;    ///< running, over `events_`
   Health health_ = Health::Ok;
   std::string reason_;
   Timestamp last_accepted_range_;

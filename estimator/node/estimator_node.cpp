@@ -208,10 +208,13 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
 void EstimatorNode::feedAligner(const EstimatorInput& in) {
   if (const auto* s = std::get_if<ImuSample>(&in)) {
     aligner_.addImu(*s);
-    const bool still = still_detector_.add(*s);
-    still_at_[s->t.us] = still;
-    if (!have_flight_state_ && options_.zupt.detect_stillness && !initialized()) initializer_->addStillness(still);
-  } else if (const auto* f = std::get_if<FlightStateSample>(&in)) {
+    // Stillness is the evidence of rest only while no flight state was received.
+    if (!have_flight_state_ && options_.zupt.detect_stillness) {
+      const bool still = still_detector_.add(*s);
+      still_at_[s->t.us] = still;
+      if (!initialized()) initializer_->addStillness(still);
+    }
+  } else if (std::holds_alternative<FlightStateSample>(in)) {
     have_flight_state_ = true;
   } else if (const auto* b = std::get_if<BaroSample>(&in)) {
     last_pressure_pa_ = b->pressure_pa;
