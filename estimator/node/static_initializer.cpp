@@ -197,10 +197,12 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
         Eigen::Vector4d J;  // ∂res/∂[p, yaw]
         J.head<3>() = u;
         J(3) = u.dot(Eigen::Vector3d::UnitZ().cross(lever));
-        const double w = 1.0 / (r.sigma_m * r.sigma_m);
+        // Huber (k = 2σ): NLOS outliers must not pick the minimum (a 109° yaw error in hover).
+        const double e = std::abs(res) / r.sigma_m;
+        const double w = (e <= 2.0 ? 1.0 : 2.0 / e) / (r.sigma_m * r.sigma_m);
         A += w * J * J.transpose();
         g += w * J * res;
-        cost += w * res * res;
+        cost += e <= 2.0 ? e * e : 4.0 * e - 4.0;
       }
       A.diagonal().array() += 1e-9;
       A(3, 3) += 1.0 / (M_PI * M_PI);  // weak yaw prior: one tag leaves yaw (nearly) unobservable
@@ -216,16 +218,25 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
   double best_cost = std::numeric_limits<double>::infinity();
   Eigen::Vector3d best_p = centroid;
   double best_yaw = 0.0;
-  std::vector<std::pair<double, Eigen::Vector3d>> minima;
+  struct Minimum {
+    double cost;
+    Eigen::Vector3d p;
+    double yaw;
+  };
+  std::vector<Minimum> minima;
+  // Starts near the floor (a landed pad) and at the anchors' mean height (a body at rest in the
+  // air): anchors in a narrow height band mirror the height, and only a start on each side lets
+  // the ambiguity check below see both.
+  for (const double z0 : {0.5, centroid.z()})
   for (int sx = -1; sx <= 1; ++sx)
     for (int sy = -1; sy <= 1; ++sy)
       for (int k = 0; k < 4; ++k) {
         Eigen::Vector3d p = centroid + Eigen::Vector3d(2.0 * sx, 2.0 * sy, 0.0);
-        p.z() = 0.5;
+        p.z() = z0;
         double yaw = k * 0.5 * M_PI;
         const double c = solve(p, yaw, nullptr);
         if (!std::isfinite(c)) continue;
-        minima.emplace_back(c, p);
+        minima.push_back({c, p, yaw});
         if (c < best_cost) {
           best_cost = c;
           best_p = p;
@@ -235,12 +246,19 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
   if (!std::isfinite(best_cost)) return false;
   // A second minimum elsewhere that fits about as well: the anchors cannot fix the position
   // (nearly coplanar anchors mirror it). Refuse rather than pick one.
-  for (const auto& [c, p] : minima)
-    if ((p - best_p).norm() > 0.5 && c - best_cost < options_.init.ambiguity_chi2) {
-      waiting_for_ = "motion: two positions " + std::to_string((p - best_p).norm()) +
+  for (const Minimum& m : minima) {
+    if (m.cost - best_cost >= options_.init.ambiguity_chi2) continue;
+    if ((m.p - best_p).norm() > 0.5) {
+      waiting_for_ = "motion: two positions " + std::to_string((m.p - best_p).norm()) +
                      " m apart fit the landed ranges alike (known anchors nearly coplanar?)";
       return false;
     }
+    const double dyaw = std::abs(std::remainder(m.yaw - best_yaw, 2.0 * M_PI));
+    if (dyaw > 30.0 * kDeg) {  // tags' lever arms too short for the range noise
+      waiting_for_ = "motion: two headings " + std::to_string(dyaw / kDeg) + " deg apart fit the ranges alike";
+      return false;
+    }
+  }
   // Drop outliers and refine.
   const Eigen::Matrix3d R = rotZ(best_yaw) * R_rp;
   n_used = 0;
