@@ -10,6 +10,7 @@
 
 #include "common/atmosphere.h"
 #include "estimator/filter/strategy_factory.h"
+#include "estimator/node/node_internals.h"
 #include "estimator/uwb/range_model.h"
 
 namespace meshnav::estimator {
@@ -42,33 +43,15 @@ EstimatorNode::Snapshot EstimatorNode::Snapshot::copy() const {
   return s;
 }
 
+using node_internal::alignerOptions;
+using node_internal::weakestPositionAxis;
+
 namespace {
 EstimatorOptions withSetupNoise(EstimatorOptions o, const SystemSetup& setup) {
   o.applySetupNoise(setup.noise);
   return o;
 }
 
-MotionAlignerOptions alignerOptions(const EstimatorOptions& o) {
-  MotionAlignerOptions a;
-  a.window_s = o.init.motion_window_s;
-  a.min_span_s = o.init.motion_min_span_s;
-  a.min_ranges = o.init.motion_min_ranges;
-  a.max_sigma_yaw_deg = o.init.motion_max_sigma_yaw_deg;
-  a.max_sigma_p_m = o.init.motion_max_sigma_p_m;
-  a.sigma_bias_acc_m_s2 = o.init.sigma_bias_acc_m_s2;
-  a.sigma_bias_gyro_rad_s = o.init.sigma_bias_gyro_rad_s;
-  a.outlier_m = o.init.range_init_outlier_m;
-  a.ambiguity_chi2 = o.init.ambiguity_chi2;
-  a.gravity_m_s2 = o.gravity_m_s2;
-  a.max_imu_gap_s = o.imu.max_dt_s;
-  return a;
-}
-
-/// Largest principal position σ [m] and its direction (G).
-std::pair<double, Eigen::Vector3d> weakestPositionAxis(const Eigen::Matrix3d& P) {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(0.5 * (P + P.transpose()));
-  return {std::sqrt(std::max(es.eigenvalues()(2), 0.0)), es.eigenvectors().col(2)};
-}
 }  // namespace
 
 EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup& setup, EstimatorSinks sinks)
@@ -205,166 +188,6 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   publishPeriodic();
 }
 
-void EstimatorNode::feedAligner(const EstimatorInput& in) {
-  if (const auto* s = std::get_if<ImuSample>(&in)) {
-    aligner_.addImu(*s);
-    // Stillness is the evidence of rest only while no flight state was received.
-    if (!have_flight_state_ && options_.zupt.detect_stillness) {
-      const bool still = still_detector_.add(*s);
-      still_at_[s->t.us] = still;
-      if (!initialized()) initializer_->addStillness(still);
-    }
-  } else if (std::holds_alternative<FlightStateSample>(in)) {
-    have_flight_state_ = true;
-  } else if (const auto* b = std::get_if<BaroSample>(&in)) {
-    last_pressure_pa_ = b->pressure_pa;
-  } else if (const auto* r = std::get_if<RangeSample>(&in)) {
-    SensorId tag = r->id_initiator, anchor = r->id_responder;
-    if (!cur_.network->isTag(tag)) std::swap(tag, anchor);
-    if (!cur_.network->isTag(tag) || cur_.network->isTag(anchor)) return;
-    const Eigen::Vector3d* p = cur_.network->exactAnchor(anchor);
-    std::optional<Eigen::Vector3d> p_est;
-    if (!p && cur_.filter && cur_.filter->state().anchor_p_AinG.count(anchor))
-      p_est = cur_.filter->state().anchor_p_AinG.at(anchor);
-    if (!p && !p_est && setup_.abs_anchor_positions.count(anchor)) p_est = setup_.abs_anchor_positions.at(anchor);
-    if (!p && !p_est) return;
-    const PairBias pb = cur_.network->pairBias(tag, anchor);
-    AlignRange a;
-    a.t = r->t;
-    a.tag = tag;
-    a.anchor = anchor;
-    a.p_AinG = p ? *p : *p_est;
-    a.d_m = ((options_.uwb.use_corrected_range ? r->range_corr_m : r->range_m) - pb.gamma_m) / pb.beta;
-    a.sigma_m = cur_.network->rangeSigma(tag, anchor, r->R_m2);
-    aligner_.addRange(a);
-  }
-}
-
-bool EstimatorNode::landedAt(Timestamp t) const {
-  if (have_flight_state_ || !options_.zupt.detect_stillness) return cur_.landed;
-  auto it = still_at_.find(t.us);
-  return it != still_at_.end() && it->second;
-}
-
-std::string EstimatorNode::waitingFor() const {
-  if (initialized()) return "";
-  return initializer_->waitingFor() + (aligner_.reason().empty() ? "" : "; " + aligner_.reason());
-}
-
-void EstimatorNode::feedInitializer(const EstimatorInput& in) {
-  std::visit(
-      [&](const auto& m) {
-        using T = std::decay_t<decltype(m)>;
-        if constexpr (std::is_same_v<T, ImuSample>) initializer_->addImu(m);
-        if constexpr (std::is_same_v<T, BaroSample>) initializer_->addBaro(m);
-        if constexpr (std::is_same_v<T, RangeSample>) initializer_->addRange(m);
-        if constexpr (std::is_same_v<T, FlightStateSample>) initializer_->addFlightState(m);
-        if constexpr (std::is_same_v<T, AnchorInit>) pending_anchor_inits_.push_back(m);
-        if constexpr (std::is_same_v<T, EstimatorCommand>)
-          if (m.action == EstimatorCommand::Action::AddAnchor) pending_anchor_inits_.push_back(m.anchor);
-      },
-      in);
-  if (!std::holds_alternative<ImuSample>(in)) return;
-  if (auto belief = initializer_->tryInitialize()) {
-    initialize(*belief);
-    return;
-  }
-  // At rest the landed data decides; in motion (or when it cannot fix the pose) the aligner.
-  if (!initializer_->isStatic() || initializer_->waitingFor().rfind("motion", 0) == 0) tryMotionInitialization(inputTime(in));
-}
-
-void EstimatorNode::tryMotionInitialization(Timestamp t) {
-  if (last_align_try_ && (t - *last_align_try_).sec() < 0.5) return;
-  last_align_try_ = t;
-  const auto r = aligner_.solve(Eigen::Vector3d::Zero());
-  if (!r) {
-    diag_.count("init_motion_refused");
-    return;
-  }
-  initialize(beliefFromAlignment(*r));
-}
-
-InitialBelief EstimatorNode::beliefFromAlignment(const AlignmentResult& r) const {
-  InitialBelief b;
-  b.t = r.t;
-  b.imu = r.imu;
-  b.cov = r.cov;
-  b.from_ranges = true;
-  b.n_ranges_used = r.n_ranges;
-  b.range_fit_rms_m = r.rms_m;
-  b.last_imu = r.last_imu;
-  b.landed = landedAt(r.t);
-  const double baro_z = (r.imu.p_IinG + r.imu.q_ItoG * setup_.baro_p_IP).z();
-  if (setup_.baro_reference_pressure_pa) {
-    b.baro_reference_pa = *setup_.baro_reference_pressure_pa;
-    b.baro_bias_m = 0.0;
-    b.baro_bias_var_m2 = std::pow(options_.baro.init_bias_sigma_m, 2);
-  } else if (last_pressure_pa_) {  // reference: the current pressure at the aligned height
-    b.baro_reference_pa = *last_pressure_pa_;
-    b.baro_bias_m = -baro_z;
-    b.baro_bias_var_m2 = r.cov(ImuErr::kP + 2, ImuErr::kP + 2) + 0.05;
-  }
-  return b;
-}
-
-void EstimatorNode::initialize(const InitialBelief& b) {
-  auto filter = makeStrategy(options_);
-  filter->reset(setup_.imu_id, b.imu, b.cov, b.t);
-  if (options_.baro.enabled && b.baro_reference_pa) {
-    baro_reference_pa_ = b.baro_reference_pa;
-    filter->addBaro(setup_.baro_id, b.baro_bias_m, b.baro_bias_var_m2);
-  }
-  for (const auto& [id, p] : setup_.abs_anchor_positions) {
-    auto sig = setup_.abs_anchor_sigmas_m.find(id);
-    if (sig != setup_.abs_anchor_sigmas_m.end())
-      filter->addAnchor(id, p, Eigen::Matrix3d::Identity() * sig->second * sig->second);
-  }
-  if (options_.uwb.estimate_tag_biases) {
-    // Tag instances with state: γ towards the setup's anchors (exact or known-but-uncertain) whose
-    // a-priori bias is uncertain. Constant per pair, so a state rather than white noise.
-    for (const auto& [tag, lever] : setup_.rel_tag_positions) {
-      std::vector<SensorId> peers;
-      std::vector<double> gamma, var;
-      for (const auto& [anchor, p] : setup_.abs_anchor_positions) {
-        const auto pb = setup_.findPairBias(tag, anchor);
-        if (!pb || pb->sigma_gamma_m <= 0.0) continue;
-        peers.push_back(anchor);
-        gamma.push_back(pb->gamma_m);
-        var.push_back(pb->sigma_gamma_m * pb->sigma_gamma_m);
-      }
-      if (!peers.empty())
-        filter->addTagBiases(tag, peers, Eigen::Map<Eigen::VectorXd>(gamma.data(), static_cast<long>(gamma.size())),
-                             Eigen::Map<Eigen::VectorXd>(var.data(), static_cast<long>(var.size())));
-    }
-  }
-  cur_.filter = std::move(filter);
-  cur_.last_imu = b.last_imu;
-  cur_.landed = b.landed;
-  cur_.last_zupt = b.t;
-  init_time_ = b.t;
-  health_.reset(b.t);
-  newest_ = newest_ ? std::max(*newest_, b.t) : b.t;
-  const Eigen::Matrix3d R0 = b.imu.q_ItoG.toRotationMatrix();
-  const double yaw_deg = std::atan2(R0(1, 0), R0(0, 0)) * 180.0 / M_PI;
-  spdlog::info(
-      "estimator: initialized at t={} from {} p_IinG=[{:.3f}, {:.3f}, {:.3f}] m, yaw {:.1f} deg (σ_p {:.2f} m, "
-      "σ_yaw {:.1f} deg){}",
-      formatSeconds(b.t), b.from_ranges ? "ranges" : "initial_pose", b.imu.p_IinG.x(), b.imu.p_IinG.y(),
-      b.imu.p_IinG.z(), yaw_deg, weakestPositionAxis(b.cov.block<3, 3>(ImuErr::kP, ImuErr::kP)).first,
-      std::sqrt((R0.transpose() * Eigen::Vector3d::UnitZ())
-                    .dot(b.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) * (R0.transpose() * Eigen::Vector3d::UnitZ()))) *
-          180.0 / M_PI,
-      b.from_ranges ? fmt::format(", {} ranges, rms {:.3f} m", b.n_ranges_used, b.range_fit_rms_m) : "");
-  if (!baro_reference_pa_ && options_.baro.enabled)
-    spdlog::warn("estimator: no baro reference pressure (none in setup, no landed baro data): baro unused");
-  const auto pending = std::move(pending_anchor_inits_);
-  pending_anchor_inits_.clear();
-  for (auto a : pending) {
-    a.t = b.t;
-    onInput(a);
-  }
-}
-
 void EstimatorNode::process(const EstimatorInput& in, bool first) {
   std::visit(
       [&](const auto& m) {
@@ -383,26 +206,6 @@ void EstimatorNode::propagateTo(Timestamp t) {
   if (!cur_.last_imu || t <= cur_.filter->state().t) return;
   ScopedStepTimer timer(timings_, "propagate");
   propagateFilter(cur_.last_imu->acc_m_s2, cur_.last_imu->gyro_rad_s, t);
-}
-
-void EstimatorNode::propagateFilter(const Eigen::Vector3d& acc, const Eigen::Vector3d& gyro, Timestamp t) {
-  FusionStrategy& f = *cur_.filter;
-  const Timestamp t0 = f.state().t;
-  f.propagate(acc, gyro, t);
-  if (!cur_.last_imu) return;
-  // Held readings beyond max_dt after the last sample: their error as white noise (velocity and
-  // attitude random walk; position gets the integrated velocity noise).
-  const Timestamp stale_from = std::max(t0, cur_.last_imu->t + Duration::fromSec(options_.imu.max_dt_s));
-  const double dt = (t - stale_from).sec();
-  if (dt <= 0.0) return;
-  const double qa = std::pow(options_.imu.gap_sigma_acc_m_s2, 2), qw = std::pow(options_.imu.gap_sigma_gyro_rad_s, 2);
-  ImuMatrix Q = ImuMatrix::Zero();
-  const Eigen::Matrix3d I3 = Eigen::Matrix3d::Identity();
-  Q.block<3, 3>(ImuErr::kP, ImuErr::kP) = I3 * qa * dt * dt * dt / 3.0;
-  Q.block<3, 3>(ImuErr::kP, ImuErr::kV) = Q.block<3, 3>(ImuErr::kV, ImuErr::kP) = I3 * qa * dt * dt / 2.0;
-  Q.block<3, 3>(ImuErr::kV, ImuErr::kV) = I3 * qa * dt;
-  Q.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) = I3 * qw * dt;
-  f.addImuNoise(Q);
 }
 
 void EstimatorNode::processImu(const ImuSample& s, bool first) {
@@ -567,78 +370,6 @@ void EstimatorNode::applyCommand(const EstimatorCommand& c, bool first) {
     }
     case EstimatorCommand::Action::Reset: break;  // handled in onInput
   }
-}
-
-void EstimatorNode::updateHealth(Timestamp t) {
-  if (!initialized()) return;
-  if (last_health_eval_ && (t - *last_health_eval_).sec() < 0.1) return;
-  last_health_eval_ = t;
-  const auto [sigma_p, axis] = weakestPositionAxis(cur_.filter->covariance(setup_.imu_id, setup_.imu_id)
-                                                       .block<3, 3>(ImuErr::kP, ImuErr::kP));
-  if (health_.evaluate(t, sigma_p)) {
-    diag_.count(std::string("health_") + healthName(health_.health()));
-    const std::string msg = fmt::format("estimator: health {} at t={}{}{}", healthName(health_.health()),
-                                        formatSeconds(t), health_.reason().empty() ? "" : ": ", health_.reason());
-    if (health_.health() == Health::Ok)
-      spdlog::info("{}", msg);
-    else
-      spdlog::warn("{}", msg);
-  }
-  if (health_.health() == Health::Lost) tryRecover(t);
-}
-
-void EstimatorNode::tryRecover(Timestamp t) {
-  if (!options_.recovery.enabled) return;
-  if (last_recovery_try_ && (t - *last_recovery_try_).sec() < options_.recovery.retry_s) return;
-  last_recovery_try_ = t;
-  const auto r = aligner_.solve(cur_.filter->state().imu.bias_gyro_rad_s);
-  if (!r) {
-    diag_.count("recovery_refused");
-    spdlog::warn("estimator: lost at t={}, cannot re-initialize yet: {}", formatSeconds(t), aligner_.reason());
-    return;
-  }
-  const ImuState before = cur_.filter->state().imu;
-  replaceImu(r->imu, r->cov, r->t, r->last_imu);
-  diag_.count("recovery");
-  spdlog::warn("estimator: recovered at t={}: re-initialized from {} ranges and the IMU (moved {:.2f} m, "
-               "σ_p {:.2f} m, σ_yaw {:.1f} deg); anchors and bias states kept",
-               formatSeconds(r->t), r->n_ranges, (r->imu.p_IinG - before.p_IinG).norm(), r->sigma_p_m,
-               r->sigma_yaw_deg);
-}
-
-void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu) {
-  const FusionStrategy& old = *cur_.filter;
-  const NominalState& s = old.state();
-  auto f = makeStrategy(options_);
-  f->reset(setup_.imu_id, x, P, t);
-  // The baro bias may have absorbed the runaway: keep its mean, widen it to the init σ.
-  for (const auto& [id, b] : s.baro_bias_m)
-    f->addBaro(id, b, std::max(old.covariance(id, id)(0, 0), std::pow(options_.baro.init_bias_sigma_m, 2)));
-  for (const auto& [id, p] : s.anchor_p_AinG) f->addAnchor(id, p, old.covariance(id, id));
-  for (const auto& [id, tb] : s.tag_biases)
-    f->addTagBiases(id, tb.peers, tb.gamma_m, old.covariance(id, id).diagonal());
-  cur_.filter = std::move(f);
-  cur_.last_imu = last_imu;
-  cur_.last_zupt = t;
-  history_.clear();  // a rewind must not restore the state before the re-initialization
-  init_time_ = t;
-  health_.reset(t);
-}
-
-void EstimatorNode::injectPoseError(const Eigen::Vector3d& dp_m, double dyaw_rad) {
-  if (!initialized()) return;
-  ImuState x = cur_.filter->state().imu;
-  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(dyaw_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  x.p_IinG += dp_m;
-  x.v_IinG = Rz * x.v_IinG;
-  x.q_ItoG = Eigen::Quaterniond(Rz * x.q_ItoG.toRotationMatrix()).normalized();
-  const ImuMatrix P = cur_.filter->covariance(setup_.imu_id, setup_.imu_id);
-  const ImuSample last = cur_.last_imu ? *cur_.last_imu : ImuSample{};
-  const Timestamp t = cur_.filter->state().t;
-  const auto keep_health = health_;
-  replaceImu(x, P, t, last);
-  health_ = keep_health;  // the fault is not a re-initialization
-  diag_.count("injected_pose_error");
 }
 
 PoseEstimate EstimatorNode::makePose() const {
