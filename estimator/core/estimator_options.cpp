@@ -77,7 +77,9 @@ void forEachField(Opt& o, Visitor&& v) {
   v("health.lost_sigma_p_m", o.health.lost_sigma_p_m, "largest position sigma beyond which the pose is lost [m]");
   v("health.hold_s", o.health.hold_s, "a better health must hold this long [s]");
   v("recovery.enabled", o.recovery.enabled, "re-initialize from ranges and IMU when lost");
-  v("recovery.retry_s", o.recovery.retry_s, "between two attempts while lost [s]");
+  v("recovery.retry_s", o.recovery.retry_s, "between two attempts while lost or degraded [s]");
+  v("recovery.degraded_disagreement_chi2", o.recovery.degraded_disagreement_chi2,
+    "degraded: re-initialize when the aligned pose disagrees beyond this chi^2 (4 dof), 0 = off [-]");
 }
 
 std::vector<std::string> splitKey(const std::string& key) {
@@ -194,7 +196,8 @@ void EstimatorOptions::validate() const {
            health.lost_gated_fraction <= 1 && health.degraded_mean_nis > 0 && health.degraded_no_aiding_s > 0 &&
            health.lost_no_aiding_s >= health.degraded_no_aiding_s && health.lost_sigma_p_m > 0 && health.hold_s >= 0,
        "health.* (0 < degraded <= lost fractions <= 1, positive times)");
-  need(recovery.retry_s > 0, "recovery.retry_s > 0");
+  need(recovery.retry_s > 0 && recovery.degraded_disagreement_chi2 >= 0,
+       "recovery.retry_s > 0, recovery.degraded_disagreement_chi2 >= 0");
   need(zupt.stillness_gate_probability > 0 && zupt.stillness_gate_probability < 1,
        "zupt.stillness_gate_probability in (0, 1)");
   need(init.duration_s >= 0.0 && init.min_ranges >= 4, "init.duration_s >= 0, init.min_ranges >= 4");

@@ -96,6 +96,9 @@ struct ZuptOptions {
 struct RecoveryOptions {
   bool enabled = true;
   double retry_s = 1.0;                  ///< between two alignment attempts while lost [s]
+  /// While `degraded`, also align every `retry_s` and re-initialize when the aligned pose and the
+  /// filter's disagree beyond this χ² (4 dof: position and yaw, both covariances) [-]; 0: off.
+  double degraded_disagreement_chi2 = 23.5;
 };
 
 struct EstimatorOptions {

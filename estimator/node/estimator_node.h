@@ -132,6 +132,8 @@ class EstimatorNode {
   InitialBelief beliefFromAlignment(const AlignmentResult& r) const;
   void updateHealth(Timestamp t);
   void tryRecover(Timestamp t);
+  /// χ² (4 dof) between the filter's position and yaw and an aligned pose, both covariances.
+  double disagreement(const AlignmentResult& r) const;
   /// Replaces the IMU instance (state, covariance, time); every other instance keeps its mean and
   /// marginal covariance (cross-covariances dropped). History before `t` is forgotten.
   void replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu);

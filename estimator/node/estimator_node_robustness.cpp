@@ -211,18 +211,50 @@ void EstimatorNode::updateHealth(Timestamp t) {
     else
       spdlog::warn("{}", msg);
   }
-  if (health_.health() == Health::Lost) tryRecover(t);
+  if (health_.health() == Health::Lost ||
+      (health_.health() == Health::Degraded && options_.recovery.degraded_disagreement_chi2 > 0.0))
+    tryRecover(t);
+}
+
+double EstimatorNode::disagreement(const AlignmentResult& r) const {
+  const ImuState& x = cur_.filter->state().imu;
+  const Eigen::MatrixXd P = cur_.filter->covariance(setup_.imu_id, setup_.imu_id);
+  auto yawOf = [](const Eigen::Quaterniond& q) {
+    const Eigen::Matrix3d R = q.toRotationMatrix();
+    return std::atan2(R(1, 0), R(0, 0));
+  };
+  auto yawVar = [](const Eigen::Quaterniond& q, const Eigen::MatrixXd& cov) {
+    const Eigen::Vector3d n = q.conjugate() * Eigen::Vector3d::UnitZ();
+    return n.dot(cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) * n);
+  };
+  Eigen::Vector4d d;
+  d.head<3>() = r.imu.p_IinG - x.p_IinG;
+  d(3) = std::remainder(yawOf(r.imu.q_ItoG) - yawOf(x.q_ItoG), 2.0 * M_PI);
+  Eigen::Matrix4d S = Eigen::Matrix4d::Zero();
+  S.topLeftCorner<3, 3>() = P.block<3, 3>(ImuErr::kP, ImuErr::kP) + r.cov.block<3, 3>(ImuErr::kP, ImuErr::kP);
+  S(3, 3) = yawVar(x.q_ItoG, P) + yawVar(r.imu.q_ItoG, r.cov);
+  return d.dot(S.ldlt().solve(d));
 }
 
 void EstimatorNode::tryRecover(Timestamp t) {
   if (!options_.recovery.enabled) return;
   if (last_recovery_try_ && (t - *last_recovery_try_).sec() < options_.recovery.retry_s) return;
   last_recovery_try_ = t;
+  const bool lost = health_.health() == Health::Lost;
   const auto r = aligner_.solve(cur_.filter->state().imu.bias_gyro_rad_s);
   if (!r) {
+    if (!lost) return;  // degraded: nothing to compare with
     diag_.count("recovery_refused");
     spdlog::warn("estimator: lost at t={}, cannot re-initialize yet: {}", formatSeconds(t), aligner_.reason());
     return;
+  }
+  // Degraded: replace only a filter that the aligned pose contradicts (a runaway not yet gated out).
+  if (!lost) {
+    const double chi2 = disagreement(*r);
+    if (chi2 <= options_.recovery.degraded_disagreement_chi2) return;
+    diag_.count("recovery_degraded");
+    spdlog::warn("estimator: degraded at t={} and the aligned pose disagrees (chi2 {:.1f} > {:.1f})",
+                 formatSeconds(t), chi2, options_.recovery.degraded_disagreement_chi2);
   }
   const ImuState before = cur_.filter->state().imu;
   replaceImu(r->imu, r->cov, r->t, r->last_imu);
