@@ -5,8 +5,11 @@ Every scenario is simulated with meshnav_sim (docs/scenarios.md), flown with
 `meshnav_run --no-calibration` (known anchors only) and evaluated with `meshnav_eval --json`.
 Per run: position RMSE [m], max position error after the first 10 s [m], orientation RMSE [deg],
 position ANEES, diverged (max error after 10 s > 1 m) and recoveries (the `recovery` counter of
-the run's status.txt, 0 when absent). Writes robustness.csv and error_cdf.png into --out, prints
-a table, and exits 1 when any run diverged or a process failed (2 on usage errors).
+the run's status.txt, 0 when absent). meshnav_run gets --allow-lost, so a run that ends lost is
+still scored; a run that never initialized is REFUSED with the estimator's reason (the designed
+answer when the data cannot fix the pose) and is not a divergence. Writes robustness.csv and
+error_cdf.png into --out, prints a table, and exits 1 when any run diverged or a process failed
+(2 on usage errors).
 
   robustness.py --runs N --seed S [--jobs 2] [--out DIR] [--strategy S] [--duration SEC]
   robustness.py --scenarios FILE [--jobs 2] [--out DIR] [--strategy S]
