@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include "tests/support/shared_data.h"
+
 #include <filesystem>
 
 #include "common/dataset.h"
@@ -67,7 +69,7 @@ TEST(Ranges, TimeGoingBackwardsIsReportedAndSorted) {
 
 TEST(Ranges, ImportsTheRealRecording) {
   const std::string dir = std::string(MESHNAV_SHARED_DIR) + "/data/real-t1-a3-loiter";
-  if (!std::filesystem::exists(dir)) GTEST_SKIP() << "shared data not present: " << dir;
+  MESHNAV_REQUIRE_SHARED_DATA(dir);
   Diagnostics diag;
   size_t total = 0;
   for (const char* name : {"a01_ranges.csv", "a02_ranges.csv", "a03_ranges.csv", "d01_ranges.csv"}) {

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include "tests/support/shared_data.h"
+
 #include <filesystem>
 
 #include "common/setup.h"
@@ -48,7 +50,7 @@ TEST(Setup, RoundTrip) {
 
 TEST(Setup, ReadsThePublishedToolboxConfig) {
   const std::string f = std::string(MESHNAV_SHARED_DIR) + "/data/real-t1-a3-loiter/config.yaml";
-  if (!std::filesystem::exists(f)) GTEST_SKIP() << "shared data not present: " << f;
+  MESHNAV_REQUIRE_SHARED_DATA(f);
   const auto s = loadSetup(f);
   ASSERT_EQ(s.rel_tag_positions.size(), 1u);
   EXPECT_TRUE(s.rel_tag_positions.at(0).isApprox(Eigen::Vector3d(-0.09, 0.04, -0.045)));

@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/shared_data.h"
+
 #include <filesystem>
 
 #include "eval/range_dataset.h"
@@ -29,7 +31,7 @@ const std::string kDir = std::string(MESHNAV_SHARED_DIR) + "/data/real-t1-a3-loi
 }  // namespace
 
 TEST(RealRecording, ReferenceStatisticsFileIsRead) {
-  if (!std::filesystem::exists(kDir + "/reference_statistics.yaml")) GTEST_SKIP() << kDir << " missing";
+  MESHNAV_REQUIRE_SHARED_DATA(kDir + "/reference_statistics.yaml");
   const auto ref = readReferenceStatistics(kDir + "/reference_statistics.yaml");
   EXPECT_EQ(ref.size(), 12u);  // 4 devices, every ordered pair
   EXPECT_DOUBLE_EQ(ref.at({1, 2}).bias_table_m, 0.41);
@@ -39,7 +41,7 @@ TEST(RealRecording, ReferenceStatisticsFileIsRead) {
 }
 
 TEST(RealRecording, BiasAndNoiseMatchTheToolboxPerOrderedPair) {
-  if (!std::filesystem::exists(kDir + "/reference_statistics.yaml")) GTEST_SKIP() << kDir << " missing";
+  MESHNAV_REQUIRE_SHARED_DATA(kDir + "/reference_statistics.yaml");
   Diagnostics diag;
   diag.max_logged_per_kind = 0;
   const auto in = loadRangeEvaluationInput(kDir, diag);
@@ -66,7 +68,7 @@ TEST(RealRecording, BiasAndNoiseMatchTheToolboxPerOrderedPair) {
 }
 
 TEST(RealRecording, AnchorPositionsFromToolboxConfig) {
-  if (!std::filesystem::exists(kDir + "/config.yaml")) GTEST_SKIP() << kDir << " missing";
+  MESHNAV_REQUIRE_SHARED_DATA(kDir + "/config.yaml");
   const auto a = readAbsAnchorPositions(kDir + "/config.yaml");
   ASSERT_EQ(a.size(), 3u);
   EXPECT_TRUE(a.at(3).isApprox(Eigen::Vector3d(2.928, 2.47, 2.153)));

@@ -4,19 +4,25 @@
 
 #include <vector>
 
+#include "meshnav/anchor_estimate_t.hpp"
 #include "meshnav/anchor_init_t.hpp"
 #include "meshnav/anchors_t.hpp"
 #include "meshnav/baro_t.hpp"
+#include "meshnav/calib_anchor_status_t.hpp"
 #include "meshnav/calib_cmd_t.hpp"
 #include "meshnav/calib_status_t.hpp"
+#include "meshnav/counter_t.hpp"
 #include "meshnav/estimator_cmd_t.hpp"
 #include "meshnav/estimator_status_t.hpp"
 #include "meshnav/flight_state_t.hpp"
 #include "meshnav/ground_truth_t.hpp"
 #include "meshnav/imu_t.hpp"
+#include "meshnav/instance_status_t.hpp"
 #include "meshnav/mission_status_t.hpp"
+#include "meshnav/pair_bias_t.hpp"
 #include "meshnav/pose_t.hpp"
 #include "meshnav/range_t.hpp"
+#include "meshnav/timing_t.hpp"
 
 namespace {
 
@@ -140,7 +146,11 @@ TEST(LcmTypes, FingerprintsAreDistinct) {
       meshnav::anchors_t::getHash(),      meshnav::anchor_init_t::getHash(),
       meshnav::estimator_status_t::getHash(), meshnav::estimator_cmd_t::getHash(),
       meshnav::calib_cmd_t::getHash(),    meshnav::calib_status_t::getHash(),
-      meshnav::mission_status_t::getHash()};
+      meshnav::mission_status_t::getHash(), meshnav::anchor_estimate_t::getHash(),
+      meshnav::calib_anchor_status_t::getHash(), meshnav::counter_t::getHash(),
+      meshnav::instance_status_t::getHash(), meshnav::pair_bias_t::getHash(),
+      meshnav::timing_t::getHash()};
+  ASSERT_EQ(hashes.size(), 19u);  // every type in lcmtypes/types
   for (size_t i = 0; i < hashes.size(); ++i)
     for (size_t j = i + 1; j < hashes.size(); ++j) EXPECT_NE(hashes[i], hashes[j]) << i << " vs " << j;
 }

@@ -2,6 +2,8 @@
 // type columns as ASCII codes 65/84), merged and time-sorted; and small files written here.
 #include <gtest/gtest.h>
 
+#include "tests/support/shared_data.h"
+
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -34,7 +36,7 @@ fs::path writeFile(const std::string& name, const std::string& content) {
 }  // namespace
 
 TEST(RangeCsvImport, RealRecordingMergesFourDevices) {
-  if (!fs::exists(kReal / "d01_ranges.csv")) GTEST_SKIP() << kReal << " is absent";
+  MESHNAV_REQUIRE_SHARED_DATA(kReal / "d01_ranges.csv");
   std::vector<std::string> files;
   int64_t rows = 0;
   for (const char* f : {"a01_ranges.csv", "a02_ranges.csv", "a03_ranges.csv", "d01_ranges.csv"}) {
