@@ -9,16 +9,9 @@
 /// Consecutive filter errors are strongly correlated, so for long runs the interval is narrow and
 /// mostly tells whether ε̄ ≈ d; it is reported as the convention the paper's toolbox uses.
 
+#include "common/chi_square.h"  // chi2Cdf, chi2Quantile (one implementation, Boost.Math)
+
 namespace meshnav::eval {
-
-/// Regularized lower incomplete gamma function P(a, x) = γ(a, x) / Γ(a), a > 0, x ≥ 0.
-double regularizedGammaP(double a, double x);
-
-/// χ² cumulative distribution function with `dof` degrees of freedom at `x`.
-double chiSquareCdf(double x, double dof);
-
-/// Quantile (inverse CDF) of χ²(dof) at probability `p` ∈ (0, 1). Accurate to ~1e-10 relative.
-double chiSquareQuantile(double p, double dof);
 
 /// Two-sided acceptance interval of the ANEES of `n_samples` samples of dimension `dof` at
 /// confidence `confidence` (0.95 → 2.5 % and 97.5 % quantiles of χ²(n·dof), divided by n).

@@ -102,48 +102,7 @@ std::string formatValue(double v) {
   return s;
 }
 
-/// Regularized lower incomplete gamma P(a, x) (series / continued fraction, Numerical Recipes style).
-double gammaP(double a, double x) {
-  if (x <= 0.0) return 0.0;
-  const double gln = std::lgamma(a);
-  if (x < a + 1.0) {
-    double ap = a, sum = 1.0 / a, del = sum;
-    for (int n = 0; n < 500; ++n) {
-      ap += 1.0;
-      del *= x / ap;
-      sum += del;
-      if (std::abs(del) < std::abs(sum) * 1e-15) break;
-    }
-    return sum * std::exp(-x + a * std::log(x) - gln);
-  }
-  double b = x + 1.0 - a, c = 1.0 / 1e-300, d = 1.0 / b, h = d;
-  for (int i = 1; i < 500; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < 1e-300) d = 1e-300;
-    c = b + an / c;
-    if (std::abs(c) < 1e-300) c = 1e-300;
-    d = 1.0 / d;
-    const double del = d * c;
-    h *= del;
-    if (std::abs(del - 1.0) < 1e-15) break;
-  }
-  return 1.0 - std::exp(-x + a * std::log(x) - gln) * h;
-}
-
 }  // namespace
-
-double chi2Quantile(int dof, double p) {
-  if (dof <= 0 || !(p > 0.0 && p < 1.0)) throw std::invalid_argument("chi2Quantile: need dof > 0 and 0 < p < 1");
-  double lo = 0.0, hi = std::max(10.0, 10.0 * dof);
-  while (gammaP(0.5 * dof, 0.5 * hi) < p) hi *= 2.0;
-  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (gammaP(0.5 * dof, 0.5 * mid) < p ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
 
 EstimatorOptions EstimatorOptions::fromYaml(const std::string& path) {
   YAML::Node root;

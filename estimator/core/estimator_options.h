@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "common/chi_square.h"
 #include "common/setup.h"
 #include "estimator/health/health_monitor.h"
 
@@ -128,7 +129,7 @@ struct EstimatorOptions {
   std::string toString() const;
 };
 
-/// χ² quantile: x with P(χ²_dof ≤ x) = p (0 < p < 1).
-double chi2Quantile(int dof, double p);
+/// χ² quantile (common/chi_square.h, Boost.Math).
+using meshnav::chi2Quantile;
 
 }  // namespace meshnav::estimator

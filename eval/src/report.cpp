@@ -224,7 +224,7 @@ std::string formatRunReport(const RunEvaluation& ev) {
               formatNumber(ev.anchors->mean_initial_error_m, 3), formatNumber(ev.anchors->mean_final_error_m, 3), "", "", ""});
     os << t.plain();
     os << "  (single NEES, 3 dof: " << formatNumber(100.0 * conf, 0) << " % interval " << fmtBounds(single, 3)
-       << ", 99.7 % threshold " << formatNumber(chiSquareQuantile(0.997, 3), 2) << ")\n\n";
+       << ", 99.7 % threshold " << formatNumber(chi2Quantile(3, 0.997), 2) << ")\n\n";
   } else {
     os << "  anchor errors: not available\n\n";
   }
