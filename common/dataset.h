@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "common/plausibility.h"
 #include "common/setup.h"
 #include "common/types.h"
 
@@ -28,8 +29,8 @@ struct Dataset {
 
 /// Limits used when validating ranges [m].
 struct RangeLimits {
-  double min_m = -0.5;   ///< biased short ranges can be slightly negative; below this is absurd
-  double max_m = 500.0;  ///< beyond this a UWB range is absurd
+  double min_m = plausible::kMinRange_m;  ///< biased short ranges can be slightly negative
+  double max_m = plausible::kMaxRange_m;  ///< beyond this a UWB range is absurd
 };
 
 std::vector<ImuSample> readImuCsv(const std::string& path, Diagnostics& diag);

@@ -1,4 +1,5 @@
 #include "calibrator/node/calibrator_node.h"
+#include "common/plausibility.h"
 
 #include <spdlog/spdlog.h>
 
@@ -15,9 +16,9 @@ namespace meshnav::calib {
 
 namespace {
 
-/// Range sanity limits [m] (as the dataset reader's RangeLimits).
-constexpr double kMinRangeM = -0.5;
-constexpr double kMaxRangeM = 500.0;
+/// Range sanity limits [m]: the project's one table (common/plausibility.h).
+constexpr double kMinRangeM = plausible::kMinRange_m;
+constexpr double kMaxRangeM = plausible::kMaxRange_m;
 
 /// Extra slack before the pose history is trimmed, so that trimming is amortised [s].
 constexpr double kPruneSlackS = 10.0;

@@ -1,4 +1,5 @@
 #include "common/dataset.h"
+#include "common/plausibility.h"
 
 #include <spdlog/spdlog.h>
 
@@ -114,7 +115,7 @@ std::vector<ImuSample> readImuCsv(const std::string& path, Diagnostics& diag) {
           v[i] = *x;
         }
         ImuSample s{*t, {v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
-        if (s.acc_m_s2.norm() > 500.0 || s.gyro_rad_s.norm() > 50.0) {
+        if (s.acc_m_s2.norm() > plausible::kMaxSpecificForce_m_s2 || s.gyro_rad_s.norm() > plausible::kMaxAngularRate_rad_s) {
           diag.report(key + ":absurd_value", r.where() + ": IMU reading beyond 500 m/s^2 or 50 rad/s; row skipped");
           return;
         }
@@ -126,7 +127,8 @@ std::vector<ImuSample> readImuCsv(const std::string& path, Diagnostics& diag) {
 }
 
 std::vector<BaroSample> readBaroCsv(const std::string& path, Diagnostics& diag) {
-  return readTimeValueCsv<BaroSample>(path, "pressure", 1000.0, 200000.0, "a plausible pressure in Pa", diag);
+  return readTimeValueCsv<BaroSample>(path, "pressure", plausible::kMinPressure_pa, plausible::kMaxPressure_pa,
+                                       "a plausible pressure in Pa", diag);
 }
 
 std::vector<RangeSample> readRangesCsv(const std::string& path, Diagnostics& diag, const RangeLimits& limits) {
@@ -217,7 +219,7 @@ std::vector<FlightStateSample> readFlightStateCsv(const std::string& path, Diagn
 }
 
 std::vector<HeightSample> readHeightCsv(const std::string& path, Diagnostics& diag) {
-  return readTimeValueCsv<HeightSample>(path, "range_m", 0.0, 100.0, "a height in [0, 100] m", diag);
+  return readTimeValueCsv<HeightSample>(path, "range_m", 0.0, plausible::kMaxHeight_m, "a height in [0, 100] m", diag);
 }
 
 std::vector<PoseSample> readTumCsv(const std::string& path, Diagnostics& diag) {

@@ -1,4 +1,5 @@
 #include "estimator/node/estimator_node.h"
+#include "common/plausibility.h"
 
 #include <spdlog/spdlog.h>
 
@@ -100,11 +101,12 @@ bool EstimatorNode::validate(const EstimatorInput& in) {
   std::string bad;
   Timestamp t = inputTime(in);
   if (const auto* s = std::get_if<ImuSample>(&in)) {
-    if (!s->acc_m_s2.allFinite() || !s->gyro_rad_s.allFinite() || s->acc_m_s2.norm() > 2000.0 ||
-        s->gyro_rad_s.norm() > 100.0)
+    if (!s->acc_m_s2.allFinite() || !s->gyro_rad_s.allFinite() ||
+        s->acc_m_s2.norm() > plausible::kMaxSpecificForce_m_s2 || s->gyro_rad_s.norm() > plausible::kMaxAngularRate_rad_s)
       bad = where("IMU", t) + ": non-finite or absurd reading";
   } else if (const auto* s = std::get_if<BaroSample>(&in)) {
-    if (!std::isfinite(s->pressure_pa) || s->pressure_pa < 1000.0 || s->pressure_pa > 200000.0)
+    if (!std::isfinite(s->pressure_pa) || s->pressure_pa < plausible::kMinPressure_pa ||
+        s->pressure_pa > plausible::kMaxPressure_pa)
       bad = where("BARO", t) + ": non-finite or absurd pressure " + std::to_string(s->pressure_pa);
   } else if (const auto* s = std::get_if<RangeSample>(&in)) {
     const double z = options_.uwb.use_corrected_range ? s->range_corr_m : s->range_m;
