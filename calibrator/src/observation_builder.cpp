@@ -4,16 +4,9 @@
 #include <cmath>
 
 #include "common/pose_interpolation.h"
+#include "common/skew.h"
 
 namespace meshnav::calib {
-
-namespace {
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
-}  // namespace
 
 ObservationBuilder::ObservationBuilder(SystemSetup setup, const CalibratorOptions& options)
     : setup_(std::move(setup)), options_(options) {}

@@ -10,14 +10,12 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "common/skew.h"
+
 namespace meshnav::estimator::so3 {
 
-/// [v]×: skew-symmetric matrix with [v]× w = v × w.
-inline Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
+/// [v]×: skew-symmetric matrix with [v]× w = v × w (common/skew.h).
+using meshnav::skew;
 
 /// Exp(φ) as a unit quaternion.
 inline Eigen::Quaterniond expQuat(const Eigen::Vector3d& phi) {
