@@ -183,6 +183,11 @@ pose_t toLcm(const PoseEstimate& s) {
   return m;
 }
 PoseEstimate fromLcm(const pose_t& m) {
+  for (const auto* f : {&m.p_IinG, &m.v_IinG, &m.bias_gyro, &m.bias_acc}) requireFinite(*f, "pose_t vector");
+  requireFinite(m.q_ItoG, "q_ItoG");
+  requireFinite(m.cov_p, "cov_p");
+  requireFinite(m.cov_v, "cov_v");
+  requireFinite(m.cov_theta, "cov_theta");
   PoseEstimate s;
   s.t = Timestamp::fromUtime(m.utime);
   s.p_IinG = get3(m.p_IinG);
@@ -205,6 +210,8 @@ anchor_estimate_t toLcm(const AnchorEstimate& s) {
   return m;
 }
 AnchorEstimate fromLcm(const anchor_estimate_t& m) {
+  requireFinite(m.p_AinG, "p_AinG");
+  requireFinite(m.cov_p, "cov_p");
   AnchorEstimate s;
   s.t = Timestamp::fromUtime(m.utime);
   s.id = m.id;
@@ -365,17 +372,16 @@ EstimatorCommand fromLcm(const estimator_cmd_t& m) {
     default: throw InvalidMessage("unknown estimator command action " + std::to_string(m.action));
   }
   s.id = m.id;
-  // The anchor part only matters for AddAnchor; an unused (zero) one must not be rejected.
+  // The anchor part is decoded by the one anchor_init_t conversion, with its checks. It only matters
+  // for AddAnchor: for the other actions an invalid one is dropped rather than rejecting the command.
   if (s.action == EstimatorCommand::Action::AddAnchor) {
     s.anchor = fromLcm(m.anchor);
   } else {
-    s.anchor.t = Timestamp::fromUtime(m.anchor.utime);
-    s.anchor.id = m.anchor.id;
-    s.anchor.p_AinG = get3(m.anchor.p_AinG);
-    s.anchor.cov_p_m2 = get33(m.anchor.cov_p);
-    for (const auto& b : m.anchor.biases) s.anchor.biases.push_back(fromLcm(b));
-    s.anchor.n_inliers = m.anchor.num_inliers;
-    s.anchor.n_outliers = m.anchor.num_outliers;
+    try {
+      s.anchor = fromLcm(m.anchor);
+    } catch (const InvalidMessage&) {
+      s.anchor = AnchorInit{};
+    }
   }
   return s;
 }

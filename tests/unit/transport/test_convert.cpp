@@ -298,4 +298,18 @@ TEST(Convert, InvalidMeasurementsThrow) {
   auto init = toLcm(someAnchorInit());
   init.biases[0].gamma = nan;
   EXPECT_THROW(fromLcm(init), InvalidMessage);
+  auto pose = toLcm(PoseEstimate{});
+  pose.cov_p[4] = nan;
+  EXPECT_THROW(fromLcm(pose), InvalidMessage);
+  pose = toLcm(PoseEstimate{});
+  pose.v_IinG[2] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(fromLcm(pose), InvalidMessage);
+  AnchorEstimate a;
+  a.id = 106;
+  auto est = toLcm(a);
+  est.p_AinG[0] = nan;
+  EXPECT_THROW(fromLcm(est), InvalidMessage);
+  auto add = toLcm(EstimatorCommand{});  // AddAnchor: the anchor is decoded with its checks
+  add.anchor.p_AinG[1] = nan;
+  EXPECT_THROW(fromLcm(add), InvalidMessage);
 }
