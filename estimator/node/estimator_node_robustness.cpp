@@ -108,6 +108,9 @@ void EstimatorNode::feedAligner(const EstimatorInput& in) {
     if (!have_flight_state_ && options_.zupt.detect_stillness) {
       const bool still = still_detector_.add(*s);
       still_at_[s->t.us] = still;
+      // Kept for rewinds within the window (also pruned there); bounded while not initialized too.
+      const int64_t oldest_us = s->t.us - Duration::fromSec(options_.window_s + 1.0).us;
+      while (!still_at_.empty() && still_at_.begin()->first < oldest_us) still_at_.erase(still_at_.begin());
       if (!initialized()) initializer_->addStillness(still);
     }
   } else if (std::holds_alternative<FlightStateSample>(in)) {
