@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 #include "common/skew.h"
@@ -49,6 +50,19 @@ inline Eigen::Matrix3d rightJacobian(const Eigen::Vector3d& phi) {
   const double t2 = theta * theta;
   return Eigen::Matrix3d::Identity() - (1.0 - std::cos(theta)) / t2 * K +
          (theta - std::sin(theta)) / (t2 * theta) * K * K;
+}
+
+/// Heading ψ of a body attitude: the angle of its x axis projected on the horizontal plane of G.
+inline double yawOf(const Eigen::Quaterniond& q_ItoG) {
+  const Eigen::Matrix3d R = q_ItoG.toRotationMatrix();
+  return std::atan2(R(1, 0), R(0, 0));
+}
+
+/// Variance of the heading for a local attitude error δθ (R = R̂ Exp(δθ)) of covariance Σ_θ:
+/// a rotation about G's z is δθ along n = R̂ᵀ e_z, so σ_ψ² = nᵀ Σ_θ n (≥ 0).
+inline double yawVariance(const Eigen::Quaterniond& q_ItoG, const Eigen::Matrix3d& Sigma_theta) {
+  const Eigen::Vector3d n = q_ItoG.conjugate() * Eigen::Vector3d::UnitZ();
+  return std::max(n.dot(Sigma_theta * n), 0.0);
 }
 
 }  // namespace meshnav::estimator::so3

@@ -438,8 +438,9 @@ EstimatorStatus EstimatorNode::status() const {
     const auto [sigma_p, axis] = weakestPositionAxis(P.block<3, 3>(ImuErr::kP, ImuErr::kP));
     s.sigma_p_max_m = sigma_p;
     s.weak_axis_G = axis;
-    const Eigen::Vector3d n = cur_.filter->state().imu.q_ItoG.conjugate() * Eigen::Vector3d::UnitZ();
-    s.sigma_yaw_deg = std::sqrt(std::max(n.dot(P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) * n), 0.0)) * 180.0 / M_PI;
+    s.sigma_yaw_deg =
+        std::sqrt(so3::yawVariance(cur_.filter->state().imu.q_ItoG, P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta))) *
+        180.0 / M_PI;
   }
   return s;
 }

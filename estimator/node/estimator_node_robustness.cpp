@@ -75,16 +75,15 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   init_time_ = b.t;
   health_.reset(b.t);
   newest_ = newest_ ? std::max(*newest_, b.t) : b.t;
-  const Eigen::Matrix3d R0 = b.imu.q_ItoG.toRotationMatrix();
-  const double yaw_deg = std::atan2(R0(1, 0), R0(0, 0)) * 180.0 / M_PI;
+  const double yaw_deg = so3::yawOf(b.imu.q_ItoG) * 180.0 / M_PI;
+  const double sigma_yaw_deg =
+      std::sqrt(so3::yawVariance(b.imu.q_ItoG, b.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta))) * 180.0 / M_PI;
   spdlog::info(
       "estimator: initialized at t={} from {} p_IinG=[{:.3f}, {:.3f}, {:.3f}] m, yaw {:.1f} deg (σ_p {:.2f} m, "
       "σ_yaw {:.1f} deg){}",
       formatSeconds(b.t), b.from_ranges ? "ranges" : "initial_pose", b.imu.p_IinG.x(), b.imu.p_IinG.y(),
       b.imu.p_IinG.z(), yaw_deg, weakestPositionAxis(b.cov.block<3, 3>(ImuErr::kP, ImuErr::kP)).first,
-      std::sqrt((R0.transpose() * Eigen::Vector3d::UnitZ())
-                    .dot(b.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) * (R0.transpose() * Eigen::Vector3d::UnitZ()))) *
-          180.0 / M_PI,
+      sigma_yaw_deg,
       b.from_ranges ? fmt::format(", {} ranges, rms {:.3f} m", b.n_ranges_used, b.range_fit_rms_m) : "");
   if (!baro_reference_pa_ && options_.baro.enabled)
     spdlog::warn("estimator: no baro reference pressure (none in setup, no landed baro data): baro unused");
@@ -222,20 +221,13 @@ void EstimatorNode::updateHealth(Timestamp t) {
 double EstimatorNode::disagreement(const AlignmentResult& r) const {
   const ImuState& x = cur_.filter->state().imu;
   const Eigen::MatrixXd P = cur_.filter->covariance(setup_.imu_id, setup_.imu_id);
-  auto yawOf = [](const Eigen::Quaterniond& q) {
-    const Eigen::Matrix3d R = q.toRotationMatrix();
-    return std::atan2(R(1, 0), R(0, 0));
-  };
-  auto yawVar = [](const Eigen::Quaterniond& q, const Eigen::MatrixXd& cov) {
-    const Eigen::Vector3d n = q.conjugate() * Eigen::Vector3d::UnitZ();
-    return n.dot(cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) * n);
-  };
   Eigen::Vector4d d;
   d.head<3>() = r.imu.p_IinG - x.p_IinG;
-  d(3) = std::remainder(yawOf(r.imu.q_ItoG) - yawOf(x.q_ItoG), 2.0 * M_PI);
+  d(3) = std::remainder(so3::yawOf(r.imu.q_ItoG) - so3::yawOf(x.q_ItoG), 2.0 * M_PI);
   Eigen::Matrix4d S = Eigen::Matrix4d::Zero();
   S.topLeftCorner<3, 3>() = P.block<3, 3>(ImuErr::kP, ImuErr::kP) + r.cov.block<3, 3>(ImuErr::kP, ImuErr::kP);
-  S(3, 3) = yawVar(x.q_ItoG, P) + yawVar(r.imu.q_ItoG, r.cov);
+  S(3, 3) = so3::yawVariance(x.q_ItoG, P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta)) +
+            so3::yawVariance(r.imu.q_ItoG, r.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta));
   return d.dot(S.ldlt().solve(d));
 }
 

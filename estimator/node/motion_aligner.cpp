@@ -6,13 +6,13 @@
 #include <limits>
 #include <set>
 
+#include "estimator/core/huber.h"
 #include "estimator/core/so3.h"
 
 namespace meshnav::estimator {
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
-constexpr double kHuberK = 2.0;  ///< Huber threshold in σ
 constexpr size_t kMaxObservations = 400;
 constexpr int kDim = 15;
 using Vec15 = Eigen::Matrix<double, kDim, 1>;
@@ -40,13 +40,7 @@ MotionAligner::Increments advance(const MotionAligner::Increments& a, const Eige
   return b;
 }
 
-/// Huber cost of a normalized residual e = r/σ.
-double huber(double e) {
-  const double a = std::abs(e);
-  return a <= kHuberK ? e * e : 2.0 * kHuberK * a - kHuberK * kHuberK;
-}
 
-double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
 }  // namespace
 
 MotionAligner::Unknowns MotionAligner::Unknowns::plus(const Vec15& d) const {
@@ -147,7 +141,7 @@ double MotionAligner::fit(const std::vector<Obs>& obs, Unknowns& x, Mat15* info)
   auto cost = [&](const Unknowns& u) {
     double c = prior_ba * u.ba.squaredNorm() + prior_bg * u.dbg.squaredNorm();
     for (const Obs& o : obs)
-      if (o.use) c += huber(residual(o, u) / o.r.sigma_m);
+      if (o.use) c += huber::cost(residual(o, u) / o.r.sigma_m);
     return c;
   };
   double c = cost(x), lambda = 1e-3;
@@ -159,7 +153,7 @@ double MotionAligner::fit(const std::vector<Obs>& obs, Unknowns& x, Mat15* info)
       if (!o.use) continue;
       const double r = residual(o, x);
       const double e = std::abs(r) / o.r.sigma_m;
-      const double w = (e <= kHuberK ? 1.0 : kHuberK / e) / (o.r.sigma_m * o.r.sigma_m);
+      const double w = huber::weight(e) / (o.r.sigma_m * o.r.sigma_m);
       const Eigen::Matrix<double, 1, 15> J = jacobian(o, x);
       H += w * J.transpose() * J;
       g += w * J.transpose() * r;
@@ -213,7 +207,7 @@ std::vector<MotionAligner::Unknowns> MotionAligner::starts(const std::vector<Obs
   // Static position fit (the window's mean position), multi-start.
   auto staticCost = [&](const Eigen::Vector3d& p) {
     double c = 0.0;
-    for (const Obs& o : obs) c += huber((o.r.d_m - (o.r.p_AinG - p).norm()) / o.r.sigma_m);
+    for (const Obs& o : obs) c += huber::cost((o.r.d_m - (o.r.p_AinG - p).norm()) / o.r.sigma_m);
     return c;
   };
   auto staticFit = [&](Eigen::Vector3d p) {
@@ -301,7 +295,7 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
   }
   std::sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
   auto distinct = [&](const ImuState& a, const ImuState& b) {
-    const double dyaw = std::remainder(yawOf(a.q_ItoG.toRotationMatrix()) - yawOf(b.q_ItoG.toRotationMatrix()), 2 * M_PI);
+    const double dyaw = std::remainder(so3::yawOf(a.q_ItoG) - so3::yawOf(b.q_ItoG), 2 * M_PI);
     return (a.p_IinG - b.p_IinG).norm() > 0.5 || std::abs(dyaw) > 15.0 * kDeg;
   };
   // Outliers by the best candidate, then refit the best and the best distinct rival on the inliers.
@@ -370,8 +364,7 @@ std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs
   }
   res.n_anchors = static_cast<int>(used_anchors.size());
   res.rms_m = res.n_ranges ? std::sqrt(sq / res.n_ranges) : 0.0;
-  const Eigen::Vector3d n = e0.q_ItoG.conjugate() * Eigen::Vector3d::UnitZ();
-  res.sigma_yaw_deg = std::sqrt(n.dot(res.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) * n)) / kDeg;
+  res.sigma_yaw_deg = std::sqrt(so3::yawVariance(e0.q_ItoG, res.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta))) / kDeg;
   res.sigma_p_m = std::sqrt(res.cov.block<3, 3>(ImuErr::kP, ImuErr::kP).diagonal().maxCoeff());
   if (!res.cov.allFinite() || res.sigma_yaw_deg > options_.max_sigma_yaw_deg || res.sigma_p_m > options_.max_sigma_p_m) {
     reason_ = "motion alignment: pose not determined yet (σ_yaw " + std::to_string(res.sigma_yaw_deg) + " deg, σ_p " +

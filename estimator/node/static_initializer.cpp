@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/atmosphere.h"
+#include "estimator/core/huber.h"
 
 namespace meshnav::estimator {
 
@@ -198,11 +199,11 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
         J.head<3>() = u;
         J(3) = u.dot(Eigen::Vector3d::UnitZ().cross(lever));
         // Huber (k = 2σ): NLOS outliers must not pick the minimum (a 109° yaw error in hover).
-        const double e = std::abs(res) / r.sigma_m;
-        const double w = (e <= 2.0 ? 1.0 : 2.0 / e) / (r.sigma_m * r.sigma_m);
+        const double e = res / r.sigma_m;
+        const double w = huber::weight(e) / (r.sigma_m * r.sigma_m);
         A += w * J * J.transpose();
         g += w * J * res;
-        cost += e <= 2.0 ? e * e : 4.0 * e - 4.0;
+        cost += huber::cost(e);
       }
       A.diagonal().array() += 1e-9;
       A(3, 3) += 1.0 / (M_PI * M_PI);  // weak yaw prior: one tag leaves yaw (nearly) unobservable
