@@ -186,10 +186,10 @@ int main(int argc, char** argv) {
     if (!node.initialized()) spdlog::error("the estimator never initialized: {}", node.waitingFor());
     if (auto pose = node.pose())
       spdlog::info("final: p_IinG [{:.3f}, {:.3f}, {:.3f}] m, b_gyro [{:.5f}, {:.5f}, {:.5f}] rad/s, "
-                   "b_acc [{:.4f}, {:.4f}, {:.4f}] m/s^2",
+                   "b_acc [{:.4f}, {:.4f}, {:.4f}] m/s^2, IMU noise scale {:.3g}",
                    pose->p_IinG.x(), pose->p_IinG.y(), pose->p_IinG.z(), pose->bias_gyro_rad_s.x(),
                    pose->bias_gyro_rad_s.y(), pose->bias_gyro_rad_s.z(), pose->bias_acc_m_s2.x(),
-                   pose->bias_acc_m_s2.y(), pose->bias_acc_m_s2.z());
+                   pose->bias_acc_m_s2.y(), pose->bias_acc_m_s2.z(), node.processNoiseScale());
     std::string counters;
     for (const auto& [k, v] : st.counters) counters += fmt::format("{}={} ", k, v);
     spdlog::info("counters: {}", counters);

@@ -76,6 +76,15 @@ void forEachField(Opt& o, Visitor&& v) {
   v("health.lost_no_aiding_s", o.health.lost_no_aiding_s, "no accepted range for this long: lost [s]");
   v("health.lost_sigma_p_m", o.health.lost_sigma_p_m, "largest position sigma beyond which the pose is lost [m]");
   v("health.hold_s", o.health.hold_s, "a better health must hold this long [s]");
+  v("process_noise.adapt", o.process_noise.enabled, "scale the IMU noise densities to the range innovations");
+  v("process_noise.batch", o.process_noise.batch, "tag-anchor ranges per decision [-]");
+  v("process_noise.upper_ratio", o.process_noise.upper_ratio, "median NIS ratio above which the scale grows [-]");
+  v("process_noise.lower_ratio", o.process_noise.lower_ratio, "median NIS ratio below which the scale shrinks [-]");
+  v("process_noise.max_grow", o.process_noise.max_grow, "largest growth of the scale per decision (factor) [-]");
+  v("process_noise.max_shrink", o.process_noise.max_shrink, "largest shrink of the scale per decision (factor) [-]");
+  v("process_noise.max_scale", o.process_noise.max_scale, "largest variance scale [-]");
+  v("process_noise.max_prior_ratio", o.process_noise.max_prior_ratio,
+    "no growth while the median predicted range variance HPH'/R exceeds this [-]");
   v("recovery.enabled", o.recovery.enabled, "re-initialize from ranges and IMU when lost");
   v("recovery.retry_s", o.recovery.retry_s, "between two attempts while lost or degraded [s]");
   v("recovery.degraded_disagreement_chi2", o.recovery.degraded_disagreement_chi2,
@@ -168,6 +177,9 @@ void EstimatorOptions::validate() const {
   need(baro.gate_probability >= 0 && baro.gate_probability < 1, "baro.gate_probability in [0, 1)");
   need(uwb.sigma_range_m > 0 && uwb.max_range_m > 0, "uwb.sigma_range_m > 0, uwb.max_range_m > 0");
   need(uwb.gate_probability >= 0 && uwb.gate_probability < 1, "uwb.gate_probability in [0, 1)");
+  need(process_noise.batch >= 5 && process_noise.upper_ratio > 1.0 && process_noise.lower_ratio > 0.0 &&
+           process_noise.lower_ratio < 1.0 && process_noise.max_grow > 1.0 && process_noise.max_shrink > 1.0 && process_noise.max_scale >= 1.0 && process_noise.max_prior_ratio > 0.0,
+       "process_noise: batch >= 5, lower_ratio in (0, 1), upper_ratio > 1, max_grow > 1, max_shrink > 1, max_scale >= 1, max_prior_ratio > 0");
   need(zupt.rate_hz > 0 && zupt.sigma_acc_m_s2 > 0 && zupt.sigma_gyro_rad_s > 0 && zupt.sigma_vel_m_s > 0,
        "zupt rate and sigmas > 0");
 }

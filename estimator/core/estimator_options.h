@@ -9,6 +9,7 @@
 #include "common/chi_square.h"
 #include "common/setup.h"
 #include "estimator/health/health_monitor.h"
+#include "estimator/imu/process_noise_adapter.h"
 
 namespace meshnav::estimator {
 
@@ -116,6 +117,7 @@ struct EstimatorOptions {
   UwbOptions uwb;
   ZuptOptions zupt;
   HealthOptions health;
+  ProcessNoiseAdaptOptions process_noise;
   RecoveryOptions recovery;
 
   /// Loads every key from `path`; throws std::runtime_error("<path>: missing key 'a.b'") etc.

@@ -41,6 +41,7 @@ EstimatorNode::Snapshot EstimatorNode::Snapshot::copy() const {
   s.last_imu = last_imu;
   s.landed = landed;
   s.last_zupt = last_zupt;
+  s.noise_adapter = noise_adapter;
   return s;
 }
 
@@ -82,6 +83,7 @@ void EstimatorNode::resetAll() {
   last_align_try_.reset();
   last_recovery_try_.reset();
   cur_ = Snapshot{};
+  cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);
   cur_.network = std::make_shared<const UwbNetwork>(setup_, options_.uwb.sigma_range_m);
   history_.clear();
   baro_reference_pa_.reset();
@@ -314,10 +316,19 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
     return;
   }
   const UpdateResult r = cur_.filter->update(lin, range_gate_);
+  const bool tag_range = cur_.network->isTag(z.a) || cur_.network->isTag(z.b);
+  // H P Hᵀ / R from NIS = ν²/S, S = H P Hᵀ + R (scalar range).
+  const double nu2 = lin.residual(0) * lin.residual(0), R = lin.R(0, 0);
+  const double prior_ratio = r.nis > 0.0 && R > 0.0 ? std::max(0.0, nu2 / r.nis - R) / R : 0.0;
+  if (tag_range && cur_.noise_adapter.onRangeNis(r.nis, prior_ratio) && first) {
+    diag_.count("process_noise_scale_change");
+    spdlog::info("estimator: IMU noise scale {:.3g} at t={} (median range NIS {:.2f} of its expected value)",
+                 cur_.noise_adapter.scale(), formatSeconds(s.t), cur_.noise_adapter.lastRatio());
+  }
   if (!first) return;
   if (!r.accepted) diag_.count("gated_range");
   // Tag ranges tell whether the pose is right; ranges between anchors do not.
-  if (cur_.network->isTag(z.a) || cur_.network->isTag(z.b))
+  if (tag_range)
     health_.onUpdate(s.t, "range", cur_.network->isTag(z.a) ? z.b : z.a, r.accepted, r.nis);
   else
     health_.onUpdate(s.t, "anchor_range", 0, r.accepted, r.nis);

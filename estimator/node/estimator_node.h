@@ -44,6 +44,7 @@
 #include "estimator/filter/fusion_strategy.h"
 #include "estimator/node/estimator_input.h"
 #include "estimator/health/health_monitor.h"
+#include "estimator/imu/process_noise_adapter.h"
 #include "estimator/node/motion_aligner.h"
 #include "estimator/node/static_initializer.h"
 #include "estimator/zupt/stillness_detector.h"
@@ -88,6 +89,8 @@ class EstimatorNode {
   const FusionStrategy* filter() const { return cur_.filter.get(); }
   /// Inputs currently held for out-of-sequence handling.
   size_t historySize() const { return history_.size(); }
+  /// Variance scale of the IMU white noise (ProcessNoiseAdapter), 1 when the densities fit.
+  double processNoiseScale() const { return cur_.noise_adapter.scale(); }
   Health health() const { return initialized() ? health_.health() : Health::Initializing; }
   const HealthMonitor& healthMonitor() const { return health_; }
   /// Why the node is not initialized yet (empty once it is).
@@ -104,6 +107,7 @@ class EstimatorNode {
     std::optional<ImuSample> last_imu;
     bool landed = true;
     Timestamp last_zupt;
+    ProcessNoiseAdapter noise_adapter;  ///< IMU noise scale from the range innovations
     Snapshot copy() const;
   };
   struct Entry {

@@ -15,6 +15,7 @@
 namespace meshnav::estimator {
 
 using node_internal::weakestPositionAxis;
+using node_internal::whiteImuNoise;
 
 void EstimatorNode::feedInitializer(const EstimatorInput& in) {
   std::visit(
@@ -182,20 +183,19 @@ void EstimatorNode::propagateFilter(const Eigen::Vector3d& acc, const Eigen::Vec
   FusionStrategy& f = *cur_.filter;
   const Timestamp t0 = f.state().t;
   f.propagate(acc, gyro, t);
+  // The IMU noise beyond its stated densities that the range innovations show (λ − 1 of it).
+  const double extra = cur_.noise_adapter.scale() - 1.0;
+  if (extra > 0.0 && t > t0)
+    f.addImuNoise(whiteImuNoise(extra * std::pow(options_.imu.acc_noise_density, 2),
+                                extra * std::pow(options_.imu.gyro_noise_density, 2), (t - t0).sec()));
   if (!cur_.last_imu) return;
   // Held readings beyond max_dt after the last sample: their error as white noise (velocity and
   // attitude random walk; position gets the integrated velocity noise).
   const Timestamp stale_from = std::max(t0, cur_.last_imu->t + Duration::fromSec(options_.imu.max_dt_s));
   const double dt = (t - stale_from).sec();
   if (dt <= 0.0) return;
-  const double qa = std::pow(options_.imu.gap_sigma_acc_m_s2, 2), qw = std::pow(options_.imu.gap_sigma_gyro_rad_s, 2);
-  ImuMatrix Q = ImuMatrix::Zero();
-  const Eigen::Matrix3d I3 = Eigen::Matrix3d::Identity();
-  Q.block<3, 3>(ImuErr::kP, ImuErr::kP) = I3 * qa * dt * dt * dt / 3.0;
-  Q.block<3, 3>(ImuErr::kP, ImuErr::kV) = Q.block<3, 3>(ImuErr::kV, ImuErr::kP) = I3 * qa * dt * dt / 2.0;
-  Q.block<3, 3>(ImuErr::kV, ImuErr::kV) = I3 * qa * dt;
-  Q.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) = I3 * qw * dt;
-  f.addImuNoise(Q);
+  f.addImuNoise(whiteImuNoise(std::pow(options_.imu.gap_sigma_acc_m_s2, 2),
+                              std::pow(options_.imu.gap_sigma_gyro_rad_s, 2), dt));
 }
 
 void EstimatorNode::updateHealth(Timestamp t) {

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "estimator/core/estimator_options.h"
+#include "estimator/core/imu_state.h"
 #include "estimator/node/motion_aligner.h"
 
 namespace meshnav::estimator::node_internal {
@@ -29,6 +30,19 @@ inline MotionAlignerOptions alignerOptions(const EstimatorOptions& o) {
   a.gravity_m_s2 = o.gravity_m_s2;
   a.max_imu_gap_s = o.imu.max_dt_s;
   return a;
+}
+
+/// Discrete covariance of white specific-force noise (density² qa [m²/s³]) and angular-rate
+/// noise (qw [rad²/s]) integrated over dt: velocity and attitude random walks, position the
+/// integrated velocity noise (qa dt³/3, cross term qa dt²/2).
+inline ImuMatrix whiteImuNoise(double qa, double qw, double dt) {
+  ImuMatrix Q = ImuMatrix::Zero();
+  const Eigen::Matrix3d I3 = Eigen::Matrix3d::Identity();
+  Q.block<3, 3>(ImuErr::kP, ImuErr::kP) = I3 * qa * dt * dt * dt / 3.0;
+  Q.block<3, 3>(ImuErr::kP, ImuErr::kV) = Q.block<3, 3>(ImuErr::kV, ImuErr::kP) = I3 * qa * dt * dt / 2.0;
+  Q.block<3, 3>(ImuErr::kV, ImuErr::kV) = I3 * qa * dt;
+  Q.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) = I3 * qw * dt;
+  return Q;
 }
 
 /// Largest principal position σ [m] and its direction (G).
