@@ -70,7 +70,7 @@ class IsasWalk1(unittest.TestCase):
         self.assertNotIn("pair_biases", setup)
         self.assertNotIn("baro", setup)
         self.assertNotIn("initial_pose", setup)
-        self.assertAlmostEqual(setup["noise"]["imu_gyro_noise_density"], math.radians(0.015))
+        self.assertAlmostEqual(setup["noise"]["imu_gyro_noise_density"], 10 * math.radians(0.015))
         truth = rs.read_yaml(os.path.join(self.out, "truth.yaml"))
         self.assertEqual(truth["truth_frame"], "vive/reference")
         self.assertIs(truth["align_required"], True)
