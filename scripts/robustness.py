@@ -11,7 +11,7 @@ answer when the data cannot fix the pose) and is not a divergence. Writes robust
 error_cdf.png into --out, prints a table, and exits 1 when any run diverged or a process failed
 (2 on usage errors).
 
-  robustness.py --runs N --seed S [--jobs 2] [--out DIR] [--strategy S] [--duration SEC]
+  robustness.py --runs N --seed S [--jobs 2] [--out DIR] [--strategy S] [--config FILE] [--duration SEC]
   robustness.py --scenarios FILE [--jobs 2] [--out DIR] [--strategy S]
 """
 
@@ -181,7 +181,7 @@ def run_command(cmd, log_path):
         return subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT)
 
 
-def run_scenario(sc, out_root, bin_dir, strategy):
+def run_scenario(sc, out_root, bin_dir, strategy, config=None):
     """Simulate, run, evaluate one scenario; returns a result dict (never raises)."""
     base = os.path.join(out_root, sc["name"])
     dataset, run = os.path.join(base, "dataset"), os.path.join(base, "run")
@@ -193,7 +193,7 @@ def run_scenario(sc, out_root, bin_dir, strategy):
         # --allow-lost: a run that ends lost is still evaluated (and counts as diverged by its error).
         ("meshnav_run", [os.path.join(bin_dir, "meshnav_run"), "--dataset", dataset, "--out", run, "--no-calibration",
                          "--allow-lost"]
-         + (["--strategy", strategy] if strategy else [])),
+         + (["--strategy", strategy] if strategy else []) + (["--config", config] if config else [])),
         ("meshnav_eval", [os.path.join(bin_dir, "meshnav_eval"), "--dataset", dataset, "--run", run, "--no-plots",
                           "--json", os.path.join(run, "metrics.json")]),
     ]
@@ -307,6 +307,7 @@ def parse_args(argv):
     p.add_argument("--jobs", type=int, default=2, help="runs in parallel (default 2)")
     p.add_argument("--out", default=os.path.join(ROOT, "out", "robustness"), help="output folder (default out/robustness)")
     p.add_argument("--strategy", choices=["centralized", "dp", "dah"], help="meshnav_run --strategy (default: its own)")
+    p.add_argument("--config", help="estimator options YAML for meshnav_run --config (default: its built-in defaults)")
     p.add_argument("--duration", type=float, default=90.0, help="sequence length of drawn scenarios [s] (default 90)")
     p.add_argument("--bin", default=os.path.join(os.environ.get("MESHNAV_BUILD_DIR", os.path.join(ROOT, "build")), "bin"),
                    help="folder of meshnav_sim, meshnav_run, meshnav_eval (default build/bin)")
@@ -319,6 +320,31 @@ def parse_args(argv):
     if a.jobs < 1:
         p.error("--jobs must be >= 1")
     return a
+
+
+def percentile(values, q):
+    """q-th percentile (0..100) with linear interpolation between order statistics."""
+    v = sorted(values)
+    if not v:
+        return float("nan")
+    k = (len(v) - 1) * q / 100.0
+    lo, hi = int(k), min(int(k) + 1, len(v) - 1)
+    return v[lo] + (v[hi] - v[lo]) * (k - lo)
+
+
+def summary_lines(results):
+    """The issue-8 target figures over the scored runs: median and 95th percentile of the
+    position RMSE, median position ANEES, median orientation RMSE of runs with two or more tags."""
+    scored = [r for r in results if r["ok"]]
+    if not scored:
+        return ["no scored run"]
+    rmse = [r["pos_rmse_m"] for r in scored]
+    anees = [r["pos_anees"] for r in scored if r["pos_anees"] == r["pos_anees"]]
+    ori2 = [r["ori_rmse_deg"] for r in scored if int(r["scenario"].get("tags", 2)) >= 2]
+    return ["scored runs: %d; position RMSE median %.3f m, 95th percentile %.3f m, max %.3f m"
+            % (len(scored), percentile(rmse, 50), percentile(rmse, 95), max(rmse)),
+            "position ANEES median %.2f (3 if consistent); orientation RMSE median with >= 2 tags %.2f deg (%d runs)"
+            % (percentile(anees, 50), percentile(ori2, 50), len(ori2))]
 
 
 def main(argv):
@@ -340,7 +366,7 @@ def main(argv):
     print("robustness: %d scenarios, %d in parallel, results in %s" % (len(scenarios), a.jobs, a.out), flush=True)
     results, lock = [None] * len(scenarios), threading.Lock()
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
-        futures = {pool.submit(run_scenario, sc, a.out, a.bin, a.strategy): i for i, sc in enumerate(scenarios)}
+        futures = {pool.submit(run_scenario, sc, a.out, a.bin, a.strategy, a.config): i for i, sc in enumerate(scenarios)}
         for done, fut in enumerate(concurrent.futures.as_completed(futures), 1):
             i = futures[fut]
             r = results[i] = fut.result()
@@ -356,6 +382,9 @@ def main(argv):
     write_csv(results, os.path.join(a.out, "robustness.csv"))
     png = os.path.join(a.out, "error_cdf.png")
     wrote_png = write_cdf_png(results, png)
+    print()
+    for line in summary_lines(results):
+        print(line)
     n_refused = sum(r["refused"] for r in results)
     n_failed = sum(not r["ok"] and not r["refused"] for r in results)
     n_div = sum(r["ok"] and r["diverged"] for r in results)
