@@ -29,6 +29,28 @@ def run_launch(text, *args, timeout=30):
         os.unlink(path)
 
 
+def run_until_then_sigterm(text, marker):
+    """Starts the supervisor on launch text `text`, reads its output until a line holding `marker`
+    (a condition, not a sleep), sends it SIGTERM. Returns (lines up to the marker, whether it was
+    still running then, exit code, output after the signal)."""
+    with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
+        f.write(text)
+    try:
+        p = subprocess.Popen([sys.executable, SUPERVISOR, f.name], stdout=subprocess.PIPE, text=True)
+        seen = []
+        for line in p.stdout:
+            seen.append(line)
+            if marker in line:
+                break
+        running = p.poll() is None
+        p.send_signal(signal.SIGTERM)
+        rest = p.stdout.read()
+        p.stdout.close()
+        return seen, running, p.wait(timeout=20), rest
+    finally:
+        os.unlink(f.name)
+
+
 class LaunchYaml(unittest.TestCase):
     def test_launch_file_is_read_as_yaml(self):
         doc = supervisor.load_yaml('''
@@ -195,23 +217,13 @@ processes:
         self.assertIn('cannot start ghost', out)
 
     def test_sigterm_stops_everything(self):
-        with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
-            f.write('processes:\n  - {name: a, command: "sh -c \'echo started; exec sleep 60\'"}\n'
-                    '  - {name: b, command: sleep 60, required: true}\n')
-        try:
-            p = subprocess.Popen([sys.executable, SUPERVISOR, f.name], stdout=subprocess.PIPE, text=True)
-            for line in p.stdout:  # wait for a condition: the child is up
-                if '[a] started' in line:
-                    break
-            p.send_signal(signal.SIGTERM)
-            rest = p.stdout.read()
-            p.stdout.close()
-            self.assertEqual(p.wait(timeout=20), 0, rest)
-            self.assertIn('stopping (signal 15)', rest)
-            self.assertIn('[supervisor] b exited', rest)
-        finally:
-            os.unlink(f.name)
-
+        _, running, rc, rest = run_until_then_sigterm(
+            'processes:\n  - {name: a, command: "sh -c \'echo started; exec sleep 60\'"}\n'
+            '  - {name: b, command: sleep 60, required: true}\n', '[a] started')
+        self.assertTrue(running)
+        self.assertEqual(rc, 0, rest)
+        self.assertIn('stopping (signal 15)', rest)
+        self.assertIn('[supervisor] b exited', rest)
 
 
 class Respawn(unittest.TestCase):
@@ -267,8 +279,7 @@ processes:
         self.assertNotIn('restarting long', out)  # stopped by the supervisor: not restarted
 
     def test_a_process_that_is_not_required_gives_up_while_the_others_run(self):
-        with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
-            f.write('''
+        seen, running, rc, rest = run_until_then_sigterm('''
 processes:
   - {name: nav, command: "sh -c 'echo nav up; exec sleep 60'", required: true, respawn: on-failure}
   - name: calib
@@ -276,26 +287,14 @@ processes:
     respawn: on-failure
     respawn_delay: 0.01
     max_respawns: 2
-''')
-        try:
-            p = subprocess.Popen([sys.executable, SUPERVISOR, f.name], stdout=subprocess.PIPE, text=True)
-            seen = []
-            for line in p.stdout:  # wait for the condition: calib has given up
-                seen.append(line)
-                if 'calib: no more respawns' in line:
-                    break
-            self.assertIn('[supervisor] calib: no more respawns (max_respawns 2)\n', seen)
-            self.assertEqual(sum('[calib] calib up' in line for line in seen), 3, seen)
-            self.assertFalse(any('nav exited' in line or 'stopping' in line for line in seen), seen)
-            self.assertIsNone(p.poll())  # the supervisor and nav still run
-            p.send_signal(signal.SIGTERM)
-            rest = p.stdout.read()
-            p.stdout.close()
-            self.assertEqual(p.wait(timeout=20), 0, rest)
-            self.assertIn('stopping (signal 15)', rest)
-            self.assertIn('[supervisor] nav exited', rest)
-        finally:
-            os.unlink(f.name)
+''', 'calib: no more respawns')  # the condition: calib has given up
+        self.assertIn('[supervisor] calib: no more respawns (max_respawns 2)\n', seen)
+        self.assertEqual(sum('[calib] calib up' in line for line in seen), 3, seen)
+        self.assertFalse(any('nav exited' in line or 'stopping' in line for line in seen), seen)
+        self.assertTrue(running)  # the supervisor and nav still ran
+        self.assertEqual(rc, 0, rest)
+        self.assertIn('stopping (signal 15)', rest)
+        self.assertIn('[supervisor] nav exited', rest)
 
     def test_shutdown_after_waits_for_the_last_restart(self):
         rc, out, _ = run_launch('''

@@ -12,7 +12,7 @@ ProcessMain::ProcessMain(std::string name, const std::string& description)
       ->type_name("URL");
   cli_.optional("log-level", log_level_, "log level (default: $MESHNAV_LOG_LEVEL, else info)")
       ->type_name("LEVEL")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "warning", "error", "critical", "off"}));
 }
 
 int ProcessMain::run(int argc, char** argv, const std::function<int()>& body) {
