@@ -72,6 +72,37 @@ CLI::Validator numberCheck(const std::string& description, bool (*ok)(double)) {
       description);
 }
 
+/// `text` with line breaks between words so that no line is longer than `width` (longer words stay).
+std::string wrap(const std::string& text, size_t width) {
+  std::string out, line, word;
+  auto flushWord = [&] {
+    if (word.empty()) return;
+    if (!line.empty() && line.size() + 1 + word.size() > width) {
+      out += line + "\n";
+      line.clear();
+    }
+    line += (line.empty() ? "" : " ") + word;
+    word.clear();
+  };
+  for (const char c : text) {
+    if (c == ' ' || c == '\n') {
+      flushWord();
+      if (c == '\n') {
+        out += line + "\n";
+        line.clear();
+      }
+    } else {
+      word += c;
+    }
+  }
+  flushWord();
+  return out + line;
+}
+
+/// Total width of --help lines [characters].
+constexpr size_t kHelpWidth = 100;
+constexpr size_t kHelpColumn = 30;
+
 /// --help lines as "  --name META   what it does; constraint (default X)": the default and the
 /// checks come from the declaration (CLI11's own layout puts them into the metavariable).
 class HelpFormatter : public CLI::Formatter {
@@ -93,7 +124,13 @@ class HelpFormatter : public CLI::Formatter {
       d += "; " + checks;
     }
     if (!opt->get_default_str().empty()) d += " (default " + opt->get_default_str() + ")";
-    return d;
+    return wrap(d, kHelpWidth - kHelpColumn);
+  }
+  std::string make_description(const CLI::App* app) const override {
+    return wrap(app->get_description(), kHelpWidth) + "\n\n";
+  }
+  std::string make_footer(const CLI::App* app) const override {
+    return app->get_footer().empty() ? std::string() : wrap(app->get_footer(), kHelpWidth) + "\n";
   }
 };
 
@@ -102,7 +139,7 @@ class HelpFormatter : public CLI::Formatter {
 Cli::Cli(std::string program, const std::string& description) : program_(std::move(program)), app_(description, program_) {
   app_.set_help_flag("-h,--help", "print this text and exit");
   auto formatter = std::make_shared<HelpFormatter>();
-  formatter->column_width(30);
+  formatter->column_width(kHelpColumn);
   app_.formatter(formatter);
 }
 
