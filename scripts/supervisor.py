@@ -1,22 +1,25 @@
 #!/usr/bin/env python3
-"""meshnav supervisor: runs the processes of a launch file (python3 standard library only).
+"""meshnav supervisor: runs the processes of a launch file (python3 and PyYAML).
 
 Usage: supervisor.py LAUNCH.yaml [VAR=value ...] [--dry-run] [--stop-timeout S]
 
-Launch file (YAML subset: block maps and lists, flow [..] and {..}, quoted strings, # comments):
+Launch file (YAML, read with yaml.safe_load; a key given twice is an error):
 
     name: demo
     stop_timeout: 5          # s between SIGTERM and SIGKILL when stopping (default 5)
-    shutdown_after: [imu_bridge, uwb_bridge]  # stop all once these have all exited ...
+    shutdown_after: [imu_bridge, uwb_bridge]  # stop all once these have all exited for good ...
     shutdown_delay: 2.0      # ... and this many seconds more have passed (default 1)
     t0_margin: 3.0           # ${T0_UTIME} = launch time + this [s] (default 3)
     processes:
       - name: estimator
         command: ${BIN}/estimator          # a path, or a whole command line when args is absent
         args: [--setup, "${DATASET}/setup.yaml"]
-        required: true       # when it exits, stop all; a non-zero exit fails the launch
-        respawn: false       # restart it whenever it exits (not with required)
-        respawn_delay: 1.0   # s before a restart (default 1)
+        required: true       # when it exits for good (no respawn left), stop all; a non-zero
+                             # exit then fails the launch
+        respawn: on-failure  # never (false, default) | on-failure (after a non-zero exit or a
+                             # signal) | always (true: after any exit)
+        respawn_delay: 1.0   # s before the first restart (default 1); doubled after every restart ...
+        respawn_delay_max: 30  # ... up to this [s] (default 30)
         max_respawns: 10     # give up restarting after this many (default 10; -1 = no limit)
         delay: 0.0           # s after the launch start before this process starts
         env: {MESHNAV_LOG_LEVEL: info}
@@ -27,7 +30,8 @@ environment; an unknown variable without default is an error naming it. Built in
 the wall time [us since the Unix epoch] t0_margin seconds after the launch, so that bridges
 started together replay in step (--t0-utime ${T0_UTIME}). Every output line of a
 process is printed as "[name] line". SIGINT/SIGTERM stop all processes (SIGTERM to each process
-group, SIGKILL after stop_timeout). Exit code: 0 when every required process and every
+group, SIGKILL after stop_timeout). A process that is not required may exit (and exhaust its
+respawns) without stopping the others. Exit code: 0 when every required process and every
 shutdown_after process exited with 0 (or was stopped cleanly by the supervisor), else 1; 2 for a
 bad launch file or arguments.
 """
@@ -40,260 +44,42 @@ import sys
 import threading
 import time
 
+import yaml
+
 
 class LaunchError(Exception):
     pass
 
 
-# ------------------------------------------------------------------------------------ YAML subset
+# ------------------------------------------------------------------------------------------- YAML
 
-def _strip_comment(s):
-    out, quote = [], None
-    for i, c in enumerate(s):
-        if quote:
-            out.append(c)
-            if c == quote and not (quote == '"' and i > 0 and s[i - 1] == '\\'):
-                quote = None
-        elif c in ('"', "'"):
-            quote = c
-            out.append(c)
-        elif c == '#' and (i == 0 or s[i - 1] in ' \t'):
-            break
-        else:
-            out.append(c)
-    return ''.join(out).rstrip()
+class _StrictLoader(yaml.SafeLoader):
+    """yaml.SafeLoader that refuses a key given twice in one map (PyYAML keeps the last one)."""
 
 
-def _convert_plain(s):
-    low = s.lower()
-    if low in ('true', 'yes', 'on'):
-        return True
-    if low in ('false', 'no', 'off'):
-        return False
-    if low in ('null', '~', ''):
-        return None
-    if re.fullmatch(r'[-+]?\d+', s):
-        return int(s)
-    if re.fullmatch(r'[-+]?(\d+\.\d*|\.\d+|\d+)([eE][-+]?\d+)?', s):
-        return float(s)
-    return s
+def _construct_mapping(loader, node, deep=False):
+    seen = set()
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        if key in seen:
+            raise yaml.constructor.ConstructorError(None, None, 'duplicate key %r' % (key,), key_node.start_mark)
+        seen.add(key)
+    return yaml.SafeLoader.construct_mapping(loader, node, deep=deep)
 
 
-class _Flow:
-    """Recursive-descent parser of a flow collection or scalar."""
-
-    def __init__(self, text, where):
-        self.s, self.i, self.where = text, 0, where
-
-    def error(self, msg):
-        raise LaunchError('%s: %s in %r' % (self.where, msg, self.s))
-
-    def ws(self):
-        while self.i < len(self.s) and self.s[self.i] in ' \t':
-            self.i += 1
-
-    def value(self, stops):
-        self.ws()
-        if self.i >= len(self.s):
-            return None
-        c = self.s[self.i]
-        if c == '[':
-            self.i += 1
-            out = []
-            self.ws()
-            if self.i < len(self.s) and self.s[self.i] == ']':
-                self.i += 1
-                return out
-            while True:
-                out.append(self.value(',]'))
-                self.ws()
-                if self.i >= len(self.s):
-                    self.error('unclosed [')
-                if self.s[self.i] == ',':
-                    self.i += 1
-                    continue
-                if self.s[self.i] == ']':
-                    self.i += 1
-                    return out
-                self.error('expected , or ]')
-        if c == '{':
-            self.i += 1
-            out = {}
-            self.ws()
-            if self.i < len(self.s) and self.s[self.i] == '}':
-                self.i += 1
-                return out
-            while True:
-                key = self.value(':,}')
-                self.ws()
-                if self.i >= len(self.s) or self.s[self.i] != ':':
-                    self.error('expected key: value')
-                self.i += 1
-                out[str(key)] = self.value(',}')
-                self.ws()
-                if self.i >= len(self.s):
-                    self.error('unclosed {')
-                if self.s[self.i] == ',':
-                    self.i += 1
-                    continue
-                if self.s[self.i] == '}':
-                    self.i += 1
-                    return out
-                self.error('expected , or }')
-        if c in ('"', "'"):
-            q = c
-            self.i += 1
-            buf = []
-            while self.i < len(self.s):
-                ch = self.s[self.i]
-                if q == '"' and ch == '\\' and self.i + 1 < len(self.s):
-                    nxt = self.s[self.i + 1]
-                    buf.append({'n': '\n', 't': '\t', '"': '"', '\\': '\\'}.get(nxt, '\\' + nxt))
-                    self.i += 2
-                    continue
-                if ch == q:
-                    if q == "'" and self.s[self.i + 1:self.i + 2] == "'":
-                        buf.append("'")
-                        self.i += 2
-                        continue
-                    self.i += 1
-                    return ''.join(buf)
-                buf.append(ch)
-                self.i += 1
-            self.error('unclosed quote')
-        start = self.i
-        while self.i < len(self.s) and self.s[self.i] not in stops:
-            if self.s[self.i] == ':' and ':' in stops and not (
-                    self.i + 1 >= len(self.s) or self.s[self.i + 1] in ' \t'):
-                self.i += 1  # a colon inside a plain scalar (e.g. udpm://...)
-                continue
-            self.i += 1
-        return _convert_plain(self.s[start:self.i].strip())
+_StrictLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
 
 
-def _scalar(text, where):
-    p = _Flow(text, where)
-    v = p.value('')
-    p.ws()
-    if p.i != len(text):
-        p.error('unexpected text after value')
-    return v
-
-
-def _split_key(text, where):
-    """'key: value' -> (key, value text) or None when the line is not a map entry."""
-    if text[:1] in ('[', '{'):
-        return None
-    quote = None
-    for i, c in enumerate(text):
-        if quote:
-            if c == quote:
-                quote = None
-        elif c in ('"', "'") and i == 0:
-            quote = c
-        elif c == ':' and (i + 1 == len(text) or text[i + 1] in ' \t'):
-            key = _scalar(text[:i].strip(), where)
-            return str(key), text[i + 1:].strip()
-    return None
-
-
-def _bracket_depth(s):
-    depth, quote = 0, None
-    for c in s:
-        if quote:
-            if c == quote:
-                quote = None
-        elif c in ('"', "'"):
-            quote = c
-        elif c in '[{':
-            depth += 1
-        elif c in ']}':
-            depth -= 1
-    return depth
-
-
-def load_yaml_subset(text, source='<launch>'):
-    lines = []
-    open_flow = None  # a flow collection continued on the next lines
-    for n, raw in enumerate(text.splitlines(), 1):
-        if '\t' in raw[:len(raw) - len(raw.lstrip())]:
-            raise LaunchError('%s:%d: tabs are not allowed for indentation' % (source, n))
-        body = _strip_comment(raw)
-        if open_flow is not None:
-            open_flow[1] += ' ' + body.strip()
-            if _bracket_depth(open_flow[1]) <= 0:
-                open_flow = None
-            continue
-        if body.strip() in ('', '---'):
-            continue
-        lines.append([len(body) - len(body.lstrip(' ')), body.strip(), '%s:%d' % (source, n)])
-        if _bracket_depth(body) > 0:
-            open_flow = lines[-1]
-    if open_flow is not None:
-        raise LaunchError('%s: unclosed [ or { at end of file' % open_flow[2])
-    if not lines:
-        return None
-    value, i = _block(lines, 0, lines[0][0])
-    if i != len(lines):
-        raise LaunchError('%s: unexpected indentation' % lines[i][2])
-    return value
-
-
-def _is_item(text):
-    return text == '-' or text.startswith('- ')
-
-
-def _block(lines, i, indent):
-    if _is_item(lines[i][1]):
-        return _list(lines, i, indent)
-    if _split_key(lines[i][1], lines[i][2]) is None:
-        if len(lines) > i + 1 and lines[i + 1][0] > indent:
-            raise LaunchError('%s: expected key: value' % lines[i][2])
-        return _scalar(lines[i][1], lines[i][2]), i + 1
-    return _map(lines, i, indent)
-
-
-def _list(lines, i, indent):
-    out = []
-    while i < len(lines) and lines[i][0] == indent and _is_item(lines[i][1]):
-        ind, text, where = lines[i]
-        rest = text[1:].strip()
-        if rest == '':
-            if i + 1 < len(lines) and lines[i + 1][0] > indent:
-                item, i = _block(lines, i + 1, lines[i + 1][0])
-            else:
-                item, i = None, i + 1
-        elif _is_item(rest) or _split_key(rest, where) is not None:
-            col = ind + (len(text) - len(text[1:].lstrip()))
-            lines[i] = [col, rest, where]
-            item, i = _block(lines, i, col)
-        else:
-            item, i = _scalar(rest, where), i + 1
-        out.append(item)
-    return out, i
-
-
-def _map(lines, i, indent):
-    out = {}
-    while i < len(lines) and lines[i][0] == indent and not _is_item(lines[i][1]):
-        ind, text, where = lines[i]
-        kv = _split_key(text, where)
-        if kv is None:
-            raise LaunchError('%s: expected key: value' % where)
-        key, rest = kv
-        if key in out:
-            raise LaunchError('%s: duplicate key %r' % (where, key))
-        if rest:
-            out[key], i = _scalar(rest, where), i + 1
-        elif i + 1 < len(lines) and lines[i + 1][0] > indent:
-            out[key], i = _block(lines, i + 1, lines[i + 1][0])
-        elif i + 1 < len(lines) and lines[i + 1][0] == indent and _is_item(lines[i + 1][1]):
-            out[key], i = _list(lines, i + 1, indent)
-        else:
-            out[key], i = None, i + 1
-    if i < len(lines) and lines[i][0] > indent:
-        raise LaunchError('%s: unexpected indentation' % lines[i][2])
-    return out, i
+def load_yaml(text, source='<launch>'):
+    """The launch document (yaml.safe_load rules, duplicate keys refused). A syntax error is raised
+    as LaunchError naming source:line."""
+    try:
+        return yaml.load(text, Loader=_StrictLoader)
+    except yaml.YAMLError as e:
+        mark = getattr(e, 'problem_mark', None) or getattr(e, 'context_mark', None)
+        where = '%s:%d' % (source, mark.line + 1) if mark is not None else source
+        problem = getattr(e, 'problem', None) or str(e)
+        raise LaunchError('%s: %s' % (where, problem))
 
 
 # ----------------------------------------------------------------------------------- launch file
@@ -328,8 +114,10 @@ def _arg_text(a):
 
 
 class ProcSpec:
-    KEYS = {'name', 'command', 'args', 'required', 'respawn', 'respawn_delay', 'max_respawns',
-            'delay', 'env', 'cwd'}
+    KEYS = {'name', 'command', 'args', 'required', 'respawn', 'respawn_delay', 'respawn_delay_max',
+            'max_respawns', 'delay', 'env', 'cwd'}
+    RESPAWN = {False: 'never', True: 'always', 'never': 'never', 'always': 'always',
+               'on-failure': 'on-failure'}
 
     def __init__(self, d, where):
         if not isinstance(d, dict):
@@ -341,22 +129,51 @@ class ProcSpec:
             if not d.get(k):
                 raise LaunchError('%s: process needs %r' % (where, k))
         self.name = str(d['name'])
+        where = '%s (%s)' % (where, self.name)
         cmd = str(d['command'])
         if d.get('args') is None:
             self.argv = shlex.split(cmd)
         else:
             if not isinstance(d['args'], list):
-                raise LaunchError('%s: args of %s must be a list' % (where, self.name))
+                raise LaunchError('%s: args must be a list' % where)
             self.argv = [cmd] + [_arg_text(a) for a in d['args']]
-        self.required = bool(d.get('required', False))
-        self.respawn = bool(d.get('respawn', False))
-        if self.required and self.respawn:
-            raise LaunchError('%s: %s cannot be both required and respawn' % (where, self.name))
-        self.respawn_delay = float(d.get('respawn_delay', 1.0))
-        self.max_respawns = int(d.get('max_respawns', 10))
-        self.delay = float(d.get('delay', 0.0))
+        self.required = _flag(d, 'required', where)
+        respawn = d.get('respawn', False)
+        if not isinstance(respawn, (bool, str)) or respawn not in self.RESPAWN:
+            raise LaunchError('%s: respawn must be never, on-failure or always (or false/true), got %r'
+                              % (where, respawn))
+        self.respawn = self.RESPAWN[respawn]
+        self.respawn_delay = _number(d, 'respawn_delay', 1.0, where, minimum=0.0)
+        self.respawn_delay_max = _number(d, 'respawn_delay_max', max(30.0, self.respawn_delay), where,
+                                         minimum=self.respawn_delay)
+        self.max_respawns = int(_number(d, 'max_respawns', 10, where, minimum=-1, integer=True))
+        self.delay = _number(d, 'delay', 0.0, where, minimum=0.0)
         self.env = {str(k): '' if v is None else str(v) for k, v in (d.get('env') or {}).items()}
         self.cwd = d.get('cwd')
+
+    def restarts_after(self, code):
+        """Whether an exit with `code` (negative: killed by that signal) calls for a restart."""
+        return self.respawn == 'always' or (self.respawn == 'on-failure' and code != 0)
+
+    def respawn_wait(self, n):
+        """Seconds before restart number n + 1 (n = restarts so far): doubling, capped."""
+        return min(self.respawn_delay * (2.0 ** n), self.respawn_delay_max)
+
+
+def _flag(d, key, where):
+    v = d.get(key, False)
+    if not isinstance(v, bool):
+        raise LaunchError('%s: %s must be true or false, got %r' % (where, key, v))
+    return v
+
+
+def _number(d, key, default, where, minimum, integer=False):
+    v = d.get(key, default)
+    ok = isinstance(v, int) if integer else isinstance(v, (int, float))
+    if isinstance(v, bool) or not ok or v < minimum:
+        raise LaunchError('%s: %s must be %s >= %s, got %r' % (where, key, 'an integer' if integer else 'a number',
+                                                               minimum, v))
+    return v
 
 
 class Launch:
@@ -368,7 +185,7 @@ class Launch:
                 text = f.read()
         except OSError as e:
             raise LaunchError('%s: %s' % (path, e.strerror))
-        doc = load_yaml_subset(text, path)
+        doc = load_yaml(text, path)
         if not isinstance(doc, dict):
             raise LaunchError('%s: expected a map with processes:' % path)
         unknown = set(doc) - self.KEYS
@@ -413,6 +230,7 @@ class Supervisor:
         self.alive = set()  # names whose output pump has not reported the exit yet
         self.respawns = {p.name: 0 for p in launch.procs}
         self.final = {}  # name -> last exit code
+        self.gone = set()  # names that exited for good (no respawn)
         self.stopping = False
         self.kill_deadline = None
         self.signal_received = None  # set by the signal handler (only a flag: no locks there)
@@ -469,6 +287,8 @@ class Supervisor:
         self.kill_deadline = time.monotonic() + self.launch.stop_timeout
 
     def on_exit(self, name, code, spec):
+        """Handles one exit; returns the monotonic time of the restart, or None when the process
+        has exited for good (then it counts for required / shutdown_after)."""
         desc = ('exit code %d' % code) if code >= 0 else ('signal %d' % -code)
         self.say('supervisor', '%s exited (%s)' % (name, desc))
         if self.stopping:
@@ -476,17 +296,20 @@ class Supervisor:
             if (spec.required or name in self.launch.shutdown_after) and code not in (0, -signal.SIGTERM, -signal.SIGKILL):
                 self.failed.append('%s (%s while stopping)' % (name, desc))
             return None
+        if spec.restarts_after(code):
+            n = self.respawns[name]
+            if spec.max_respawns < 0 or n < spec.max_respawns:
+                wait = spec.respawn_wait(n)
+                self.say('supervisor', 'restarting %s in %.2f s' % (name, wait))
+                return time.monotonic() + wait
+            self.say('supervisor', '%s: no more respawns (max_respawns %d)' % (name, spec.max_respawns))
+        self.gone.add(name)
         if name in self.launch.shutdown_after and code != 0:
             self.failed.append('%s (%s)' % (name, desc))
         if spec.required:
             if code != 0 and name not in self.launch.shutdown_after:
                 self.failed.append('%s (%s)' % (name, desc))
             self.stop_all('required process %s exited' % name)
-            return None
-        if spec.respawn:
-            if spec.max_respawns < 0 or self.respawns[name] < spec.max_respawns:
-                return time.monotonic() + spec.respawn_delay
-            self.say('supervisor', '%s: no more respawns (max_respawns %d)' % (name, spec.max_respawns))
         return None
 
     def run(self):
@@ -530,7 +353,7 @@ class Supervisor:
                 if when is not None:
                     respawn_at[name] = when
             if not self.stopping and self.launch.shutdown_after and shutdown_at is None and \
-                    all(n in self.final for n in self.launch.shutdown_after):
+                    all(n in self.gone for n in self.launch.shutdown_after):
                 shutdown_at = time.monotonic() + self.launch.shutdown_delay
             with self.cv:
                 idle = not self.alive and not self.events
@@ -576,7 +399,7 @@ def main(argv):
         launch.stop_timeout = stop_timeout
     if dry_run:
         for p in launch.procs:
-            flags = [f for f in ('required', 'respawn') if getattr(p, f)]
+            flags = (['required'] if p.required else []) + (['respawn ' + p.respawn] if p.respawn != 'never' else [])
             print('%s%s: %s' % (p.name, ' [' + ', '.join(flags) + ']' if flags else '',
                                 ' '.join(shlex.quote(a) for a in p.argv)))
         return 0

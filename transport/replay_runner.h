@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "common/cli.h"
-#include "transport/option_source.h"
 #include "transport/lcm_node.h"
 #include "transport/replay/replay_scheduler.h"
 
@@ -23,22 +22,22 @@ struct ReplayProcessOptions {
   Duration start_delay{0};              ///< extra delay before the replay starts
 };
 
-inline constexpr const char* kReplayUsage =
-    "Replay options:\n"
-    "  --rate N           playback speed: 1 = real time (default), N = N times faster, 0 = as fast as possible\n"
-    "  --t0-utime US      wall time [µs since the Unix epoch] at which data time --data-t0 is played;\n"
-    "                     give the same value to several bridges to replay them in step (default: at start)\n"
-    "  --data-t0 S        data time [s] played at --t0-utime (default 0; with --t0-utime only)\n"
-    "  --wait-for CH      start only after a message was seen on channel CH (e.g. ESTIMATOR_STATUS)\n"
-    "  --wait-timeout S   give up (exit 3) when nothing arrived on --wait-for within S seconds (default: wait forever)\n"
-    "  --start-delay S    sleep S seconds before starting (prefer --wait-for)\n"
-    "  --progress S       seconds between progress lines (default 5; 0 = none)\n";
+/// The replay options as given on the command line (or in the `--config` options file).
+struct ReplayCliValues {
+  double rate = replay::ReplayOptions{}.rate;
+  int64_t t0_utime = 0;
+  double data_t0_s = 0.0;
+  std::string wait_for;
+  double wait_timeout_s = 0.0;
+  double start_delay_s = 0.0;
+  double progress_s = replay::ReplayOptions{}.progress_period.sec();
+};
 
-/// Names of the replay options (for OptionSource).
-const std::vector<std::string>& replayOptionNames();
-void declareReplayOptions(Cli& cli);
-/// Throws std::runtime_error on an invalid value.
-ReplayProcessOptions replayOptionsFrom(const OptionSource& opts);
+/// Declares --rate, --t0-utime, --data-t0, --wait-for, --wait-timeout, --start-delay, --progress
+/// bound to `values` (which must outlive the parse).
+void declareReplayOptions(Cli& cli, ReplayCliValues& values);
+/// The options after parsing. Throws std::runtime_error on --data-t0 without --t0-utime.
+ReplayProcessOptions replayOptionsFrom(const Cli& cli, const ReplayCliValues& values);
 
 /// Waits for --wait-for / --start-delay. Returns false when stopped or timed out (logged).
 bool waitForStart(LcmNode& node, const ReplayProcessOptions& options);

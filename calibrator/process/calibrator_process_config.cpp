@@ -13,69 +13,44 @@
 
 namespace meshnav::calib {
 
-const char* const kCalibratorProcessUsage =
-    "calibrator --setup FILE [--config FILE] [options]\n"
-    "  Calibrates new UWB anchors fly-by (DESIGN §5): subscribes RANGE, POSE, ANCHORS, CALIB_CMD;\n"
-    "  publishes ANCHOR_INIT (position, covariance, pair biases) and CALIB_STATUS (per-anchor\n"
-    "  state, counters; also a wall-clock heartbeat). Driven by a mission (CALIB_CMD) or, with\n"
-    "  --auto, by itself. Malformed messages are counted per channel and reported in CALIB_STATUS.\n"
-    "  --setup FILE       system setup (setup.yaml: tags, known anchors, pair biases, noise)\n"
-    "  --config FILE      calibrator options YAML, `calibrator:` and `calibrator_node:` maps\n"
-    "                     (default: built-in = config/calibrator.yaml); without\n"
-    "                     calibrator.sigma_range, σ_d is setup.yaml's noise.sigma_range, else 0.1 m\n"
-    "  --auto             calibrate automatically once an anchor's data suffices (when no mission\n"
-    "                     drives the calibrator; sets calibrator_node.auto_mode)\n"
-    "  --out-yaml FILE    write the calibration results (DESIGN §6 YAML) after every calibration\n"
-    "                     and on exit\n"
-    "  --pose-rate HZ     POSE decimation towards the calibrator (default 50; 0 = every pose)\n"
-    "  --heartbeat S      wall seconds between heartbeat CALIB_STATUS (default 1)\n"
-    "  --print-config     print the options and exit\n";
+const char* const kCalibratorProcessDescription =
+    "Calibrates new UWB anchors fly-by (docs/calibration.md): subscribes RANGE, POSE, ANCHORS, CALIB_CMD; "
+    "publishes ANCHOR_INIT (position, covariance, pair biases) and CALIB_STATUS (per-anchor state, counters; also "
+    "a wall-clock heartbeat). Driven by a mission (CALIB_CMD) or, with --auto, by itself. Malformed messages are "
+    "counted per channel and reported in CALIB_STATUS.";
 
-void declareCalibratorProcessOptions(Cli& cli) {
-  cli.option("setup").option("out-yaml").option("pose-rate").option("heartbeat");
-  cli.option("auto", false).option("print-config", false);
-  cli.option("lcm-url").option("config").option("log-level");
+void declareCalibratorProcessOptions(Cli& cli, CalibratorProcessConfig& c) {
+  cli.optional("setup", c.setup_path, "system setup (setup.yaml: tags, known anchors, pair biases, noise); required")
+      ->type_name("FILE");
+  cli.optional("config", c.config_path,
+               "calibrator options YAML, `calibrator:` and `calibrator_node:` maps (default: built-in = "
+               "config/calibrator.yaml); without calibrator.sigma_range, sigma_d is setup.yaml's "
+               "noise.sigma_range, else the built-in one")
+      ->type_name("FILE");
+  cli.flag("auto", c.auto_requested,
+           "calibrate automatically once an anchor's data suffices (when no mission drives the calibrator; sets "
+           "calibrator_node.auto_mode)");
+  cli.optional("out-yaml", c.out_yaml,
+               "write the calibration results YAML (calibrator/calibration_io.h) after every calibration and on exit")
+      ->type_name("FILE");
+  cli.option("pose-rate", c.pose_rate_hz, "POSE decimation towards the calibrator [Hz] (0 = every pose)")
+      ->type_name("HZ")
+      ->check(cli::nonNegative());
+  cli.option("heartbeat", c.heartbeat_s, "wall seconds between heartbeat CALIB_STATUS")
+      ->type_name("S")
+      ->check(cli::positive());
+  cli.flag("print-config", c.print_config, "print the options and exit");
 }
 
-namespace {
-
-double nonNegative(const Cli& cli, const std::string& name, double fallback, bool strictly_positive) {
-  double v = fallback;
-  try {
-    v = cli.getDouble(name, fallback);
-  } catch (const std::exception&) {
-    throw std::runtime_error("--" + name + ": not a number: '" + cli.get(name) + "'");
-  }
-  if (!std::isfinite(v) || v < 0.0 || (strictly_positive && v == 0.0))
-    throw std::runtime_error("--" + name + " must be " + (strictly_positive ? "> 0" : ">= 0") + ", got '" +
-                             cli.get(name) + "'");
-  return v;
-}
-
-/// --config through the shared loader (calibrator/node/calibrator_config.h).
-void loadConfigFile(CalibratorProcessConfig& c) {
-  const CalibratorConfig cc = CalibratorConfig::load(c.config_path);
-  c.calibrator = cc.calibrator;
-  c.node = cc.node;
-  c.sigma_range_from_config = cc.sigma_range_from_config;
-}
-
-}  // namespace
-
-CalibratorProcessConfig calibratorProcessConfig(const Cli& cli) {
-  CalibratorProcessConfig c;
-  c.setup_path = cli.get("setup");
-  c.config_path = cli.get("config");
-  c.out_yaml = cli.get("out-yaml");
-  c.print_config = cli.has("print-config");
-  c.pose_rate_hz = nonNegative(cli, "pose-rate", 50.0, false);
-  c.heartbeat_s = nonNegative(cli, "heartbeat", 1.0, true);
+void loadCalibratorProcessConfig(CalibratorProcessConfig& c) {
   if (!c.config_path.empty()) {
-    loadConfigFile(c);
+    const CalibratorConfig cc = CalibratorConfig::load(c.config_path);
+    c.calibrator = cc.calibrator;
+    c.node = cc.node;
+    c.sigma_range_from_config = cc.sigma_range_from_config;
     if (c.sigma_range_from_config) c.sigma_range_source = c.config_path;
   }
-  if (cli.has("auto")) c.node.auto_mode = true;
-  return c;
+  if (c.auto_requested) c.node.auto_mode = true;
 }
 
 void applySetup(CalibratorProcessConfig& config, const SystemSetup& setup) {

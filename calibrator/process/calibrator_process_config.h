@@ -25,6 +25,7 @@ struct CalibratorProcessConfig {
   double pose_rate_hz = 50.0;       ///< --pose-rate: POSE decimation towards the node (0 = every pose) [Hz]
   double heartbeat_s = 1.0;         ///< --heartbeat: wall time between CALIB_STATUS heartbeats [s]
   bool print_config = false;        ///< --print-config
+  bool auto_requested = false;      ///< --auto (forces node.auto_mode on after --config is read)
   CalibratorOptions calibrator;     ///< `calibrator:` of --config
   CalibratorNodeOptions node;       ///< `calibrator_node:` of --config, auto_mode forced on by --auto
   /// Whether --config sets `calibrator.sigma_range`; if not, applySetup() takes setup.yaml's.
@@ -35,16 +36,17 @@ struct CalibratorProcessConfig {
   std::string toString() const;
 };
 
-/// The process's usage text (without the common process options).
-extern const char* const kCalibratorProcessUsage;
+/// What the process does (the first paragraph of --help).
+extern const char* const kCalibratorProcessDescription;
 
-/// Declares every option of the process on `cli` (including the common ones of
-/// transport/process_options.h: --lcm-url, --config, --log-level).
-void declareCalibratorProcessOptions(Cli& cli);
+/// Declares the process's own options on `cli`, bound to the fields of `config` (their initial
+/// values are the defaults --help shows); values out of range are refused by the parse. The
+/// options every process has (--lcm-url, --log-level) come from transport::ProcessMain.
+void declareCalibratorProcessOptions(Cli& cli, CalibratorProcessConfig& config);
 
-/// Reads the parsed command line and loads --config. Throws std::runtime_error naming the option
-/// (or the file and key) on a bad value.
-CalibratorProcessConfig calibratorProcessConfig(const Cli& cli);
+/// After the parse: loads --config and applies --auto. Throws std::runtime_error naming the file
+/// and key on a bad file.
+void loadCalibratorProcessConfig(CalibratorProcessConfig& config);
 
 /// σ_d from `setup.noise.sigma_range` unless the config file set it.
 void applySetup(CalibratorProcessConfig& config, const SystemSetup& setup);

@@ -2,33 +2,43 @@
 ///   RANGE, POSE, ANCHORS, CALIB_CMD -> ANCHOR_INIT, CALIB_STATUS.
 /// CALIB_STATUS goes out at the node's data-time rate, after every Calibrate command and, as the
 /// process heartbeat, every --heartbeat seconds of wall time (also while no data flows).
-#include <spdlog/spdlog.h>
-
 #include <cmath>
 #include <iostream>
 #include <optional>
 
 #include "calibrator/node/calibrator_node.h"
 #include "calibrator/process/calibrator_process_config.h"
-#include "common/cli.h"
 #include "common/setup.h"
 #include "transport/channels.h"
-#include "transport/lcm_node.h"
-#include "transport/process_options.h"
-#include "transport/replay/clock.h"
+#include "transport/process_main.h"
+
+namespace {
+
+using namespace meshnav;
+
+void logAnchorInit(const AnchorInit& a) {
+  spdlog::info("ANCHOR_INIT {} at t = {} s: p_AinG [{:.3f}, {:.3f}, {:.3f}] m, σ [{:.3f}, {:.3f}, {:.3f}] m, "
+               "{} references, {} inliers, {} outliers",
+               a.id, formatSeconds(a.t), a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z(), std::sqrt(a.cov_p_m2(0, 0)),
+               std::sqrt(a.cov_p_m2(1, 1)), std::sqrt(a.cov_p_m2(2, 2)), a.biases.size(), a.n_inliers, a.n_outliers);
+}
+
+std::string anchorStates(const CalibStatus& st) {
+  std::string out;
+  for (const auto& a : st.anchors) out += fmt::format("{} {} ({} ranges); ", a.id, a.state, a.n_ranges);
+  return out;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
-  using namespace meshnav;
-  const std::string usage = std::string(calib::kCalibratorProcessUsage) + transport::kProcessUsage;
-  Cli cli("calibrator", usage);
-  calib::declareCalibratorProcessOptions(cli);
-  int code = 0;
-  if (!cli.parse(argc, argv, code)) return code;
-  transport::startProcess("calibrator", cli);
-  try {
-    calib::CalibratorProcessConfig config = calib::calibratorProcessConfig(cli);
+  transport::ProcessMain process("calibrator", calib::kCalibratorProcessDescription);
+  calib::CalibratorProcessConfig config;
+  calib::declareCalibratorProcessOptions(process.cli(), config);
+  return process.run(argc, argv, [&] {
+    calib::loadCalibratorProcessConfig(config);
     if (config.setup_path.empty() && !config.print_config) {
-      spdlog::error("--setup is required\n{}", usage);
+      spdlog::error("--setup is required (see --help)");
       return 2;
     }
     SystemSetup setup;
@@ -40,85 +50,59 @@ int main(int argc, char** argv) {
       std::cout << config.toString();
       return 0;
     }
-    transport::LcmNode lcm("calibrator", cli.get("lcm-url"));
-
-    /// Status as published: the node's, plus the process's own counters (malformed messages).
-    auto fullStatus = [&lcm](CalibStatus st) {
-      st.wall_utime = replay::wallUtimeNow();
-      for (const auto& [k, v] : lcm.diagnostics().snapshot()) st.counters[k] += v;
-      return st;
-    };
+    transport::LcmNode& lcm = process.lcm();
     calib::CalibratorSinks sinks;
     sinks.anchor_init = [&](const AnchorInit& a) {
-      spdlog::info("ANCHOR_INIT {} at t = {} s: p_AinG [{:.3f}, {:.3f}, {:.3f}] m, σ [{:.3f}, {:.3f}, {:.3f}] m, "
-                   "{} references, {} inliers, {} outliers",
-                   a.id, formatSeconds(a.t), a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z(), std::sqrt(a.cov_p_m2(0, 0)),
-                   std::sqrt(a.cov_p_m2(1, 1)), std::sqrt(a.cov_p_m2(2, 2)), a.biases.size(), a.n_inliers,
-                   a.n_outliers);
+      logAnchorInit(a);
       lcm.publish(channels::kAnchorInit, a);
     };
-    sinks.status = [&](const CalibStatus& s) { lcm.publish(channels::kCalibStatus, fullStatus(s)); };
+    sinks.status = [&](const CalibStatus& s) { lcm.publish(channels::kCalibStatus, process.stamped(s)); };
     calib::CalibratorNode node(config.calibrator, setup, sinks, config.node);
     spdlog::info("calibrator options:\n{}", config.toString());
 
     calib::CalibrationYamlWriter results_file(config.out_yaml);
-    auto attempts = [&node] {
-      return node.diagnostics().get("calibrations_ok") + node.diagnostics().get("calibrations_refused");
-    };
-    auto afterInput = [&] {
-      if (results_file.update(node.results(), attempts()))
+    auto writeResults = [&](bool force) {
+      const int64_t attempts =
+          node.diagnostics().get("calibrations_ok") + node.diagnostics().get("calibrations_refused");
+      if (results_file.update(node.results(), attempts, force))
         spdlog::info("calibration results written to {}", results_file.path());
     };
-
     std::optional<Timestamp> last_pose;
     const Duration pose_period = Duration::fromSec(config.pose_rate_hz > 0 ? 1.0 / config.pose_rate_hz : 0.0);
     lcm.subscribe<RangeSample>(channels::kRange, [&](const RangeSample& r) {
       node.onRange(r);
-      afterInput();  // automatic mode calibrates on data
+      writeResults(false);  // automatic mode calibrates on data
     });
     lcm.subscribe<PoseEstimate>(channels::kPose, [&](const PoseEstimate& p) {
       if (last_pose && p.t >= *last_pose && p.t - *last_pose < pose_period) return;  // decimation
       last_pose = p.t;
       node.onPose(p);
-      afterInput();
+      writeResults(false);
     });
     lcm.subscribe<std::vector<AnchorEstimate>>(channels::kAnchors,
                                                [&](const std::vector<AnchorEstimate>& a) { node.onAnchors(a); });
     lcm.subscribe<CalibCommand>(channels::kCalibCmd, [&](const CalibCommand& c) {
       node.onCommand(c);
-      afterInput();
+      writeResults(false);
     });
-    auto anchorStates = [](const CalibStatus& st) {
-      std::string out;
-      for (const auto& a : st.anchors) out += fmt::format("{} {} ({} ranges); ", a.id, a.state, a.n_ranges);
-      return out;
-    };
     const int64_t progress_period_us = 10'000'000;  // a progress line every 10 s of wall time
     int64_t next_progress = replay::wallUtimeNow() + progress_period_us;
-    lcm.setHeartbeat(Duration::fromSec(config.heartbeat_s), [&] {
-      const CalibStatus st = fullStatus(node.status());
-      lcm.publish(channels::kCalibStatus, st);
-      if (st.wall_utime >= next_progress && node.dataTime()) {
-        spdlog::info("t = {} s; anchors: {}", formatSeconds(st.t), anchorStates(st));
-        next_progress = st.wall_utime + progress_period_us;
-      }
-    });
+    process.heartbeat<CalibStatus>(channels::kCalibStatus, config.heartbeat_s, [&] { return node.status(); },
+                                   [&](const CalibStatus& st) {
+                                     if (st.wall_utime < next_progress || !node.dataTime()) return;
+                                     spdlog::info("t = {} s; anchors: {}", formatSeconds(st.t), anchorStates(st));
+                                     next_progress = st.wall_utime + progress_period_us;
+                                   });
     spdlog::info("LCM {}; {} tags, {} known anchors; {}", lcm.url(), setup.rel_tag_positions.size(),
                  setup.abs_anchor_positions.size(),
                  config.node.auto_mode ? "automatic calibration" : "calibration on CALIB_CMD");
     const int rc = lcm.spin();
 
-    const CalibStatus st = fullStatus(node.status());
+    const CalibStatus st = process.stamped(node.status());
     lcm.publish(channels::kCalibStatus, st);
-    if (results_file.enabled() && results_file.update(node.results(), attempts(), true))
-      spdlog::info("calibration results written to {}", results_file.path());
-    const std::string anchors = anchorStates(st);
-    std::string counters;
-    for (const auto& [k, v] : st.counters) counters += fmt::format("{}={} ", k, v);
-    spdlog::info("stopped at t = {} s; anchors: {}counters: {}", formatSeconds(st.t), anchors, counters);
+    if (results_file.enabled()) writeResults(true);
+    spdlog::info("stopped at t = {} s; anchors: {}counters: {}", formatSeconds(st.t), anchorStates(st),
+                 transport::formatCounters(st.counters));
     return rc;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
-  }
+  });
 }

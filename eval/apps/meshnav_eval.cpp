@@ -21,58 +21,64 @@ using namespace meshnav::eval;
 
 namespace {
 
-const char* kUsage = R"(meshnav_eval — metrics of a run against ground truth, and plots.
+/// The command line of meshnav_eval (EvalOptions holds the defaults of the metric options).
+struct EvalCli {
+  EvalOptions eval;
+  bool no_baseline = false;
+  std::string align;
+  std::string dataset, run, out, json, calibration, batch, table_md;
+  std::string dataset_subdir = "dataset", run_subdir = "run";
+  bool no_plots = false, plots = false;
+};
 
-Single run:
-  meshnav_eval --dataset DIR --run DIR [--out DIR] [--no-plots] [--json FILE] [--align none|se3|yaw]
-Multilateration baseline only (no run):
-  meshnav_eval --dataset DIR [--align none|se3|yaw] [--out DIR]
-Many runs (paper-style table):
-  meshnav_eval --batch ROOT [--table-md FILE] [--dataset-subdir NAME] [--run-subdir NAME] [--plots]
+void declareOptions(Cli& cli, EvalCli& c) {
+  const std::string batch = "Many runs (--batch)";
+  cli.optional("dataset", c.dataset, "dataset folder (groundtruth.csv, truth.yaml, setup.yaml, flight_state.csv); "
+                                     "without --run: the multilateration baseline only")->type_name("DIR");
+  cli.optional("run", c.run, "run folder (estimate.csv, anchors.csv, optional calibration.yaml)")->type_name("DIR");
+  cli.optional("out", c.out, "where metrics.yaml, errors.csv, anchors_eval.csv and PNGs go (default: --run)")
+      ->type_name("DIR");
+  cli.flag("no-plots", c.no_plots, "do not call eval/plots/plot_run.py");
+  cli.optional("json", c.json, "also write the metrics as JSON")->type_name("FILE");
+  cli.option("skip", c.eval.skip_first_s, "ignore the first S seconds after the first estimate [s]")
+      ->type_name("S")->check(cli::nonNegative());
+  cli.flag("only-flying", c.eval.only_flying, "evaluate only while not landed (flight_state.csv); default: all samples");
+  cli.option("max-gt-gap", c.eval.max_gt_gap_s, "largest ground-truth gap that is interpolated [s]")
+      ->type_name("S")->check(cli::positive());
+  cli.optional("align", c.align,
+               "align the estimate (and the baseline, each with its own fit) to the ground truth before the errors "
+               "are taken: se3 = rotation + translation (Umeyama, no scale), yaw = rotation about z + translation. "
+               "Default: se3 when truth.yaml says align_required (truth in another frame, e.g. imported real "
+               "recordings), else none. The table states the mode used")
+      ->type_name("none|se3|yaw")
+      ->check(cli::oneOf([](const std::string& m) { return parseAlignmentMode(m).has_value(); }, "none|se3|yaw"));
+  cli.flag("no-baseline", c.no_baseline, "do not run the multilateration baseline on the dataset's ranges.csv");
+  cli.option("baseline-window", c.eval.baseline_window_s,
+             "epoch length of the multilateration baseline [s] (shorter than the 51 ms between two RTLS messages "
+             "of ISAS-Walk1, so one message = one epoch)")
+      ->type_name("S")->check(cli::positive());
+  cli.optional("calibration", c.calibration,
+               "calibration result YAML giving the initial anchor beliefs (default: RUN/calibration.yaml if "
+               "present, else first anchors.csv row)")
+      ->type_name("FILE");
+  cli.optional("batch", c.batch, "evaluate every ROOT/<name>/ holding <dataset-subdir>/ and <run-subdir>/")
+      ->type_name("ROOT")->group(batch);
+  cli.option("dataset-subdir", c.dataset_subdir, "dataset folder name inside each run folder")
+      ->type_name("NAME")->group(batch);
+  cli.option("run-subdir", c.run_subdir, "run folder name inside each run folder")->type_name("NAME")->group(batch);
+  cli.optional("table-md", c.table_md, "write the table as Markdown to FILE")->type_name("FILE")->group(batch);
+  cli.flag("plots", c.plots, "also write plots of every run (default: no plots in batch mode)")->group(batch);
+  cli.app().footer(
+      "Errors are truth minus estimate. RMSE = sqrt(mean |e|^2); ARMSE = mean |e| (the toolbox's \"ARMSE\"); NEES = "
+      "e^T P^-1 e per sample (chi2, 3 dof), ANEES its mean with the 95 % interval.\nExit status: 0 ok, 1 nothing "
+      "could be evaluated, 2 usage error.");
+}
 
-Options:
-  --dataset DIR         dataset folder (groundtruth.csv, truth.yaml, setup.yaml, flight_state.csv)
-  --run DIR             run folder (estimate.csv, anchors.csv, optional calibration.yaml)
-  --out DIR             where metrics.yaml, errors.csv, anchors_eval.csv and PNGs go (default: --run)
-  --no-plots            do not call eval/plots/plot_run.py
-  --json FILE           also write the metrics as JSON
-  --skip S              ignore the first S seconds after the first estimate [s] (default 0)
-  --only-flying         evaluate only while not landed (flight_state.csv); default: all samples
-  --max-gt-gap S        largest ground-truth gap that is interpolated [s] (default 0.2)
-  --align MODE          none | se3 | yaw: align the estimate (and the baseline, each with its own
-                        fit) to the ground truth before the errors are taken: se3 = rotation +
-                        translation (Umeyama, no scale), yaw = rotation about z + translation.
-                        Default: se3 when truth.yaml says align_required (truth in another frame,
-                        e.g. imported real recordings), else none. The table states the mode used.
-  --no-baseline         do not run the multilateration baseline on the dataset's ranges.csv
-  --baseline-window S   epoch length of the multilateration baseline [s] (default 0.03: shorter than
-                        the 51 ms between two RTLS messages of ISAS-Walk1, so one message = one epoch)
-  --calibration FILE    calibration result YAML giving the initial anchor beliefs
-                        (default: RUN/calibration.yaml if present, else first anchors.csv row)
-  --batch ROOT          evaluate every ROOT/<name>/ holding <dataset-subdir>/ and <run-subdir>/
-  --dataset-subdir NAME (batch) dataset folder name inside each run folder (default dataset)
-  --run-subdir NAME     (batch) run folder name inside each run folder (default run)
-  --table-md FILE       (batch) write the table as Markdown to FILE
-  --plots               (batch) also write plots of every run (default: no plots in batch mode)
-  --help                this text
-
-Errors are truth minus estimate. RMSE = sqrt(mean |e|^2); ARMSE = mean |e| (the toolbox's
-"ARMSE"); NEES = e^T P^-1 e per sample (chi2, 3 dof), ANEES its mean with the 95 % interval.
-Exit status: 0 ok, 1 nothing could be evaluated, 2 usage error.
-)";
-
-EvalOptions optionsFrom(const Cli& cli) {
-  EvalOptions o;
-  o.skip_first_s = cli.getDouble("skip", 0.0);
-  o.only_flying = cli.has("only-flying");
-  o.max_gt_gap_s = cli.getDouble("max-gt-gap", 0.2);
-  o.baseline = !cli.has("no-baseline");
-  o.baseline_window_s = cli.getDouble("baseline-window", 0.03);
-  if (cli.has("align")) {
-    o.align = parseAlignmentMode(cli.get("align"));
-    if (!o.align) throw std::invalid_argument("--align '" + cli.get("align") + "': expected none, se3 or yaw");
-  }
-  if (!(o.baseline_window_s > 0.0)) throw std::invalid_argument("--baseline-window must be > 0 [s]");
+/// The metric options after the parse.
+EvalOptions optionsFrom(const EvalCli& c) {
+  EvalOptions o = c.eval;
+  o.baseline = !c.no_baseline;
+  if (!c.align.empty()) o.align = parseAlignmentMode(c.align);
   return o;
 }
 
@@ -93,45 +99,38 @@ void writeOutputs(const RunEvaluation& ev, const fs::path& out, bool plots, cons
 }
 
 /// No --run: the multilateration baseline of the dataset alone (metrics.yaml only with --out).
-int runBaselineOnly(const std::string& dataset, const EvalOptions& options, const Cli& cli) {
+int runBaselineOnly(const std::string& dataset, const EvalOptions& options, const EvalCli& cli) {
   if (!fs::is_directory(dataset)) {
     spdlog::error("{} is not a directory", dataset);
     return 1;
   }
   const RunEvaluation ev = evaluateRun(dataset, "", options);
   std::cout << formatRunReport(ev) << std::flush;
-  if (cli.has("out")) {
-    fs::create_directories(cli.get("out"));
-    writeMetricsYaml(ev, (fs::path(cli.get("out")) / "metrics.yaml").string());
+  if (!cli.out.empty()) {
+    fs::create_directories(cli.out);
+    writeMetricsYaml(ev, (fs::path(cli.out) / "metrics.yaml").string());
   }
   return ev.baseline && ev.baseline->trajectory.n_selected > 0 ? 0 : 1;
 }
 
-int runSingle(const Cli& cli) {
-  if (!cli.has("dataset")) {
-    std::cerr << "meshnav_eval: --dataset is required (or --batch ROOT)\n\n" << cli.usage();
+int runSingle(const EvalCli& cli) {
+  if (cli.dataset.empty()) {
+    std::cerr << "meshnav_eval: --dataset is required (or --batch ROOT); see --help\n";
     return 2;
   }
-  EvalOptions options;
-  try {
-    options = optionsFrom(cli);
-  } catch (const std::invalid_argument& ex) {
-    std::cerr << "meshnav_eval: " << ex.what() << "\n\n" << cli.usage();
-    return 2;
-  }
-  const std::string dataset = cli.get("dataset"), run = cli.get("run");
-  if (run.empty()) return runBaselineOnly(dataset, options, cli);
-  for (const auto& d : {dataset, run})
+  const EvalOptions options = optionsFrom(cli);
+  if (cli.run.empty()) return runBaselineOnly(cli.dataset, options, cli);
+  for (const auto& d : {cli.dataset, cli.run})
     if (!fs::is_directory(d)) {
       spdlog::error("{} is not a directory", d);
       return 1;
     }
-  RunEvaluation ev = evaluateRun(dataset, run, options, cli.get("calibration"));
+  RunEvaluation ev = evaluateRun(cli.dataset, cli.run, options, cli.calibration);
   std::cout << formatRunReport(ev) << std::flush;
-  const fs::path out = cli.has("out") ? fs::path(cli.get("out")) : fs::path(run);
+  const fs::path out = cli.out.empty() ? fs::path(cli.run) : fs::path(cli.out);
   try {
-    writeOutputs(ev, out, !cli.has("no-plots"), dataset);
-    if (cli.has("json")) writeMetricsJson(ev, cli.get("json"));
+    writeOutputs(ev, out, !cli.no_plots, cli.dataset);
+    if (!cli.json.empty()) writeMetricsJson(ev, cli.json);
   } catch (const std::exception& ex) {
     spdlog::error("{}", ex.what());
     return 1;
@@ -139,14 +138,14 @@ int runSingle(const Cli& cli) {
   return (ev.trajectory.n_selected > 0 || ev.anchors) ? 0 : 1;
 }
 
-int runBatch(const Cli& cli) {
-  const fs::path root = cli.get("batch");
+int runBatch(const EvalCli& cli) {
+  const fs::path root = cli.batch;
   if (!fs::is_directory(root)) {
     spdlog::error("--batch {}: not a directory", root.string());
     return 1;
   }
-  const std::string ds_name = cli.get("dataset-subdir", "dataset");
-  const std::string run_name = cli.get("run-subdir", "run");
+  const std::string& ds_name = cli.dataset_subdir;
+  const std::string& run_name = cli.run_subdir;
   std::vector<fs::path> dirs;
   for (const auto& e : fs::directory_iterator(root))
     if (e.is_directory() && fs::is_directory(e.path() / ds_name) && fs::is_directory(e.path() / run_name))
@@ -157,20 +156,14 @@ int runBatch(const Cli& cli) {
     return 1;
   }
   std::vector<BatchEntry> entries;
-  EvalOptions opt;
-  try {
-    opt = optionsFrom(cli);
-  } catch (const std::invalid_argument& ex) {
-    std::cerr << "meshnav_eval: " << ex.what() << "\n";
-    return 2;
-  }
+  const EvalOptions opt = optionsFrom(cli);
   for (size_t i = 0; i < dirs.size(); ++i) {
     const auto& d = dirs[i];
     spdlog::info("[{}/{}] evaluating {}", i + 1, dirs.size(), d.filename().string());
     BatchEntry e{d.filename().string(),
                  evaluateRun((d / ds_name).string(), (d / run_name).string(), opt)};
     try {
-      writeOutputs(e.ev, d / run_name, cli.has("plots"), (d / ds_name).string());
+      writeOutputs(e.ev, d / run_name, cli.plots, (d / ds_name).string());
     } catch (const std::exception& ex) {
       spdlog::warn("{}: {}", d.string(), ex.what());
     }
@@ -181,17 +174,17 @@ int runBatch(const Cli& cli) {
             << "(★ = initial anchor estimate from the calibration, no mark = final filter estimate; "
                "errors in m, orientation in deg)\n\n"
             << table.plain() << std::flush;
-  if (cli.has("table-md")) {
-    std::ofstream f(cli.get("table-md"));
+  if (!cli.table_md.empty()) {
+    std::ofstream f(cli.table_md);
     if (!f) {
-      spdlog::error("cannot write {}", cli.get("table-md"));
+      spdlog::error("cannot write {}", cli.table_md);
       return 1;
     }
     f << "<!-- generated by meshnav_eval --batch " << root.string() << " -->\n"
       << "Pose RMSE (position [m], orientation [deg]), ANEES (3 dof each; consistent ≈ 3) and anchor "
          "position errors [m] of the initial (★) and final estimates.\n\n"
       << table.markdown();
-    spdlog::info("wrote {}", cli.get("table-md"));
+    spdlog::info("wrote {}", cli.table_md);
   }
   return 0;
 }
@@ -200,15 +193,16 @@ int runBatch(const Cli& cli) {
 
 int main(int argc, char** argv) {
   setupLogging("meshnav_eval");
-  Cli cli("meshnav_eval", kUsage);
-  for (const char* o : {"dataset", "run", "out", "json", "skip", "max-gt-gap", "calibration", "batch",
-                        "dataset-subdir", "run-subdir", "table-md", "align", "baseline-window"})
-    cli.option(o, true);
-  for (const char* f : {"no-plots", "only-flying", "plots", "no-baseline"}) cli.option(f, false);
+  Cli cli("meshnav_eval",
+          "Metrics of a run against ground truth (pose RMSE, ARMSE, ANEES, anchor errors) and plots; the "
+          "multilateration baseline of a dataset alone (no --run); or, with --batch, the paper-style table over "
+          "many runs.");
+  EvalCli c;
+  declareOptions(cli, c);
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   try {
-    return cli.has("batch") ? runBatch(cli) : runSingle(cli);
+    return c.batch.empty() ? runSingle(c) : runBatch(c);
   } catch (const std::exception& ex) {
     spdlog::error("{}", ex.what());
     return 1;

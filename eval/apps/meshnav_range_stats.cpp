@@ -25,34 +25,44 @@ using namespace meshnav::eval;
 
 namespace {
 
-const char* kUsage = R"(meshnav_range_stats — per ordered pair range bias and noise against true distances.
+/// The command line of meshnav_range_stats (RangeStatsOptions holds the defaults).
+struct RangeStatsCli {
+  RangeStatsOptions stats;
+  std::string dataset, reference, method, yaml, plots;
+  double max_dt_s = 0.05;
+};
 
-  meshnav_range_stats --dataset DIR [options]
-
-DIR is either
-  - a recording like shared/data/real-t1-a3-loiter: *_ranges.csv (measured), true_ranges*.csv (true
-    tag-to-anchor distances), config.yaml (abs_anchor_positions), optional reference_statistics.yaml;
-  - a meshnav dataset (DESIGN §6): ranges.csv, groundtruth.csv, setup.yaml (tag lever arms) and
-    truth.yaml (all anchors, true pair biases γ, β, σ).
-
-Options:
-  --reference FILE      toolbox statistics to compare with (default DIR/reference_statistics.yaml)
-  --method NAME         histogram: the toolbox's filtered histogram (reproduces its tables; its σ is
-                                   about half the true σ for Gaussian noise)
-                        clip: median/MAD start, iterated 3σ clipping (recovers a simulated γ, σ_d)
-                        gate: plain mean/std after the gate
-                        default: histogram when a reference is compared, else clip
-  --max-error M         gross outlier gate |z - d| <= M [m] (default 1.0)
-  --bins N              histogram bins (default 50)
-  --inlier-fraction F   assumed inlier fraction of the histogram filter (default 0.3)
-  --max-dt S            largest time difference to the nearest true range sample [s] (default 0.05)
-  --yaml FILE           write the statistics as YAML
-  --plots DIR           write range_errors.csv and one error histogram PNG per pair into DIR
-  --help                this text
-
-Bias convention: γ = mean(z - d), measured minus true (range model z = β d + γ). The toolbox's
-reference table holds the opposite sign (d - z); it is converted for the comparison.
-)";
+void declareOptions(Cli& cli, RangeStatsCli& c) {
+  cli.optional("dataset", c.dataset,
+               "a recording like shared/data/real-t1-a3-loiter (*_ranges.csv measured, true_ranges*.csv true "
+               "tag-to-anchor distances, config.yaml abs_anchor_positions, optional reference_statistics.yaml), or a "
+               "meshnav dataset (ranges.csv, groundtruth.csv, setup.yaml tag lever arms, truth.yaml all anchors and "
+               "true pair biases)")
+      ->type_name("DIR")
+      ->required();
+  cli.optional("reference", c.reference, "toolbox statistics to compare with (default DIR/reference_statistics.yaml)")
+      ->type_name("FILE");
+  cli.optional("method", c.method,
+               "histogram: the toolbox's filtered histogram (reproduces its tables; its sigma is about half the true "
+               "sigma for Gaussian noise); clip: median/MAD start, iterated 3 sigma clipping (recovers a simulated "
+               "gamma, sigma_d); gate: plain mean/std after the gate. Default: histogram when a reference is "
+               "compared, else clip")
+      ->type_name("NAME")
+      ->check(CLI::IsMember({"histogram", "clip", "gate"}));
+  cli.option("max-error", c.stats.max_error_m, "gross outlier gate |z - d| <= M [m]")
+      ->type_name("M")->check(cli::positive());
+  cli.option("bins", c.stats.histogram_bins, "histogram bins")->type_name("N")->check(CLI::Range(1, 100000));
+  cli.option("inlier-fraction", c.stats.inlier_fraction, "assumed inlier fraction of the histogram filter")
+      ->type_name("F")->check(CLI::Range(0.0, 1.0));
+  cli.option("max-dt", c.max_dt_s, "largest time difference to the nearest true range sample [s]")
+      ->type_name("S")->check(cli::positive());
+  cli.optional("yaml", c.yaml, "write the statistics as YAML")->type_name("FILE");
+  cli.optional("plots", c.plots, "write range_errors.csv and one error histogram PNG per pair into DIR")
+      ->type_name("DIR");
+  cli.app().footer(
+      "Bias convention: gamma = mean(z - d), measured minus true (range model z = beta d + gamma). The toolbox's "
+      "reference table holds the opposite sign (d - z); it is converted for the comparison.");
+}
 
 void writeStatsYaml(const std::map<std::pair<SensorId, SensorId>, PairRangeStats>& stats,
                     const RangeStatsOptions& o, const std::string& path) {
@@ -81,36 +91,23 @@ void writeStatsYaml(const std::map<std::pair<SensorId, SensorId>, PairRangeStats
   f << out.c_str() << "\n";
 }
 
-int run(const Cli& cli) {
-  if (!cli.has("dataset")) {
-    std::cerr << "meshnav_range_stats: --dataset is required\n\n" << cli.usage();
-    return 2;
-  }
-  const fs::path dir = cli.get("dataset");
+int run(const RangeStatsCli& cli) {
+  const fs::path dir = cli.dataset;
   if (!fs::is_directory(dir)) {
     spdlog::error("{} is not a directory", dir.string());
     return 1;
   }
-  RangeStatsOptions opt;
+  RangeStatsOptions opt = cli.stats;
   const std::string ref_path =
-      cli.has("reference") ? cli.get("reference")
-                           : (fs::exists(dir / "reference_statistics.yaml") ? (dir / "reference_statistics.yaml").string()
-                                                                             : "");
-  const std::string method = cli.get("method", ref_path.empty() ? "clip" : "histogram");
-  if (method == "histogram") opt.method = BiasMethod::Histogram;
-  else if (method == "gate") opt.method = BiasMethod::Gate;
-  else if (method == "clip") opt.method = BiasMethod::Clip;
-  else {
-    std::cerr << "meshnav_range_stats: unknown --method '" << method << "' (histogram|clip|gate)\n";
-    return 2;
-  }
-  opt.max_error_m = cli.getDouble("max-error", 1.0);
-  opt.histogram_bins = static_cast<int>(cli.getInt("bins", 50));
-  opt.inlier_fraction = cli.getDouble("inlier-fraction", 0.3);
+      !cli.reference.empty() ? cli.reference
+                             : (fs::exists(dir / "reference_statistics.yaml") ? (dir / "reference_statistics.yaml").string()
+                                                                               : "");
+  const std::string method = !cli.method.empty() ? cli.method : ref_path.empty() ? "clip" : "histogram";
+  opt.method = method == "histogram" ? BiasMethod::Histogram : method == "gate" ? BiasMethod::Gate : BiasMethod::Clip;
 
   Diagnostics diag;
   diag.max_logged_per_kind = 2;  // real recordings hold hundreds of absurd ranges; all are counted
-  RangeEvaluationInput in = loadRangeEvaluationInput(dir.string(), diag, cli.getDouble("max-dt", 0.05));
+  RangeEvaluationInput in = loadRangeEvaluationInput(dir.string(), diag, cli.max_dt_s);
   const auto& ranges = in.ranges;
   const auto& truth = in.truth;
   const auto& truth_pairs = in.truth_pairs;
@@ -143,12 +140,12 @@ int run(const Cli& cli) {
   const std::string d = diag.summary();
   if (!d.empty()) std::cout << "input diagnostics: " << d << "\n";
 
-  if (cli.has("yaml")) {
-    writeStatsYaml(stats, opt, cli.get("yaml"));
-    spdlog::info("wrote {}", cli.get("yaml"));
+  if (!cli.yaml.empty()) {
+    writeStatsYaml(stats, opt, cli.yaml);
+    spdlog::info("wrote {}", cli.yaml);
   }
-  if (cli.has("plots")) {
-    const fs::path out = cli.get("plots");
+  if (!cli.plots.empty()) {
+    const fs::path out = cli.plots;
     fs::create_directories(out);
     const fs::path csv = out / "range_errors.csv";
     std::ofstream f(csv);
@@ -171,14 +168,13 @@ int run(const Cli& cli) {
 
 int main(int argc, char** argv) {
   setupLogging("meshnav_range_stats");
-  Cli cli("meshnav_range_stats", kUsage);
-  for (const char* o : {"dataset", "reference", "method", "max-error", "bins", "inlier-fraction", "max-dt",
-                        "yaml", "plots"})
-    cli.option(o, true);
+  Cli cli("meshnav_range_stats", "Per ordered pair range bias and noise against true distances.");
+  RangeStatsCli c;
+  declareOptions(cli, c);
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   try {
-    return run(cli);
+    return run(c);
   } catch (const std::exception& ex) {
     spdlog::error("{}", ex.what());
     return 1;

@@ -2,49 +2,43 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 
 namespace meshnav::mission {
 
-const char* const kMissionProcessUsage =
-    "mission --mission FILE [options]\n"
-    "  Runs a mission script (mission/README.md) in data time: subscribes POSE, RANGE (data time;\n"
-    "  see --time-from), CALIB_STATUS, ESTIMATOR_STATUS; publishes CALIB_CMD, ESTIMATOR_CMD and\n"
-    "  MISSION_STATUS (also a wall-clock heartbeat). Step times are seconds after t0. Exits once\n"
-    "  every step ran and the calibrator answered the last Calibrate (or --linger passed), unless\n"
-    "  --stay.\n"
-    "  --mission FILE     mission script (e.g. config/missions/paper_s2.yaml)\n"
-    "  --t0 S|auto        dataset time [s] of step time 0 (e.g. 0 for meshnav_sim datasets);\n"
-    "                     auto (default): the first data time received (start the mission before\n"
-    "                     the data flows)\n"
-    "  --time-from LIST   comma-separated channels whose message time advances the mission clock,\n"
-    "                     besides POSE (which starts only once the estimator initialized):\n"
-    "                     RANGE, IMU, BARO, FLIGHT_STATE, or none (default RANGE)\n"
-    "  --stay             keep running (heartbeat) after the mission finished\n"
-    "  --linger S         wall seconds to wait for the calibrator's answer to the last step\n"
-    "                     before exiting (default 10)\n"
-    "  --status-period S  MISSION_STATUS period in data time (default 1)\n"
-    "  --heartbeat S      wall seconds between heartbeat MISSION_STATUS (default 1)\n"
-    "  --print-config     print the options and exit\n";
+const char* const kMissionProcessDescription =
+    "Runs a mission script (mission/README.md) in data time: subscribes POSE, RANGE (data time; see --time-from), "
+    "CALIB_STATUS, ESTIMATOR_STATUS; publishes CALIB_CMD, ESTIMATOR_CMD and MISSION_STATUS (also a wall-clock "
+    "heartbeat). Step times are seconds after t0. Exits once every step ran and the calibrator answered the last "
+    "Calibrate (or --linger passed), unless --stay.";
 
-void declareMissionProcessOptions(Cli& cli) {
-  cli.option("mission").option("t0").option("time-from").option("linger").option("status-period").option("heartbeat");
-  cli.option("stay", false).option("print-config", false);
-  cli.option("lcm-url").option("config").option("log-level");
+void declareMissionProcessOptions(Cli& cli, MissionProcessConfig& c) {
+  cli.optional("mission", c.mission_path, "mission script (e.g. config/missions/paper_s2.yaml); required")
+      ->type_name("FILE");
+  cli.option("t0", c.t0_text,
+             "dataset time [s] of step time 0 (e.g. 0 for meshnav_sim datasets); auto: the first data time "
+             "received (start the mission before the data flows)")
+      ->type_name("S|auto");
+  cli.option("time-from", c.time_from_text,
+             "comma-separated channels whose message time advances the mission clock, besides POSE (which starts "
+             "only once the estimator initialized): RANGE, IMU, BARO, FLIGHT_STATE, or none")
+      ->type_name("LIST");
+  cli.flag("stay", c.stay, "keep running (heartbeat) after the mission finished");
+  cli.option("linger", c.linger_s, "wall seconds to wait for the calibrator's answer to the last step before exiting")
+      ->type_name("S")
+      ->check(cli::nonNegative());
+  cli.option("status-period", c.status_period_s, "MISSION_STATUS period in data time [s]")
+      ->type_name("S")
+      ->check(cli::positive());
+  cli.option("heartbeat", c.heartbeat_s, "wall seconds between heartbeat MISSION_STATUS")
+      ->type_name("S")
+      ->check(cli::positive());
+  cli.flag("print-config", c.print_config, "print the options and exit");
 }
 
 namespace {
-
-double number(const Cli& cli, const std::string& name, double fallback, double min, bool strict) {
-  const double v = cli.getDouble(name, fallback);  // throws naming the option when not a number
-  if (!std::isfinite(v) || v < min || (strict && v == min)) {
-    std::ostringstream s;
-    s << "--" << name << " must be " << (strict ? "> " : ">= ") << min << ", got '" << cli.get(name) << "'";
-    throw std::runtime_error(s.str());
-  }
-  return v;
-}
 
 std::vector<std::string> splitChannels(const std::string& list) {
   std::vector<std::string> out;
@@ -64,22 +58,16 @@ std::vector<std::string> splitChannels(const std::string& list) {
 
 }  // namespace
 
-MissionProcessConfig missionProcessConfig(const Cli& cli) {
-  MissionProcessConfig c;
-  c.mission_path = cli.get("mission");
-  c.print_config = cli.has("print-config");
-  c.stay = cli.has("stay");
-  const std::string t0 = cli.get("t0", "auto");
-  if (t0 != "auto") {
-    const double v = cli.getDouble("t0", 0.0);
-    if (!std::isfinite(v)) throw std::runtime_error("--t0 must be a finite number of seconds or auto");
+void finishMissionProcessConfig(MissionProcessConfig& c) {
+  c.t0_s.reset();
+  if (c.t0_text != "auto") {
+    char* end = nullptr;
+    const double v = std::strtod(c.t0_text.c_str(), &end);
+    if (c.t0_text.empty() || *end != '\0' || !std::isfinite(v))
+      throw std::runtime_error("--t0 must be a finite number of seconds or auto, got '" + c.t0_text + "'");
     c.t0_s = v;
   }
-  if (cli.has("time-from")) c.time_channels = splitChannels(cli.get("time-from"));
-  c.linger_s = number(cli, "linger", 10.0, 0.0, false);
-  c.status_period_s = number(cli, "status-period", 1.0, 0.0, true);
-  c.heartbeat_s = number(cli, "heartbeat", 1.0, 0.0, true);
-  return c;
+  c.time_channels = splitChannels(c.time_from_text);
 }
 
 std::string MissionProcessConfig::toString() const {

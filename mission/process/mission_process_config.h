@@ -33,17 +33,22 @@ struct MissionProcessConfig {
   double heartbeat_s = 1.0;                     ///< --heartbeat: wall time between MISSION_STATUS heartbeats [s]
   double status_period_s = 1.0;                 ///< --status-period: MISSION_STATUS period in data time [s]
   bool print_config = false;                    ///< --print-config
+  std::string t0_text = "auto";                 ///< --t0 as given (S or auto), read by finishMissionProcessConfig
+  std::string time_from_text = "RANGE";         ///< --time-from as given, read by finishMissionProcessConfig
   std::string toString() const;
 };
 
-/// The process's usage text (without the common process options).
-extern const char* const kMissionProcessUsage;
+/// What the process does (the first paragraph of --help).
+extern const char* const kMissionProcessDescription;
 
-/// Declares every option of the process on `cli` (including --lcm-url, --config, --log-level).
-void declareMissionProcessOptions(Cli& cli);
+/// Declares the process's own options on `cli`, bound to the fields of `config` (their initial
+/// values are the defaults --help shows); numbers out of range are refused by the parse. The
+/// options every process has (--lcm-url, --log-level) come from transport::ProcessMain.
+void declareMissionProcessOptions(Cli& cli, MissionProcessConfig& config);
 
-/// Reads the parsed command line. Throws std::runtime_error naming the option on a bad value.
-MissionProcessConfig missionProcessConfig(const Cli& cli);
+/// After the parse: reads --t0 (S or auto) and --time-from (channel list). Throws
+/// std::runtime_error naming the option on a bad value.
+void finishMissionProcessConfig(MissionProcessConfig& config);
 
 /// Passes on only advancing data times (several channels, arriving out of order between them).
 class DataClock {

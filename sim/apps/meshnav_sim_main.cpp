@@ -16,57 +16,81 @@
 #include "sim/uncertain_anchors.h"
 
 namespace {
-constexpr const char* kUsage = R"(meshnav_sim: simulate one sequence (the paper's scenario by default, DESIGN §7)
+/// The command line: the simulation options (their defaults are the code's) and the texts that
+/// are parsed after the command line.
+struct SimCli {
+  meshnav::sim::SimulationOptions sim;
+  int64_t seed = 1;
+  std::string out, trajectory, hall, anchor_layout, imu_grade;
+  double duration_s = 0.0;
+  double bias_max_m = 0.0;
+  double uncertain_sigma_m = 0.0;
+  bool no_initial_pose = false, uncertain_known = false;
+};
 
-Usage: meshnav_sim --seed N --out DIR [options]
-
-  --seed N                 sequence seed; 1-12 are the twelve sequences (default 1); every random
-                           choice below (flight, anchors, noise) is drawn from it
-  --out DIR                output dataset folder (required; created if needed)
-
-Scenario (defaults: the paper's scenario):
-  --trajectory KIND        spiral|figure8|lawnmower|helix|hover|walk (default spiral: the paper's
-                           flight). hover starts in the air; walk is a hand-held rig at 0.9-1.5 m
-                           with no take-off, no landed state and no barometer
-  --hall X,Y,Z             hall size [m], centred on x = y = 0, floor at z = 0; X, Y in [3, 100],
-                           Z in [2.5, 30] (default: the paper's hall, 5.5 x 8.4 x 8.2 m)
-  --anchor-layout L        paper|walls|one-wall|ceiling|random (default paper: the paper's anchors,
-                           mapped into --hall)
-  --tags N                 UWB tags on the vehicle, 1-3: 100, 105, 99 (default 2)
-  --known N                anchors with known positions in setup.yaml, 3-5 (default 4: 101-104)
-  --unknown N              further anchors, only in truth.yaml (fly-by calibration), 0-20
-                           (default 5: 106-110; paper layout: --known + --unknown <= 9)
-  --duration S             sequence length [s], 30-3600 (default 140 s x --duration-scale; for
-                           spiral the paper's flight is time-scaled to about S)
-  --duration-scale S       multiply every time constant of the flight (default 1: ~140 s)
-
-Sensors:
-  --sigma-range M          UWB range noise sigma_d [m] (default 0.1)
-  --outliers F             fraction of NLOS outlier ranges, +U(0.5, 3) m (default 0.05);
-  --outlier-fraction F     the same
-  --drop F                 fraction of dropped range messages (default 0.02);
-  --drop-fraction F        the same
-  --bias-max M             max |constant pairwise bias gamma| of the UWB hardware [m], (0, 2]
-                           (default 0.4; gamma ~ N(0, (0.375 M)^2) clipped to +-M)
-  --imu-grade G            consumer|fc|tactical IMU noise densities and bias random walks, written
-                           to setup.yaml noise: (default fc, a flight-controller IMU)
-  --no-initial-pose        do not write the take-off pad prior to setup.yaml (never written for
-                           hover and walk, which do not start on a pad)
-  --uncertain-anchors M    write the anchors that are not known (106-110) to setup.yaml as
-                           truth + N(0, M^2) per axis (seeded by --seed) with position sigma M [m],
-                           so that the estimator refines them online, with a-priori pair biases for
-                           every pair (as for 101-104); 101-104 stay exact; truth.yaml is unchanged
-                           (default: off, only 101-104 in setup.yaml)
-  --uncertain-known-anchors
-                           with --uncertain-anchors: perturb 101-104 as well (no exact anchor left:
-                           the frame is held by the priors only)
-  --help                   this text
-
-Writes imu.csv (200 Hz), baro.csv (50 Hz; not for walk), ranges.csv (meshed TDMA over every tag
-and anchor, 10 ms slots), flight_state.csv (10 Hz; only for motions with a landed phase),
-groundtruth.csv (60 Hz, TUM), setup.yaml (what a user knows) and truth.yaml (evaluation only).
-The same seed and options give the same files.
-)";
+void declareOptions(meshnav::Cli& cli, SimCli& c) {
+  namespace cli_checks = meshnav::cli;
+  auto& o = c.sim;
+  cli.option("seed", c.seed,
+             "sequence seed; 1-12 are the twelve sequences; every random choice below (flight, anchors, noise) is "
+             "drawn from it")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber);
+  cli.optional("out", c.out, "output dataset folder (created if needed)")->type_name("DIR")->required();
+  cli.optional("trajectory", c.trajectory,
+               "spiral|figure8|lawnmower|helix|hover|walk (default spiral: the paper's flight). hover starts in the "
+               "air; walk is a hand-held rig at 0.9-1.5 m with no take-off, no landed state and no barometer")
+      ->type_name("KIND")
+      ->group("Scenario (default: the paper's)");
+  cli.optional("hall", c.hall,
+               "hall size [m], centred on x = y = 0, floor at z = 0; X, Y in [3, 100], Z in [2.5, 30] (default: the "
+               "paper's hall, 5.5 x 8.4 x 8.2 m)")
+      ->type_name("X,Y,Z")
+      ->group("Scenario (default: the paper's)");
+  cli.optional("anchor-layout", c.anchor_layout,
+               "paper|walls|one-wall|ceiling|random (default paper: the paper's anchors, mapped into --hall)")
+      ->type_name("L")
+      ->group("Scenario (default: the paper's)");
+  cli.option("tags", o.n_tags, "UWB tags on the vehicle: 100, 105, 99")
+      ->type_name("N")->check(CLI::Range(1, 3))->group("Scenario (default: the paper's)");
+  cli.option("known", o.n_known_anchors, "anchors with known positions in setup.yaml (101-...)")
+      ->type_name("N")->check(CLI::Range(3, 5))->group("Scenario (default: the paper's)");
+  cli.option("unknown", o.n_unknown_anchors,
+             "further anchors, only in truth.yaml (fly-by calibration; paper layout: --known + --unknown <= 9)")
+      ->type_name("N")->check(CLI::Range(0, 20))->group("Scenario (default: the paper's)");
+  cli.optional("duration", c.duration_s,
+               "sequence length [s], 30-3600 (default 140 s x --duration-scale; for spiral the paper's flight is "
+               "time-scaled to about S)")
+      ->type_name("S")->check(cli_checks::finite())->group("Scenario (default: the paper's)");
+  cli.option("duration-scale", o.duration_scale, "multiply every time constant of the flight")
+      ->type_name("S")->check(cli_checks::positive())->group("Scenario (default: the paper's)");
+  cli.option("sigma-range", o.uwb.sigma_range_m, "UWB range noise sigma_d [m]")
+      ->type_name("M")->check(cli_checks::nonNegative())->group("Sensors");
+  cli.option("outliers,--outlier-fraction", o.uwb.outlier_fraction, "fraction of NLOS outlier ranges, +U(0.5, 3) m")
+      ->type_name("F")->check(cli_checks::nonNegative())->group("Sensors");
+  cli.option("drop,--drop-fraction", o.uwb.drop_fraction, "fraction of dropped range messages")
+      ->type_name("F")->check(cli_checks::nonNegative())->group("Sensors");
+  c.bias_max_m = o.hardware.gamma_max_m;
+  cli.option("bias-max", c.bias_max_m,
+             "max |constant pairwise bias gamma| of the UWB hardware [m], (0, 2]; gamma ~ N(0, (0.375 M)^2) clipped "
+             "to +-M")
+      ->type_name("M")->group("Sensors");
+  cli.optional("imu-grade", c.imu_grade,
+               "consumer|fc|tactical IMU noise densities and bias random walks, written to setup.yaml noise: "
+               "(default fc, a flight-controller IMU)")
+      ->type_name("G")->group("Sensors");
+  cli.flag("no-initial-pose", c.no_initial_pose,
+           "do not write the take-off pad prior to setup.yaml (never written for hover and walk)")
+      ->group("Sensors");
+  cli.optional("uncertain-anchors", c.uncertain_sigma_m,
+               "write the anchors that are not known (106-110) to setup.yaml as truth + N(0, M^2) per axis (seeded by "
+               "--seed) with position sigma M [m], so that the estimator refines them online, with a-priori pair "
+               "biases for every pair; 101-104 stay exact; truth.yaml is unchanged (default: off)")
+      ->type_name("M")->group("Sensors");
+  cli.flag("uncertain-known-anchors", c.uncertain_known,
+           "with --uncertain-anchors: perturb 101-104 as well (the frame is held by the priors only)")
+      ->group("Sensors");
+}
 
 /// "X,Y,Z" → three numbers; throws naming --hall.
 Eigen::Vector3d parseHall(const std::string& text) {
@@ -78,114 +102,81 @@ Eigen::Vector3d parseHall(const std::string& text) {
   return v;
 }
 
-int intOption(const meshnav::Cli& cli, const char* name, int fallback, int lo, int hi) {
-  const int64_t v = cli.getInt(name, fallback);
-  if (v < lo || v > hi)
-    throw std::invalid_argument("--" + std::string(name) + " must be in [" + std::to_string(lo) + ", " +
-                                std::to_string(hi) + "], got " + std::to_string(v));
-  return static_cast<int>(v);
-}
-
-/// The scenario-generator options (see kUsage).
-void applyScenarioOptions(const meshnav::Cli& cli, meshnav::sim::SimulationOptions& o) {
+/// The options given as text (kinds, hall, IMU grade, bias bound), checked with messages naming them.
+void applyScenarioOptions(const meshnav::Cli& cli, SimCli& c) {
   using namespace meshnav::sim;
-  if (cli.has("trajectory")) {
-    const auto kind = parseTrajectoryKind(cli.get("trajectory"));
-    if (!kind) throw std::invalid_argument("--trajectory must be one of " + trajectoryKindNames() + ", got '" + cli.get("trajectory") + "'");
+  auto& o = c.sim;
+  if (cli.given("trajectory")) {
+    const auto kind = parseTrajectoryKind(c.trajectory);
+    if (!kind) throw std::invalid_argument("--trajectory must be one of " + trajectoryKindNames() + ", got '" + c.trajectory + "'");
     o.trajectory_kind = *kind;
   }
-  if (cli.has("anchor-layout")) {
-    const auto layout = parseAnchorLayoutKind(cli.get("anchor-layout"));
-    if (!layout) throw std::invalid_argument("--anchor-layout must be one of " + anchorLayoutKindNames() + ", got '" + cli.get("anchor-layout") + "'");
+  if (cli.given("anchor-layout")) {
+    const auto layout = parseAnchorLayoutKind(c.anchor_layout);
+    if (!layout) throw std::invalid_argument("--anchor-layout must be one of " + anchorLayoutKindNames() + ", got '" + c.anchor_layout + "'");
     o.anchor_layout = *layout;
   }
-  if (cli.has("hall")) o.hall_size_m = parseHall(cli.get("hall"));
-  o.n_tags = intOption(cli, "tags", o.n_tags, 1, 3);
-  o.n_known_anchors = intOption(cli, "known", o.n_known_anchors, 3, 5);
-  o.n_unknown_anchors = intOption(cli, "unknown", o.n_unknown_anchors, 0, 20);
-  if (cli.has("duration")) o.duration_s = cli.getDouble("duration", 140.0);
-  if (cli.has("imu-grade")) {
+  if (cli.given("hall")) o.hall_size_m = parseHall(c.hall);
+  if (cli.given("duration")) o.duration_s = c.duration_s;
+  if (cli.given("imu-grade")) {
     try {
-      o.imu = ImuNoiseOptions::forGrade(cli.get("imu-grade"));
+      o.imu = ImuNoiseOptions::forGrade(c.imu_grade);
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(std::string("--imu-grade: ") + e.what());
     }
   }
-  if (cli.has("bias-max")) {
-    const double m = cli.getDouble("bias-max", o.hardware.gamma_max_m);
-    if (!(m > 0.0 && m <= 2.0)) throw std::invalid_argument("--bias-max must be in (0, 2] m");
-    o.hardware.gamma_sigma_m = 0.375 * m;  // the default 0.15 m for 0.4 m
-    o.hardware.gamma_max_m = m;
+  if (cli.given("bias-max")) {
+    if (!(c.bias_max_m > 0.0 && c.bias_max_m <= 2.0)) throw std::invalid_argument("--bias-max must be in (0, 2] m");
+    o.hardware.gamma_sigma_m = 0.375 * c.bias_max_m;  // the default 0.15 m for 0.4 m
+    o.hardware.gamma_max_m = c.bias_max_m;
   }
+  if (cli.given("uncertain-anchors") && !(c.uncertain_sigma_m > 0.0 && c.uncertain_sigma_m < 10.0))
+    throw std::invalid_argument("--uncertain-anchors must be in (0, 10) m");
+  if (c.uncertain_known && !cli.given("uncertain-anchors"))
+    throw std::invalid_argument("--uncertain-known-anchors needs --uncertain-anchors M");
+  o.seed = static_cast<uint64_t>(c.seed);
+  o.with_initial_pose = !c.no_initial_pose;
+  o.validate();
 }
 
-meshnav::sim::SimulationOptions optionsFrom(const meshnav::Cli& cli) {
-  meshnav::sim::SimulationOptions options;
-  const int64_t seed = cli.getInt("seed", 1);
-  if (seed < 0) throw std::invalid_argument("--seed must be >= 0");
-  options.seed = static_cast<uint64_t>(seed);
-  options.uwb.sigma_range_m = cli.getDouble("sigma-range", options.uwb.sigma_range_m);
-  if (cli.has("outliers") && cli.has("outlier-fraction")) throw std::invalid_argument("give --outliers or --outlier-fraction, not both");
-  if (cli.has("drop") && cli.has("drop-fraction")) throw std::invalid_argument("give --drop or --drop-fraction, not both");
-  options.uwb.outlier_fraction = cli.getDouble(cli.has("outliers") ? "outliers" : "outlier-fraction", options.uwb.outlier_fraction);
-  options.uwb.drop_fraction = cli.getDouble(cli.has("drop") ? "drop" : "drop-fraction", options.uwb.drop_fraction);
-  options.duration_scale = cli.getDouble("duration-scale", options.duration_scale);
-  options.with_initial_pose = !cli.has("no-initial-pose");
-  applyScenarioOptions(cli, options);
-  options.validate();
-  return options;
-}
 }  // namespace
 
 int main(int argc, char** argv) {
   meshnav::setupLogging("meshnav_sim");
-  meshnav::Cli cli("meshnav_sim", kUsage);
-  cli.option("seed").option("out").option("sigma-range").option("outlier-fraction").option("drop-fraction")
-      .option("outliers").option("drop").option("duration-scale").option("no-initial-pose", false)
-      .option("uncertain-anchors").option("uncertain-known-anchors", false).option("trajectory").option("hall")
-      .option("anchor-layout").option("tags").option("known").option("unknown").option("bias-max")
-      .option("imu-grade").option("duration");
+  meshnav::Cli cli("meshnav_sim",
+                   "Simulates one sequence (the paper's scenario by default; docs/scenarios.md) and writes it as a "
+                   "dataset folder: imu.csv (200 Hz), baro.csv (50 Hz; not for walk), ranges.csv (meshed TDMA over "
+                   "every tag and anchor, 10 ms slots), flight_state.csv (10 Hz; only for motions with a landed "
+                   "phase), groundtruth.csv (60 Hz, TUM), setup.yaml (what a user knows) and truth.yaml (evaluation "
+                   "only). The same seed and options give the same files.");
+  SimCli c;
+  declareOptions(cli, c);
   int exit_code = 0;
   if (!cli.parse(argc, argv, exit_code)) return exit_code;
-  if (!cli.positional().empty()) {
-    std::cerr << "meshnav_sim: unexpected argument '" << cli.positional().front() << "'\n\n" << kUsage;
-    return 2;
-  }
-  if (!cli.has("out")) {
-    std::cerr << "meshnav_sim: --out DIR is required\n\n" << kUsage;
-    return 2;
-  }
-  meshnav::sim::SimulationOptions options;
   try {
-    options = optionsFrom(cli);
+    applyScenarioOptions(cli, c);
   } catch (const std::exception& e) {
     std::cerr << "meshnav_sim: " << e.what() << "\n(see meshnav_sim --help)\n";
     return 2;
   }
   try {
+    const auto& options = c.sim;
     spdlog::info("simulating: {}", options.toString());
-    const double uncertain_sigma_m = cli.getDouble("uncertain-anchors", 0.0);
-    if (cli.has("uncertain-anchors") && !(uncertain_sigma_m > 0.0 && uncertain_sigma_m < 10.0))
-      throw std::invalid_argument("--uncertain-anchors must be in (0, 10) m");
-    if (cli.has("uncertain-known-anchors") && !cli.has("uncertain-anchors"))
-      throw std::invalid_argument("--uncertain-known-anchors needs --uncertain-anchors M");
-
     const meshnav::sim::ScenarioSimulator simulator(options);
     meshnav::sim::SimulationResult result = simulator.run();
-    if (cli.has("uncertain-anchors")) {
+    if (cli.given("uncertain-anchors")) {
       meshnav::sim::UncertainAnchorOptions uo;
-      uo.sigma_m = uncertain_sigma_m;
-      uo.include_known = cli.has("uncertain-known-anchors");
+      uo.sigma_m = c.uncertain_sigma_m;
+      uo.include_known = c.uncertain_known;
       uo.seed = options.seed;
       const int n = meshnav::sim::makeAnchorsUncertain(result.dataset, uo, options.hardware, options.uwb.sigma_range_m);
       spdlog::info("uncertain anchors: {} anchors written with sigma {} m ({}), {} a-priori pair biases", n,
-                   uncertain_sigma_m, uo.include_known ? "all" : "known anchors exact", result.dataset.setup.pair_biases.size());
+                   c.uncertain_sigma_m, uo.include_known ? "all" : "known anchors exact", result.dataset.setup.pair_biases.size());
     }
     spdlog::info("{}", result.trajectory_description);
-    const std::string out = cli.get("out");
-    spdlog::info("writing dataset to {}", out);
-    meshnav::writeDataset(result.dataset, out);
-    std::cout << result.summary() << "\nDataset written to " << out << std::endl;
+    spdlog::info("writing dataset to {}", c.out);
+    meshnav::writeDataset(result.dataset, c.out);
+    std::cout << result.summary() << "\nDataset written to " << c.out << std::endl;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

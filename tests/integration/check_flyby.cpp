@@ -27,29 +27,22 @@
 #include "common/pose_interpolation.h"
 #include "common/setup.h"
 
-namespace {
-
 using namespace meshnav;
-
-std::vector<SensorId> parseIds(const std::string& list) {
-  std::vector<SensorId> ids;
-  std::stringstream ss(list);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    if (!item.empty()) ids.push_back(static_cast<SensorId>(std::stol(item)));
-  }
-  return ids;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   Cli cli("meshnav_check_flyby",
-          "meshnav_check_flyby --truth FILE --anchor-ids ID,ID [--anchor-init FILE] [--anchors FILE]\n"
-          "                    [--estimate FILE --groundtruth FILE] [--max-anchor-error M] [--max-rmse M]\n"
-          "  checks a fly-by run against truth.yaml (see the file's header); exit 0 when every check passes\n");
-  cli.option("truth").option("anchor-ids").option("anchor-init").option("anchors").option("estimate");
-  cli.option("groundtruth").option("max-anchor-error").option("max-rmse");
+          "Checks a fly-by run against truth.yaml (see the file's header); exit 0 when every check passes.");
+  std::string truth_path, anchor_init_path, anchors_path, estimate_path, groundtruth_path;
+  std::vector<SensorId> ids;
+  double max_err = 0.3, max_rmse = 0.15;
+  cli.optional("truth", truth_path, "truth.yaml")->type_name("FILE")->required();
+  cli.idList("anchor-ids", ids, "anchors to check")->required();
+  cli.optional("anchor-init", anchor_init_path, "anchor_init.yaml of the run")->type_name("FILE");
+  cli.optional("anchors", anchors_path, "anchors.csv of the run")->type_name("FILE");
+  cli.optional("estimate", estimate_path, "estimate.csv of the run")->type_name("FILE");
+  cli.optional("groundtruth", groundtruth_path, "groundtruth.csv (with --estimate)")->type_name("FILE");
+  cli.option("max-anchor-error", max_err, "largest anchor error [m]")->type_name("M")->check(cli::positive());
+  cli.option("max-rmse", max_rmse, "largest position RMSE [m]")->type_name("M")->check(cli::positive());
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   setupLogging("check_flyby");
@@ -59,10 +52,7 @@ int main(int argc, char** argv) {
     ++failures;
   };
   try {
-    const Truth truth = loadTruth(cli.get("truth"));
-    const std::vector<SensorId> ids = parseIds(cli.get("anchor-ids"));
-    const double max_err = cli.getDouble("max-anchor-error", 0.3);
-    const double max_rmse = cli.getDouble("max-rmse", 0.15);
+    const Truth truth = loadTruth(truth_path);
     auto truePos = [&](SensorId id) -> const Eigen::Vector3d* {
       const auto it = truth.anchor_positions.find(id);
       if (it == truth.anchor_positions.end()) return nullptr;
@@ -70,17 +60,17 @@ int main(int argc, char** argv) {
     };
 
     std::map<SensorId, AnchorInit> inits;  // the last one per anchor
-    if (cli.has("anchor-init")) {
-      for (const auto& a : readAnchorInitsYaml(cli.get("anchor-init"))) inits[a.id] = a;
+    if (!anchor_init_path.empty()) {
+      for (const auto& a : readAnchorInitsYaml(anchor_init_path)) inits[a.id] = a;
       for (SensorId id : ids) {
         const auto* truth_p = truePos(id);
         if (!truth_p) {
-          fail("anchor " + std::to_string(id) + " is not in " + cli.get("truth"));
+          fail("anchor " + std::to_string(id) + " is not in " + truth_path);
           continue;
         }
         const auto it = inits.find(id);
         if (it == inits.end()) {
-          fail("anchor " + std::to_string(id) + " is not in " + cli.get("anchor-init"));
+          fail("anchor " + std::to_string(id) + " is not in " + anchor_init_path);
           continue;
         }
         const double err = (it->second.p_AinG - *truth_p).norm();
@@ -91,9 +81,9 @@ int main(int argc, char** argv) {
       }
     }
 
-    if (cli.has("anchors")) {
+    if (!anchors_path.empty()) {
       Diagnostics diag;
-      const auto rows = readAnchorsCsv(cli.get("anchors"), diag);
+      const auto rows = readAnchorsCsv(anchors_path, diag);
       for (SensorId id : ids) {
         const auto init = inits.find(id);
         const Timestamp since = init != inits.end() ? init->second.t : Timestamp{};
@@ -117,10 +107,10 @@ int main(int argc, char** argv) {
       }
     }
 
-    if (cli.has("estimate")) {
+    if (!estimate_path.empty()) {
       Diagnostics diag;
-      const auto gt = readTumCsv(cli.get("groundtruth"), diag);
-      const auto est = readEstimateCsv(cli.get("estimate"), diag);
+      const auto gt = readTumCsv(groundtruth_path, diag);
+      const auto est = readEstimateCsv(estimate_path, diag);
       double sum = 0.0;
       size_t n = 0;
       for (const auto& e : est) {

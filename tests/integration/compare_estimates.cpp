@@ -37,19 +37,22 @@ Rmse positionRmse(const std::vector<meshnav::PoseSample>& gt, const std::vector<
 int main(int argc, char** argv) {
   using namespace meshnav;
   Cli cli("meshnav_compare_estimates",
-          "meshnav_compare_estimates --groundtruth FILE --reference FILE --candidate FILE [--tolerance F]\n"
-          "  position RMSE [m] of both estimate.csv files against the TUM ground truth; exit 0 when the\n"
-          "  candidate's RMSE is within F (default 0.05 = 5 %) of the reference's\n");
-  cli.option("groundtruth").option("reference").option("candidate").option("tolerance");
+          "Position RMSE [m] of both estimate.csv files against the TUM ground truth; exit 0 when the candidate's "
+          "RMSE is within --tolerance of the reference's.");
+  std::string gt_path, ref_path, cand_path;
+  double tol = 0.05;
+  cli.optional("groundtruth", gt_path, "TUM ground truth")->type_name("FILE")->required();
+  cli.optional("reference", ref_path, "reference estimate.csv")->type_name("FILE")->required();
+  cli.optional("candidate", cand_path, "candidate estimate.csv")->type_name("FILE")->required();
+  cli.option("tolerance", tol, "relative RMSE difference allowed (0.05 = 5 %)")->type_name("F")->check(cli::nonNegative());
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   setupLogging("compare");
   try {
     Diagnostics diag;
-    const auto gt = readTumCsv(cli.get("groundtruth"), diag);
-    const auto ref = readEstimateCsv(cli.get("reference"), diag);
-    const auto cand = readEstimateCsv(cli.get("candidate"), diag);
-    const double tol = cli.getDouble("tolerance", 0.05);
+    const auto gt = readTumCsv(gt_path, diag);
+    const auto ref = readEstimateCsv(ref_path, diag);
+    const auto cand = readEstimateCsv(cand_path, diag);
     const Rmse a = positionRmse(gt, ref), b = positionRmse(gt, cand);
     const double rel = std::abs(b.rmse_m - a.rmse_m) / a.rmse_m;
     std::printf("reference: %zu poses, position RMSE %.4f m\n", a.n, a.rmse_m);

@@ -22,21 +22,54 @@ namespace {
 using namespace meshnav;
 namespace fs = std::filesystem;
 
-/// Parses `args` (without the program name) with `declare`d options; returns the parse result.
+/// A process's options declared on a Cli (plus --lcm-url, which transport::ProcessMain adds in the
+/// process) and parsed from `args` (without the program name).
+template <class Config>
 struct Parsed {
   std::unique_ptr<Cli> cli;
+  Config config;
+  std::string lcm_url;
   bool ok = false;
   int code = -1;
 };
-template <typename Declare>
-Parsed parse(const std::string& program, Declare declare, std::vector<std::string> args) {
-  Parsed p;
-  p.cli = std::make_unique<Cli>(program, "usage");
-  declare(*p.cli);
-  std::vector<char*> argv{const_cast<char*>(program.c_str())};
-  for (auto& a : args) argv.push_back(a.data());
-  p.ok = p.cli->parse(static_cast<int>(argv.size()), argv.data(), p.code);
+template <class Config, typename Declare>
+std::unique_ptr<Parsed<Config>> parse(const std::string& program, Declare declare, std::vector<std::string> args) {
+  auto p = std::make_unique<Parsed<Config>>();
+  p->cli = std::make_unique<Cli>(program, "usage");
+  declare(*p->cli, p->config);
+  p->cli->optional("lcm-url", p->lcm_url, "LCM provider");
+  p->ok = p->cli->parse(args, p->code);
   return p;
+}
+auto parseCalibrator(std::vector<std::string> args) {
+  return parse<calib::CalibratorProcessConfig>("calibrator", calib::declareCalibratorProcessOptions, std::move(args));
+}
+auto parseMission(std::vector<std::string> args) {
+  return parse<mission::MissionProcessConfig>("mission", mission::declareMissionProcessOptions, std::move(args));
+}
+/// The config after the parse and loadCalibratorProcessConfig.
+calib::CalibratorProcessConfig loaded(const Parsed<calib::CalibratorProcessConfig>& p) {
+  calib::CalibratorProcessConfig c = p.config;
+  calib::loadCalibratorProcessConfig(c);
+  return c;
+}
+mission::MissionProcessConfig finished(const Parsed<mission::MissionProcessConfig>& p) {
+  mission::MissionProcessConfig c = p.config;
+  mission::finishMissionProcessConfig(c);
+  return c;
+}
+
+/// Why a command line is refused: by the parse (exit 2, the message) or after it (`finish` throws);
+/// "" when it is accepted.
+template <class Config, class Finish>
+std::string refusal(const Parsed<Config>& p, Finish finish) {
+  if (!p.ok) return p.code == 2 ? p.cli->error() : "";
+  try {
+    finish(p);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
 }
 
 class TempDir {
@@ -63,9 +96,9 @@ std::string repoFile(const std::string& rel) { return std::string(MESHNAV_SOURCE
 // ------------------------------------------------------------------------------------ calibrator
 
 TEST(CalibratorProcessConfig, DefaultsWithoutConfig) {
-  auto p = parse("calibrator", calib::declareCalibratorProcessOptions, {"--setup", "s.yaml"});
-  ASSERT_TRUE(p.ok);
-  const auto c = calib::calibratorProcessConfig(*p.cli);
+  auto p = parseCalibrator({"--setup", "s.yaml"});
+  ASSERT_TRUE(p->ok);
+  const auto c = loaded(*p);
   EXPECT_EQ(c.setup_path, "s.yaml");
   EXPECT_TRUE(c.config_path.empty());
   EXPECT_TRUE(c.out_yaml.empty());
@@ -76,11 +109,11 @@ TEST(CalibratorProcessConfig, DefaultsWithoutConfig) {
 }
 
 TEST(CalibratorProcessConfig, AutoOutYamlAndRates) {
-  auto p = parse("calibrator", calib::declareCalibratorProcessOptions,
-                 {"--setup", "s.yaml", "--auto", "--out-yaml", "o/c.yaml", "--pose-rate", "0", "--heartbeat", "0.2",
+  auto p = parseCalibrator(
+      {"--setup", "s.yaml", "--auto", "--out-yaml", "o/c.yaml", "--pose-rate", "0", "--heartbeat", "0.2",
                   "--lcm-url", "memq://"});
-  ASSERT_TRUE(p.ok);
-  const auto c = calib::calibratorProcessConfig(*p.cli);
+  ASSERT_TRUE(p->ok);
+  const auto c = loaded(*p);
   EXPECT_TRUE(c.node.auto_mode);
   EXPECT_EQ(c.out_yaml, "o/c.yaml");
   EXPECT_DOUBLE_EQ(c.pose_rate_hz, 0.0);
@@ -90,28 +123,23 @@ TEST(CalibratorProcessConfig, AutoOutYamlAndRates) {
 TEST(CalibratorProcessConfig, BadValuesNameTheOption) {
   for (const auto& args : std::vector<std::vector<std::string>>{
            {"--heartbeat", "0"}, {"--heartbeat", "x"}, {"--pose-rate", "-1"}, {"--pose-rate", "nan"}}) {
-    auto p = parse("calibrator", calib::declareCalibratorProcessOptions, args);
-    ASSERT_TRUE(p.ok);
-    try {
-      calib::calibratorProcessConfig(*p.cli);
-      FAIL() << "accepted " << args[0] << " " << args[1];
-    } catch (const std::runtime_error& e) {
-      EXPECT_NE(std::string(e.what()).find(args[0]), std::string::npos) << e.what();
-    }
+    auto p = parseCalibrator(args);
+    const std::string why = refusal(*p, loaded);
+    EXPECT_NE(why.find(args[0]), std::string::npos) << args[0] << " " << args[1] << ": " << why;
   }
 }
 
 TEST(CalibratorProcessConfig, UnknownOptionIsRejected) {
-  auto p = parse("calibrator", calib::declareCalibratorProcessOptions, {"--autom"});
-  EXPECT_FALSE(p.ok);
-  EXPECT_EQ(p.code, 2);
+  auto p = parseCalibrator({"--autom"});
+  EXPECT_FALSE(p->ok);
+  EXPECT_EQ(p->code, 2);
 }
 
 TEST(CalibratorProcessConfig, RepoConfigEqualsBuiltInDefaults) {
-  auto p = parse("calibrator", calib::declareCalibratorProcessOptions,
-                 {"--config", repoFile("config/calibrator.yaml")});
-  ASSERT_TRUE(p.ok);
-  const auto c = calib::calibratorProcessConfig(*p.cli);
+  auto p = parseCalibrator(
+      {"--config", repoFile("config/calibrator.yaml")});
+  ASSERT_TRUE(p->ok);
+  const auto c = loaded(*p);
   EXPECT_EQ(c.calibrator.toString(), calib::CalibratorOptions{}.toString());
   EXPECT_EQ(c.node.toString(), calib::CalibratorNodeOptions{}.toString());
   EXPECT_FALSE(c.sigma_range_from_config);  // left to setup.yaml on purpose
@@ -122,49 +150,49 @@ TEST(CalibratorProcessConfig, SigmaRangeFromSetupUnlessConfigured) {
   SystemSetup setup;
   setup.noise.sigma_range_m = 0.17;
 
-  auto p = parse("calibrator", calib::declareCalibratorProcessOptions, {});
-  ASSERT_TRUE(p.ok);
-  auto c = calib::calibratorProcessConfig(*p.cli);
+  auto p = parseCalibrator({});
+  ASSERT_TRUE(p->ok);
+  auto c = loaded(*p);
   calib::applySetup(c, setup);
   EXPECT_DOUBLE_EQ(c.calibrator.sigma_range_m, 0.17);
 
   const auto cfg = dir.file("c.yaml", "calibrator:\n  sigma_range: 0.12\ncalibrator_node:\n  auto_min_ranges: 50\n");
-  auto q = parse("calibrator", calib::declareCalibratorProcessOptions, {"--config", cfg});
-  ASSERT_TRUE(q.ok);
-  auto d = calib::calibratorProcessConfig(*q.cli);
+  auto q = parseCalibrator({"--config", cfg});
+  ASSERT_TRUE(q->ok);
+  auto d = loaded(*q);
   EXPECT_TRUE(d.sigma_range_from_config);
   calib::applySetup(d, setup);
   EXPECT_DOUBLE_EQ(d.calibrator.sigma_range_m, 0.12);
   EXPECT_EQ(d.node.auto_min_ranges, 50);
 
   SystemSetup no_noise;
-  auto e = calib::calibratorProcessConfig(*p.cli);
+  auto e = loaded(*p);
   calib::applySetup(e, no_noise);
   EXPECT_DOUBLE_EQ(e.calibrator.sigma_range_m, calib::CalibratorOptions{}.sigma_range_m);
 }
 
 TEST(CalibratorProcessConfig, EitherMapMayBeMissing) {
   TempDir dir;
-  auto p = parse("calibrator", calib::declareCalibratorProcessOptions,
-                 {"--config", dir.file("n.yaml", "calibrator_node:\n  auto_min_ranges: 50\n")});
-  ASSERT_TRUE(p.ok);
-  const auto c = calib::calibratorProcessConfig(*p.cli);
+  auto p = parseCalibrator(
+      {"--config", dir.file("n.yaml", "calibrator_node:\n  auto_min_ranges: 50\n")});
+  ASSERT_TRUE(p->ok);
+  const auto c = loaded(*p);
   EXPECT_EQ(c.node.auto_min_ranges, 50);
   EXPECT_EQ(c.calibrator.toString(), calib::CalibratorOptions{}.toString());
-  auto q = parse("calibrator", calib::declareCalibratorProcessOptions,
-                 {"--config", dir.file("flat.yaml", "min_measurements: 40\n")});
-  ASSERT_TRUE(q.ok);
-  const auto d = calib::calibratorProcessConfig(*q.cli);
+  auto q = parseCalibrator(
+      {"--config", dir.file("flat.yaml", "min_measurements: 40\n")});
+  ASSERT_TRUE(q->ok);
+  const auto d = loaded(*q);
   EXPECT_EQ(d.calibrator.min_measurements, 40);
 }
 
 TEST(CalibratorProcessConfig, ConfigErrorsNameFileAndKey) {
   TempDir dir;
   const auto bad = dir.file("bad.yaml", "calibrator_node:\n  auto_min_rangez: 50\n");
-  auto p = parse("calibrator", calib::declareCalibratorProcessOptions, {"--config", bad});
-  ASSERT_TRUE(p.ok);
+  auto p = parseCalibrator({"--config", bad});
+  ASSERT_TRUE(p->ok);
   try {
-    calib::calibratorProcessConfig(*p.cli);
+    loaded(*p);
     FAIL() << "accepted an unknown key";
   } catch (const std::runtime_error& e) {
     const std::string what = e.what();
@@ -172,17 +200,17 @@ TEST(CalibratorProcessConfig, ConfigErrorsNameFileAndKey) {
     EXPECT_NE(what.find("auto_min_rangez"), std::string::npos) << what;
   }
   const auto typo = dir.file("typo.yaml", "calibrator:\n  min_measurements: 40\ncalibrator_nodes:\n  auto_mode: true\n");
-  auto t = parse("calibrator", calib::declareCalibratorProcessOptions, {"--config", typo});
-  ASSERT_TRUE(t.ok);
+  auto t = parseCalibrator({"--config", typo});
+  ASSERT_TRUE(t->ok);
   try {
-    calib::calibratorProcessConfig(*t.cli);
+    loaded(*t);
     FAIL() << "accepted an unknown top-level key";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("calibrator_nodes"), std::string::npos) << e.what();
   }
-  auto q = parse("calibrator", calib::declareCalibratorProcessOptions, {"--config", dir.file("missing.yaml")});
-  ASSERT_TRUE(q.ok);
-  EXPECT_THROW(calib::calibratorProcessConfig(*q.cli), std::runtime_error);
+  auto q = parseCalibrator({"--config", dir.file("missing.yaml")});
+  ASSERT_TRUE(q->ok);
+  EXPECT_THROW(loaded(*q), std::runtime_error);
 }
 
 TEST(CalibrationYamlWriter, WritesOnChangeAndReadsBack) {
@@ -211,9 +239,9 @@ TEST(CalibrationYamlWriter, WritesOnChangeAndReadsBack) {
 // --------------------------------------------------------------------------------------- mission
 
 TEST(MissionProcessConfig, Defaults) {
-  auto p = parse("mission", mission::declareMissionProcessOptions, {"--mission", "m.yaml"});
-  ASSERT_TRUE(p.ok);
-  const auto c = mission::missionProcessConfig(*p.cli);
+  auto p = parseMission({"--mission", "m.yaml"});
+  ASSERT_TRUE(p->ok);
+  const auto c = finished(*p);
   EXPECT_EQ(c.mission_path, "m.yaml");
   EXPECT_FALSE(c.t0_s.has_value());
   EXPECT_EQ(c.time_channels, std::vector<std::string>{"RANGE"});
@@ -222,19 +250,19 @@ TEST(MissionProcessConfig, Defaults) {
 }
 
 TEST(MissionProcessConfig, T0TimeChannelsStay) {
-  auto p = parse("mission", mission::declareMissionProcessOptions,
-                 {"--t0", "0", "--time-from", "RANGE, IMU,RANGE", "--stay", "--linger", "0"});
-  ASSERT_TRUE(p.ok);
-  const auto c = mission::missionProcessConfig(*p.cli);
+  auto p = parseMission(
+      {"--t0", "0", "--time-from", "RANGE, IMU,RANGE", "--stay", "--linger", "0"});
+  ASSERT_TRUE(p->ok);
+  const auto c = finished(*p);
   ASSERT_TRUE(c.t0_s.has_value());
   EXPECT_DOUBLE_EQ(*c.t0_s, 0.0);
   EXPECT_EQ(c.time_channels, (std::vector<std::string>{"RANGE", "IMU"}));
   EXPECT_TRUE(c.stay);
   EXPECT_DOUBLE_EQ(c.linger_s, 0.0);
 
-  auto q = parse("mission", mission::declareMissionProcessOptions, {"--t0", "auto", "--time-from", "none"});
-  ASSERT_TRUE(q.ok);
-  const auto d = mission::missionProcessConfig(*q.cli);
+  auto q = parseMission({"--t0", "auto", "--time-from", "none"});
+  ASSERT_TRUE(q->ok);
+  const auto d = finished(*q);
   EXPECT_FALSE(d.t0_s.has_value());
   EXPECT_TRUE(d.time_channels.empty());
 }
@@ -246,14 +274,9 @@ TEST(MissionProcessConfig, BadValuesNameTheOption) {
                                                                 {"--linger", "-1"},
                                                                 {"--heartbeat", "0"},
                                                                 {"--status-period", "inf"}}) {
-    auto p = parse("mission", mission::declareMissionProcessOptions, args);
-    ASSERT_TRUE(p.ok);
-    try {
-      mission::missionProcessConfig(*p.cli);
-      FAIL() << "accepted " << args[0] << " " << args[1];
-    } catch (const std::runtime_error& e) {
-      EXPECT_NE(std::string(e.what()).find(args[0]), std::string::npos) << e.what();
-    }
+    auto p = parseMission(args);
+    const std::string why = refusal(*p, finished);
+    EXPECT_NE(why.find(args[0]), std::string::npos) << args[0] << " " << args[1] << ": " << why;
   }
 }
 

@@ -12,16 +12,16 @@
 
 int main(int argc, char** argv) {
   meshnav::Cli cli("meshnav_publish_garbage",
-                   "meshnav_publish_garbage --channel CH [--count N] [--lcm-url URL]\n"
-                   "  publishes N malformed messages on CH (N-1 random byte strings and one MISSION_STATUS)\n");
-  cli.option("channel").option("count").option("lcm-url");
+                   "Publishes N malformed messages on CH (N-1 random byte strings and one MISSION_STATUS).");
+  std::string ch, url;
+  int n = 3;
+  cli.optional("channel", ch, "channel")->type_name("CH")->required();
+  cli.option("count", n, "messages")->type_name("N")->check(CLI::NonNegativeNumber);
+  cli.optional("lcm-url", url, "LCM provider")->type_name("URL");
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
-  if (!cli.has("channel")) return 2;
-  lcm::LCM lcm(cli.get("lcm-url"));
+  lcm::LCM lcm(url);
   if (!lcm.good()) return 1;
-  const std::string ch = cli.get("channel");
-  const int n = static_cast<int>(cli.getInt("count", 3));
   std::mt19937 rng(42);
   for (int i = 0; i + 1 < n; ++i) {
     std::vector<uint8_t> bytes(static_cast<size_t>(1 + i * 37 % 200));

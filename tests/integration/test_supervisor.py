@@ -1,6 +1,8 @@
-"""Tests of scripts/supervisor.py: the launch-file YAML subset, variable substitution, and the
-process supervision (prefixed output, respawn, required processes, shutdown_after, SIGTERM then
-SIGKILL, stop on a signal). Processes are small shell commands; waits are on process exit."""
+"""Tests of scripts/supervisor.py: launch-file reading (yaml.safe_load, errors with file:line),
+variable substitution, and the process supervision (prefixed output, respawn with its limit and
+back-off, required processes, shutdown_after, SIGTERM then SIGKILL, stop on a signal), and the
+respawn / required settings of the shipped launch files. Processes are small shell commands;
+waits are on process exit or on a line of output."""
 import os
 import signal
 import subprocess
@@ -27,12 +29,33 @@ def run_launch(text, *args, timeout=30):
         os.unlink(path)
 
 
-class YamlSubset(unittest.TestCase):
-    def test_nested_document(self):
-        doc = supervisor.load_yaml_subset('''
+def run_until_then_sigterm(text, marker):
+    """Starts the supervisor on launch text `text`, reads its output until a line holding `marker`
+    (a condition, not a sleep), sends it SIGTERM. Returns (lines up to the marker, whether it was
+    still running then, exit code, output after the signal)."""
+    with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
+        f.write(text)
+    try:
+        p = subprocess.Popen([sys.executable, SUPERVISOR, f.name], stdout=subprocess.PIPE, text=True)
+        seen = []
+        for line in p.stdout:
+            seen.append(line)
+            if marker in line:
+                break
+        running = p.poll() is None
+        p.send_signal(signal.SIGTERM)
+        rest = p.stdout.read()
+        p.stdout.close()
+        return seen, running, p.wait(timeout=20), rest
+    finally:
+        os.unlink(f.name)
+
+
+class LaunchYaml(unittest.TestCase):
+    def test_launch_file_is_read_as_yaml(self):
+        doc = supervisor.load_yaml('''
 # a launch file
 name: demo   # trailing comment
-stop_timeout: 2.5
 shutdown_after: [a, "b c"]
 processes:
   - name: a
@@ -45,46 +68,28 @@ processes:
     args:
       - one
       - [nested, list]
-  -
-    name: d
-    command: x
 empty:
 ''')
-        self.assertEqual(doc['name'], 'demo')
-        self.assertEqual(doc['stop_timeout'], 2.5)
         self.assertEqual(doc['shutdown_after'], ['a', 'b c'])
         p = doc['processes']
-        self.assertEqual(len(p), 3)
         self.assertEqual(p[0]['args'], ['--url', 'udpm://239.255.76.67:7667?ttl=0', "it's", 3, -1.5, True,
                                         '# not a comment'])
         self.assertEqual(p[0]['env'], {'X': 1, 'Y': 'two words'})
         self.assertIs(p[1]['required'], True)
         self.assertEqual(p[1]['args'], ['one', ['nested', 'list']])
-        self.assertEqual(p[2], {'name': 'd', 'command': 'x'})
         self.assertIsNone(doc['empty'])
 
-    def test_multiline_flow_and_list_at_key_indent(self):
-        doc = supervisor.load_yaml_subset('a: [1,\n     2, {k: v,\n  w: [x]}]\nb:\n- p\n- q\n')
-        self.assertEqual(doc, {'a': [1, 2, {'k': 'v', 'w': ['x']}], 'b': ['p', 'q']})
-
     def test_errors_name_the_line(self):
-        for text, line in [('a: 1\n  b: 2\n', ':2'), ('a: [1, 2\nb: 3\n', ':1'), ('a: 1\na: 2\n', ':2'),
-                           ('a:\n\tb: 1\n', ':2'), ('a: "open\n', ':1')]:
+        for text, line in [('a: 1\n  b: 2\n', ':2'), ('a: [1, 2\nb: 3\n', ':2'), ('a: 1\na: 2\n', ':2'),
+                           ('x: 0\na:\n\tb: 1\n', ':3'), ('a: "open\n', ':2')]:
             with self.assertRaises(supervisor.LaunchError) as cm:
-                supervisor.load_yaml_subset(text, 'f.yaml')
-            self.assertIn('f.yaml' + line, str(cm.exception), text)
+                supervisor.load_yaml(text, 'f.yaml')
+            self.assertIn('f.yaml' + line + ':', str(cm.exception), text)
 
-    def test_same_as_pyyaml_on_the_launch_files(self):
-        try:
-            import yaml
-        except ImportError:
-            self.skipTest('PyYAML is not installed')
-        folder = os.path.join(SOURCE, 'config', 'launch')
-        for name in sorted(os.listdir(folder)):
-            if name.endswith('.yaml'):
-                with open(os.path.join(folder, name)) as f:
-                    text = f.read()
-                self.assertEqual(supervisor.load_yaml_subset(text, name), yaml.safe_load(text), name)
+    def test_duplicate_key_is_refused(self):
+        with self.assertRaises(supervisor.LaunchError) as cm:
+            supervisor.load_yaml('processes:\n  - {name: a, command: x, name: b}\n', 'f.yaml')
+        self.assertIn("duplicate key 'name'", str(cm.exception))
 
 
 class Substitution(unittest.TestCase):
@@ -122,7 +127,11 @@ class Substitution(unittest.TestCase):
                           ('processes:\n  - {name: a, command: x, bogus: 1}\n', 'bogus'),
                           ('processes:\n  - {name: a, command: x}\n  - {name: a, command: y}\n', 'duplicate'),
                           ('shutdown_after: [z]\nprocesses:\n  - {name: a, command: x}\n', "'z'"),
-                          ('processes:\n  - {name: a, command: "${NOPE}"}\n', 'NOPE')]:
+                          ('processes:\n  - {name: a, command: "${NOPE}"}\n', 'NOPE'),
+                          ('processes:\n  - {name: a, command: x, respawn: sometimes}\n', 'respawn must be'),
+                          ('processes:\n  - {name: a, command: x, max_respawns: 1.5}\n', 'max_respawns'),
+                          ('processes:\n  - {name: a, command: x, respawn_delay: -1}\n', 'respawn_delay'),
+                          ('processes:\n  - {name: a, command: x, required: maybe}\n', 'required')]:
             rc, out, err = run_launch(text)
             self.assertEqual(rc, 2, text)
             self.assertIn(msg, err, text)
@@ -208,23 +217,120 @@ processes:
         self.assertIn('cannot start ghost', out)
 
     def test_sigterm_stops_everything(self):
-        with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
-            f.write('processes:\n  - {name: a, command: "sh -c \'echo started; exec sleep 60\'"}\n'
-                    '  - {name: b, command: sleep 60, required: true}\n')
-        try:
-            p = subprocess.Popen([sys.executable, SUPERVISOR, f.name], stdout=subprocess.PIPE, text=True)
-            for line in p.stdout:  # wait for a condition: the child is up
-                if '[a] started' in line:
-                    break
-            p.send_signal(signal.SIGTERM)
-            rest = p.stdout.read()
-            p.stdout.close()
-            self.assertEqual(p.wait(timeout=20), 0, rest)
-            self.assertIn('stopping (signal 15)', rest)
-            self.assertIn('[supervisor] b exited', rest)
-        finally:
-            os.unlink(f.name)
+        _, running, rc, rest = run_until_then_sigterm(
+            'processes:\n  - {name: a, command: "sh -c \'echo started; exec sleep 60\'"}\n'
+            '  - {name: b, command: sleep 60, required: true}\n', '[a] started')
+        self.assertTrue(running)
+        self.assertEqual(rc, 0, rest)
+        self.assertIn('stopping (signal 15)', rest)
+        self.assertIn('[supervisor] b exited', rest)
 
+
+class Respawn(unittest.TestCase):
+    """respawn / required semantics: restarts up to the limit with a doubling back-off, a clean exit
+    not restarted under on-failure, a required process stopping all only once it is gone for good,
+    a process that is not required failing for good while the others go on."""
+
+    def test_on_failure_restarts_up_to_the_limit_with_back_off(self):
+        rc, out, _ = run_launch('''
+processes:
+  - name: flaky
+    command: sh -c 'echo run; exit 3'
+    respawn: on-failure
+    respawn_delay: 0.01
+    respawn_delay_max: 0.03
+    max_respawns: 3
+''')
+        self.assertEqual(rc, 0, out)  # not required: its failure does not fail the launch
+        self.assertEqual(out.count('[flaky] run'), 4, out)  # first run + 3 restarts
+        delays = [line.split(' in ')[1] for line in out.splitlines() if 'restarting flaky in' in line]
+        self.assertEqual(delays, ['0.01 s', '0.02 s', '0.03 s'])  # doubled, capped by respawn_delay_max
+        self.assertIn('flaky: no more respawns (max_respawns 3)', out)
+
+    def test_on_failure_does_not_restart_a_clean_exit(self):
+        rc, out, _ = run_launch('''
+processes:
+  - {name: done, command: "sh -c 'echo run; exit 0'", respawn: on-failure, respawn_delay: 0.01}
+  - {name: killed, command: "sh -c 'echo run; kill -9 $$'", respawn: on-failure, respawn_delay: 0.01,
+     max_respawns: 1}
+''')
+        self.assertEqual(rc, 0, out)
+        self.assertEqual(out.count('[done] run'), 1, out)
+        self.assertEqual(out.count('[killed] run'), 2, out)  # death by a signal is a failure
+        self.assertIn('killed exited (signal 9)', out)
+
+    def test_required_process_is_restarted_before_it_stops_all(self):
+        rc, out, _ = run_launch('''
+processes:
+  - {name: long, command: sleep 60, respawn: on-failure}
+  - name: core
+    command: sh -c 'echo core up; exit 4'
+    required: true
+    respawn: on-failure
+    respawn_delay: 0.01
+    max_respawns: 2
+''')
+        self.assertEqual(rc, 1, out)
+        self.assertEqual(out.count('[core] core up'), 3, out)
+        self.assertEqual(out.count('required process core exited'), 1, out)
+        self.assertLess(out.index('core: no more respawns'), out.index('stopping (required process core exited)'))
+        self.assertIn('FAILED: core (exit code 4)', out)
+        self.assertIn('[supervisor] long exited', out)
+        self.assertNotIn('restarting long', out)  # stopped by the supervisor: not restarted
+
+    def test_a_process_that_is_not_required_gives_up_while_the_others_run(self):
+        seen, running, rc, rest = run_until_then_sigterm('''
+processes:
+  - {name: nav, command: "sh -c 'echo nav up; exec sleep 60'", required: true, respawn: on-failure}
+  - name: calib
+    command: sh -c 'echo calib up; exit 1'
+    respawn: on-failure
+    respawn_delay: 0.01
+    max_respawns: 2
+''', 'calib: no more respawns')  # the condition: calib has given up
+        self.assertIn('[supervisor] calib: no more respawns (max_respawns 2)\n', seen)
+        self.assertEqual(sum('[calib] calib up' in line for line in seen), 3, seen)
+        self.assertFalse(any('nav exited' in line or 'stopping' in line for line in seen), seen)
+        self.assertTrue(running)  # the supervisor and nav still ran
+        self.assertEqual(rc, 0, rest)
+        self.assertIn('stopping (signal 15)', rest)
+        self.assertIn('[supervisor] nav exited', rest)
+
+    def test_shutdown_after_waits_for_the_last_restart(self):
+        rc, out, _ = run_launch('''
+shutdown_after: [job]
+shutdown_delay: 0
+processes:
+  - {name: bg, command: sleep 60}
+  - {name: job, command: "sh -c 'echo job run; exit 5'", respawn: on-failure, respawn_delay: 0.01,
+     max_respawns: 2}
+''')
+        self.assertEqual(rc, 1, out)
+        self.assertEqual(out.count('[job] job run'), 3, out)
+        self.assertLess(out.index('job: no more respawns'), out.index('stopping (every shutdown_after'))
+
+
+class ShippedLaunchFiles(unittest.TestCase):
+    """config/launch/*.yaml: every process is restarted after a crash with a limit, the estimator
+    is required, the calibrator is not (a calibrator crash must not stop navigation)."""
+
+    def test_respawn_and_required(self):
+        folder = os.path.join(SOURCE, 'config', 'launch')
+        variables = {'DATASET': '/d', 'OUT': '/o', 'LOG': '/l', 'SETUP': '/s', 'DEVICE': '/dev/null'}
+        names = sorted(n for n in os.listdir(folder) if n.endswith('.yaml'))
+        self.assertGreaterEqual(len(names), 5)
+        for name in names:
+            launch = supervisor.Launch(os.path.join(folder, name), variables)
+            for p in launch.procs:
+                where = '%s: %s' % (name, p.name)
+                self.assertNotEqual(p.respawn, 'never', where)
+                if p.max_respawns < 0:  # unlimited only with a bounded back-off
+                    self.assertLessEqual(p.respawn_delay_max, 30.0, where)
+                    self.assertGreater(p.respawn_delay, 0.0, where)
+                if p.name == 'estimator':
+                    self.assertTrue(p.required, where)
+                if p.name in ('calibrator', 'mission'):
+                    self.assertFalse(p.required, where)
 
 if __name__ == '__main__':
     unittest.main()

@@ -15,16 +15,6 @@
 
 namespace {
 
-const char* kUsage =
-    "dataset_to_lcmlog --dataset DIR --out FILE.lcmlog [--no-ground-truth]\n"
-    "  Writes imu.csv, baro.csv, flight_state.csv, ranges.csv and groundtruth.csv of DIR as the\n"
-    "  channels IMU, BARO, FLIGHT_STATE, RANGE, GROUND_TRUTH into an LCM log (event time = data\n"
-    "  time), ready for `lcm-logplayer FILE.lcmlog`.\n"
-    "  --dataset DIR        dataset folder (setup.yaml and ranges.csv required)\n"
-    "  --out FILE           output log file (overwritten)\n"
-    "  --no-ground-truth    leave GROUND_TRUTH out\n"
-    "  --help               this text\n";
-
 template <class Msg>
 bool writeEvent(lcm::LogFile& log, const std::string& channel, int64_t utime, const Msg& msg,
                 std::vector<uint8_t>& buf) {
@@ -44,19 +34,22 @@ bool writeEvent(lcm::LogFile& log, const std::string& channel, int64_t utime, co
 
 int main(int argc, char** argv) {
   using namespace meshnav;
-  Cli cli("dataset_to_lcmlog", kUsage);
-  cli.option("dataset").option("out").option("no-ground-truth", false);
+  Cli cli("dataset_to_lcmlog",
+          "Writes imu.csv, baro.csv, flight_state.csv, ranges.csv and groundtruth.csv of a dataset folder as the "
+          "channels IMU, BARO, FLIGHT_STATE, RANGE, GROUND_TRUTH into an LCM log (event time = data time), ready "
+          "for `lcm-logplayer FILE.lcmlog`.");
+  std::string dataset, out;
+  bool no_ground_truth = false;
+  cli.optional("dataset", dataset, "dataset folder (setup.yaml and ranges.csv required)")->type_name("DIR")->required();
+  cli.optional("out", out, "output log file (overwritten)")->type_name("FILE")->required();
+  cli.flag("no-ground-truth", no_ground_truth, "leave GROUND_TRUTH out");
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   setupLogging("dataset_to_lcmlog");
-  if (!cli.has("dataset") || !cli.has("out")) {
-    spdlog::error("--dataset and --out are required\n{}", kUsage);
-    return 2;
-  }
   try {
     Diagnostics diag;
-    const Dataset ds = readDataset(cli.get("dataset"), diag);
-    const bool with_gt = !cli.has("no-ground-truth");
+    const Dataset ds = readDataset(dataset, diag);
+    const bool with_gt = !no_ground_truth;
     // Streams in this order: equal times keep it — the estimator's canonical order (flight state,
     // IMU, baro, range), so a replay of the log causes no rewinds; inputs before the truth.
     const std::vector<std::vector<Timestamp>> times = {
@@ -64,7 +57,6 @@ int main(int argc, char** argv) {
         replay::timesOf(ds.ranges), with_gt ? replay::timesOf(ds.ground_truth) : std::vector<Timestamp>{}};
     const auto events = replay::mergeTimeline(times);
 
-    const std::string out = cli.get("out");
     const std::filesystem::path outp(out);
     if (outp.has_parent_path()) std::filesystem::create_directories(outp.parent_path());
     lcm::LogFile log(out, "w");

@@ -9,29 +9,43 @@
 
 namespace meshnav::transport {
 
-const std::vector<std::string>& replayOptionNames() {
-  static const std::vector<std::string> names = {"rate", "t0-utime", "data-t0", "wait-for",
-                                                 "wait-timeout", "start-delay", "progress"};
-  return names;
+void declareReplayOptions(Cli& cli, ReplayCliValues& v) {
+  cli.option("rate", v.rate, "playback speed: 1 = real time, N = N times faster, 0 = as fast as possible")
+      ->type_name("N")
+      ->check(cli::nonNegative());
+  cli.optional("t0-utime", v.t0_utime,
+               "wall time [µs since the Unix epoch] at which data time --data-t0 is played; give the same value "
+               "to several bridges to replay them in step (default: at start)")
+      ->type_name("US");
+  cli.optional("data-t0", v.data_t0_s, "data time [s] played at --t0-utime (default 0; with --t0-utime only)")
+      ->type_name("S")
+      ->check(cli::finite());
+  cli.optional("wait-for", v.wait_for, "start only after a message was seen on channel CH (e.g. ESTIMATOR_STATUS)")
+      ->type_name("CH");
+  cli.optional("wait-timeout", v.wait_timeout_s,
+               "give up (exit 3) when nothing arrived on --wait-for within S seconds (default: wait forever)")
+      ->type_name("S")
+      ->check(cli::nonNegative());
+  cli.option("start-delay", v.start_delay_s, "sleep S seconds before starting (prefer --wait-for)")
+      ->type_name("S")
+      ->check(cli::nonNegative());
+  cli.option("progress", v.progress_s, "seconds between progress lines (0 = none)")
+      ->type_name("S")
+      ->check(cli::nonNegative());
 }
 
-void declareReplayOptions(Cli& cli) {
-  for (const auto& n : replayOptionNames()) cli.option(n);
-}
-
-ReplayProcessOptions replayOptionsFrom(const OptionSource& cli) {
+ReplayProcessOptions replayOptionsFrom(const Cli& cli, const ReplayCliValues& v) {
   ReplayProcessOptions o;
-  o.replay.rate = cli.getDouble("rate", 1.0);
-  if (!(o.replay.rate >= 0.0)) throw std::runtime_error("--rate must be >= 0 (0 = as fast as possible)");
-  if (cli.has("t0-utime")) o.replay.t0_wall_utime = cli.getInt("t0-utime", 0);
-  if (cli.has("data-t0")) {
-    if (!cli.has("t0-utime")) throw std::runtime_error("--data-t0 needs --t0-utime");
-    o.replay.data_t0 = Timestamp::fromSec(cli.getDouble("data-t0", 0.0));
+  o.replay.rate = v.rate;
+  if (cli.given("t0-utime")) o.replay.t0_wall_utime = v.t0_utime;
+  if (cli.given("data-t0")) {
+    if (!cli.given("t0-utime")) throw std::runtime_error("--data-t0 needs --t0-utime");
+    o.replay.data_t0 = Timestamp::fromSec(v.data_t0_s);
   }
-  o.wait_for = cli.get("wait-for");
-  o.wait_timeout = Duration::fromSec(cli.getDouble("wait-timeout", 0.0));
-  o.start_delay = Duration::fromSec(cli.getDouble("start-delay", 0.0));
-  o.replay.progress_period = Duration::fromSec(cli.getDouble("progress", 5.0));
+  o.wait_for = v.wait_for;
+  o.wait_timeout = Duration::fromSec(v.wait_timeout_s);
+  o.start_delay = Duration::fromSec(v.start_delay_s);
+  o.replay.progress_period = Duration::fromSec(v.progress_s);
   return o;
 }
 

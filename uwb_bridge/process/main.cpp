@@ -7,11 +7,10 @@
 #include <set>
 #include <sstream>
 
-#include "common/cli.h"
 #include "common/setup.h"
 #include "transport/channels.h"
 #include "transport/lcm_node.h"
-#include "transport/process_options.h"
+#include "transport/process_main.h"
 #include "transport/replay/clock.h"
 #include "transport/replay_runner.h"
 #include "uwb_bridge/line_reader.h"
@@ -22,50 +21,51 @@ namespace {
 
 using namespace meshnav;
 
-const std::string kUsage = std::string(
-    "uwb_bridge (--dataset DIR | --csv FILE[,FILE...] [FILE...] | --serial DEV|-) [options]\n"
-    "  Publishes UWB ranges on RANGE (message utime = range time).\n"
-    "  --dataset DIR      replay ranges.csv of a dataset folder\n"
-    "  --csv FILES        replay range CSV files in the published format (t,range_raw,range_corr,R,\n"
-    "                     UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS; types T/A or 84/65), merged and\n"
-    "                     time-sorted; more files may follow as arguments\n"
-    "  --serial DEV       read the firmware driver's lines 'seq ID1 ID2 range_m' (space or comma\n"
-    "                     separated) from a serial device, FIFO, file, or '-' for stdin; each range is\n"
-    "                     stamped with the wall time of its receipt; malformed lines are reported\n"
-    "                     with their line number and counted\n"
-    "  --baud N           serial speed when DEV is a tty (default: leave as is)\n"
-    "  --tags ID,ID       (serial) ids that are tags; every other id is an anchor\n"
-    "  --setup FILE       (serial) take the tag ids from setup.yaml (rel_tag_positions)\n"
-    "  --min-range M      smallest plausible range [m] (default -0.5)\n"
-    "  --max-range M      largest plausible range [m] (default 500)\n"
-    "  Replays (dataset, csv) exit when played (0); serial ends at end of input (0). Bad input: 1;\n"
-    "  --wait-for timeout: 3.\n") +
-    transport::kReplayUsage + transport::kProcessUsage;
+/// The command line of the bridge.
+struct UwbBridgeOptions {
+  std::string dataset, csv, serial, setup;
+  std::vector<std::string> files;  ///< more range CSV files (positional)
+  int baud = 0;
+  std::vector<SensorId> tags;
+  RangeLimits limits;
+  transport::ReplayCliValues replay;
+};
 
-std::set<SensorId> parseIdList(const std::string& s) {
-  std::set<SensorId> ids;
-  for (const auto& item : uwb::splitPathList(s)) {
-    char* end = nullptr;
-    const long v = std::strtol(item.c_str(), &end, 10);
-    if (end == item.c_str() || *end != '\0' || v < 0) throw std::runtime_error("--tags: '" + item + "' is not an id");
-    ids.insert(static_cast<SensorId>(v));
-  }
-  return ids;
+void declareOptions(Cli& cli, UwbBridgeOptions& o) {
+  cli.optional("dataset", o.dataset, "replay ranges.csv of a dataset folder")->type_name("DIR");
+  cli.optional("csv", o.csv,
+               "replay range CSV files in the published format (t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,"
+               "type_ID2,LOS; types T/A or 84/65), merged and time-sorted; more files may follow as arguments")
+      ->type_name("FILE[,FILE...]");
+  cli.app().add_option("files", o.files, "more range CSV files (with --csv)")->type_name("FILE");
+  cli.optional("serial", o.serial,
+               "read the firmware driver's lines 'seq ID1 ID2 range_m' (space or comma separated) from a serial "
+               "device, FIFO, file, or '-' for stdin; each range is stamped with the wall time of its receipt; "
+               "malformed lines are reported with their line number and counted")
+      ->type_name("DEV");
+  cli.optional("baud", o.baud, "serial speed when DEV is a tty (default: leave as is)")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber);
+  cli.idList("tags", o.tags, "(serial) ids that are tags; every other id is an anchor");
+  cli.optional("setup", o.setup, "(serial) take the tag ids from setup.yaml (rel_tag_positions)")->type_name("FILE");
+  cli.option("min-range", o.limits.min_m, "smallest plausible range [m]")->type_name("M")->check(cli::finite());
+  cli.option("max-range", o.limits.max_m, "largest plausible range [m]")->type_name("M")->check(cli::finite());
+  transport::declareReplayOptions(cli, o.replay);
+  cli.optionsFile("these options as a YAML map (`rate: 10`, `max_range: 100`); the command line wins");
 }
 
-int runSerial(transport::LcmNode& node, const transport::OptionSource& opts, const RangeLimits& limits,
-              const transport::ReplayProcessOptions& start) {
+int runSerial(transport::LcmNode& node, const UwbBridgeOptions& opts, const transport::ReplayProcessOptions& start) {
   uwb::SerialParserOptions po;
-  po.limits = limits;
-  if (opts.has("tags")) po.tag_ids = parseIdList(opts.get("tags"));
-  if (opts.has("setup"))
-    for (const auto& [id, p] : loadSetup(opts.get("setup")).rel_tag_positions) po.tag_ids.insert(id);
+  po.limits = opts.limits;
+  po.tag_ids.insert(opts.tags.begin(), opts.tags.end());
+  if (!opts.setup.empty())
+    for (const auto& [id, p] : loadSetup(opts.setup).rel_tag_positions) po.tag_ids.insert(id);
   std::ostringstream tags;
   for (auto id : po.tag_ids) tags << id << ' ';
-  const std::string dev = opts.get("serial");
+  const std::string& dev = opts.serial;
   spdlog::info("serial input {}; tags: {}(all other ids are anchors)", dev == "-" ? "stdin" : dev,
                po.tag_ids.empty() ? std::string("none ") : tags.str());
-  uwb::LineReader reader(dev, static_cast<int>(opts.getInt("baud", 0)));
+  uwb::LineReader reader(dev, opts.baud);
   uwb::SerialLineParser parser(po, node.diagnostics(), dev == "-" ? "stdin" : dev);
   if (!transport::waitForStart(node, start)) return node.stopRequested() ? 0 : 3;
 
@@ -119,48 +119,29 @@ int runReplay(transport::LcmNode& node, const std::vector<RangeSample>& ranges,
 }  // namespace
 
 int main(int argc, char** argv) {
-  Cli cli("uwb_bridge", kUsage);
-  std::vector<std::string> names = {"dataset", "csv", "serial", "baud", "tags", "setup", "min-range", "max-range",
-                                    "lcm-url", "log-level"};
-  for (const auto& n : names) cli.option(n);
-  transport::declareProcessOptions(cli);
-  transport::declareReplayOptions(cli);
-  names.insert(names.end(), transport::replayOptionNames().begin(), transport::replayOptionNames().end());
-  int code = 0;
-  if (!cli.parse(argc, argv, code)) return code;
-  transport::startProcess("uwb_bridge", cli);
-  try {
-    const transport::OptionSource opts(cli, names);
+  transport::ProcessMain process(
+      "uwb_bridge",
+      "Publishes UWB ranges on RANGE (message utime = range time), from a dataset folder (--dataset), range CSV "
+      "files (--csv) or the serial line output of the UWB TWR firmware driver (--serial); give exactly one. Replays "
+      "exit when played (0); serial ends at end of input (0). Bad input: 1; --wait-for timeout: 3.");
+  UwbBridgeOptions opts;
+  declareOptions(process.cli(), opts);
+  return process.run(argc, argv, [&] {
     std::vector<std::string> csv_files;
-    if (opts.has("csv")) csv_files = uwb::splitPathList(opts.get("csv"));
-    for (const auto& p : cli.positional()) csv_files.push_back(p);
-    const int modes = (opts.has("dataset") ? 1 : 0) + (csv_files.empty() ? 0 : 1) + (opts.has("serial") ? 1 : 0);
+    if (!opts.csv.empty()) csv_files = uwb::splitPathList(opts.csv);
+    csv_files.insert(csv_files.end(), opts.files.begin(), opts.files.end());
+    const int modes = (opts.dataset.empty() ? 0 : 1) + (csv_files.empty() ? 0 : 1) + (opts.serial.empty() ? 0 : 1);
     if (modes != 1) {
-      spdlog::error("give exactly one of --dataset, --csv, --serial\n{}", kUsage);
+      spdlog::error("give exactly one of --dataset, --csv, --serial (see --help)");
       return 2;
     }
-    RangeLimits limits;
-    limits.min_m = opts.getDouble("min-range", limits.min_m);
-    limits.max_m = opts.getDouble("max-range", limits.max_m);
-    const auto replay_options = transport::replayOptionsFrom(opts);
-
-    if (opts.has("serial")) {
-      transport::LcmNode node("uwb_bridge", opts.get("lcm-url"));
-      return runSerial(node, opts, limits, replay_options);
-    }
+    const auto replay_options = transport::replayOptionsFrom(process.cli(), opts.replay);
+    if (!opts.serial.empty()) return runSerial(process.lcm(), opts, replay_options);
     Diagnostics diag;
-    std::vector<RangeSample> ranges;
-    if (opts.has("dataset")) {
-      ranges = uwb::importRangeCsv({(std::filesystem::path(opts.get("dataset")) / "ranges.csv").string()}, diag, limits);
-    } else {
-      ranges = uwb::importRangeCsv(csv_files, diag, limits);
-    }
+    if (!opts.dataset.empty()) csv_files = {(std::filesystem::path(opts.dataset) / "ranges.csv").string()};
+    const std::vector<RangeSample> ranges = uwb::importRangeCsv(csv_files, diag, opts.limits);
     if (diag.total() > 0) spdlog::warn("input problems (rows dropped): {}", diag.summary());
-    transport::LcmNode node("uwb_bridge", opts.get("lcm-url"));
-    spdlog::info("LCM {}", node.url());
-    return runReplay(node, ranges, replay_options);
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
-  }
+    spdlog::info("LCM {}", process.lcm().url());
+    return runReplay(process.lcm(), ranges, replay_options);
+  });
 }

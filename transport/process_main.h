@@ -1,0 +1,79 @@
+#pragma once
+/// @file process_main.h
+/// @brief The start-up every LCM process shares, so that a process main is its node's wiring
+/// only: the command line (common/cli.h) with the options every process has (`--lcm-url`,
+/// `--log-level`, `--help`), logging, SIGINT/SIGTERM (StopSignal), the LCM instance, exceptions
+/// turned into a logged error and exit 1, and the heartbeat that publishes the node's status
+/// stamped with the wall time and the process's own counters (malformed messages per channel).
+///
+/// Use:
+///   transport::ProcessMain process("estimator", "Fuses ...");
+///   process.cli().option("heartbeat", heartbeat_s, "...");
+///   return process.run(argc, argv, [&] { ...; return process.lcm().spin(); });
+
+#include <spdlog/spdlog.h>
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "common/cli.h"
+#include "transport/lcm_node.h"
+#include "transport/replay/clock.h"
+
+namespace meshnav::transport {
+
+class ProcessMain {
+ public:
+  /// Declares --lcm-url and --log-level on cli(); the process adds its own options.
+  ProcessMain(std::string name, const std::string& description);
+
+  Cli& cli() { return cli_; }
+  const std::string& name() const { return name_; }
+
+  /// Parses the command line (--help: exit 0; a bad one: exit 2), sets up logging (--log-level,
+  /// else $MESHNAV_LOG_LEVEL) and the SIGINT/SIGTERM stop, and runs `body`, whose return value is
+  /// the exit code; an exception out of it is logged and gives exit 1.
+  int run(int argc, char** argv, const std::function<int()>& body);
+
+  /// The LCM instance on --lcm-url (created on first use; throws when LCM cannot start).
+  LcmNode& lcm();
+
+  /// `status` as published: stamped with the wall time, and with the process's own counters
+  /// (added to `counters`, or appended to `text` for a status without counters).
+  template <class Status>
+  Status stamped(Status status) {
+    status.wall_utime = replay::wallUtimeNow();
+    if constexpr (requires { status.counters; }) {
+      for (const auto& [k, v] : lcm().diagnostics().snapshot()) status.counters[k] += v;
+    } else {
+      if (lcm().diagnostics().total() > 0) status.text += "; counters: " + lcm().diagnostics().summary();
+    }
+    return status;
+  }
+
+  /// Publishes stamped(status()) on `channel` every `period_s` of wall time from spin() (first at
+  /// once, so that others can wait for the process), then calls `after` with what was published.
+  template <class Status>
+  void heartbeat(const std::string& channel, double period_s, std::function<Status()> status,
+                 std::function<void(const Status&)> after = {}) {
+    lcm().setHeartbeat(Duration::fromSec(period_s), [this, channel, status, after] {
+      const Status st = stamped(status());
+      lcm().publish(channel, st);
+      if (after) after(st);
+    });
+  }
+
+ private:
+  std::string name_;
+  Cli cli_;
+  std::string lcm_url_;
+  std::string log_level_;
+  std::unique_ptr<LcmNode> lcm_;
+};
+
+/// "key=value key=value " of a counter map, for the last log line of a process.
+std::string formatCounters(const std::map<std::string, int64_t>& counters);
+
+}  // namespace meshnav::transport

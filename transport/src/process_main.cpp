@@ -1,0 +1,43 @@
+#include "transport/process_main.h"
+
+#include <fmt/format.h>
+
+#include "transport/stop_signal.h"
+
+namespace meshnav::transport {
+
+ProcessMain::ProcessMain(std::string name, const std::string& description)
+    : name_(std::move(name)), cli_(name_, description + "\nSIGINT / SIGTERM stop the process cleanly.") {
+  cli_.optional("lcm-url", lcm_url_, "LCM provider (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)")
+      ->type_name("URL");
+  cli_.optional("log-level", log_level_, "log level (default: $MESHNAV_LOG_LEVEL, else info)")
+      ->type_name("LEVEL")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "warning", "error", "critical", "off"}));
+}
+
+int ProcessMain::run(int argc, char** argv, const std::function<int()>& body) {
+  int code = 0;
+  if (!cli_.parse(argc, argv, code)) return code;
+  setupLogging(name_);
+  if (!log_level_.empty()) spdlog::set_level(spdlog::level::from_str(log_level_));
+  StopSignal::install();
+  try {
+    return body();
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+}
+
+LcmNode& ProcessMain::lcm() {
+  if (!lcm_) lcm_ = std::make_unique<LcmNode>(name_, lcm_url_);
+  return *lcm_;
+}
+
+std::string formatCounters(const std::map<std::string, int64_t>& counters) {
+  std::string out;
+  for (const auto& [k, v] : counters) out += fmt::format("{}={} ", k, v);
+  return out;
+}
+
+}  // namespace meshnav::transport
