@@ -95,6 +95,8 @@ void writeOutputs(const RunEvaluation& ev, const fs::path& out, bool plots, cons
   const fs::path est = fs::path(ev.run_dir) / "estimate.csv";
   if (fs::exists(gt)) args.insert(args.end(), {"--groundtruth", gt.string()});
   if (fs::exists(est)) args.insert(args.end(), {"--estimate", est.string()});
+  const fs::path track = fs::path(ev.run_dir) / "anchors.csv";
+  if (fs::exists(track)) args.insert(args.end(), {"--anchor-track", track.string()});
   if (runPlotScript("plot_run.py", args)) spdlog::info("plots written to {}", out.string());
 }
 

@@ -9,9 +9,11 @@ Writes into --out:
   position_error.png     position error x/y/z (truth - estimate) [m] with +-3 sigma bounds
   orientation_error.png  orientation error x/y/z (local, Log(R_est^T R_true)) [deg] with +-3 sigma
   nees.png               NEES of position and orientation with the 95 % chi2(3) interval
+  anchor_errors.png      per estimated anchor with a true position: error norm [m] and NEES (3 dof,
+                         log scale, 95 % interval and 99.7 % threshold) over time, from anchors.csv
 
 Inputs: errors.csv and anchors_eval.csv written by meshnav_eval, groundtruth.csv (TUM, optional),
-estimate.csv (optional). Headless: uses the Agg backend.
+estimate.csv and the run's anchors.csv (optional). Headless: uses the Agg backend.
 """
 import argparse
 import csv
@@ -25,6 +27,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 CHI2_3_95 = (0.2158, 9.3484)  # two-sided 95 % interval of chi2 with 3 dof
+CHI2_3_997 = 13.93  # 99.7 % quantile of chi2 with 3 dof
 MAX_POINTS = 20000
 
 
@@ -180,6 +183,55 @@ def plot_nees(out, err):
     plt.close(fig)
 
 
+def anchor_tracks(track, anchors):
+    """{id: (t, error norm, NEES)} for every anchor that is estimated (not known) and has a true
+    position; rows without a positive-definite covariance get NEES nan."""
+    out = {}
+    if track is None or anchors is None:
+        return out
+    for i, aid in enumerate(anchors["id"]):
+        if anchors["known"][i] > 0.5 or anchors["has_truth"][i] < 0.5:
+            continue
+        rows = track["id"] == aid
+        if not np.any(rows):
+            continue
+        truth = np.array([anchors["true_x"][i], anchors["true_y"][i], anchors["true_z"][i]])
+        e = np.stack([track["x"][rows], track["y"][rows], track["z"][rows]], 1) - truth
+        nees = np.full(len(e), np.nan)
+        for k in range(len(e)):
+            P = np.array([[track["pxx"][rows][k], track["pxy"][rows][k], track["pxz"][rows][k]],
+                          [track["pxy"][rows][k], track["pyy"][rows][k], track["pyz"][rows][k]],
+                          [track["pxz"][rows][k], track["pyz"][rows][k], track["pzz"][rows][k]]])
+            try:
+                np.linalg.cholesky(P)
+                nees[k] = e[k] @ np.linalg.solve(P, e[k])
+            except np.linalg.LinAlgError:
+                pass
+        out[int(aid)] = (track["t"][rows], np.linalg.norm(e, axis=1), nees)
+    return out
+
+
+def plot_anchor_errors(out, tracks):
+    fig, (ax_e, ax_n) = plt.subplots(2, 1, figsize=(10, 7), sharex=True)
+    t0 = min(v[0][0] for v in tracks.values())
+    for aid, (t, err, nees) in sorted(tracks.items()):
+        ax_e.plot(t - t0, err, lw=1.2, label=str(aid))
+        ax_n.semilogy(t - t0, np.maximum(nees, 1e-3), lw=1.2, label=str(aid))
+    ax_e.set_ylabel("error [m]")
+    ax_e.set_title("Estimated anchors: position error and NEES over time")
+    ax_e.grid(alpha=0.3)
+    ax_e.legend(fontsize=8, ncol=5)
+    ax_n.axhspan(*CHI2_3_95, color="0.85", label="95 % χ²(3)")
+    ax_n.axhline(CHI2_3_997, color="tab:red", ls="--", lw=1, label="99.7 % (13.93)")
+    ax_n.set_ylabel("NEES (3 dof)")
+    ax_n.set_xlabel("t − %.3f [s]" % t0)
+    ax_n.grid(alpha=0.3, which="both")
+    ax_n.legend(fontsize=8, ncol=6)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "anchor_errors.png"), dpi=110)
+    plt.close(fig)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", required=True, help="output folder for the PNGs")
@@ -187,6 +239,7 @@ def main():
     ap.add_argument("--anchors", help="anchors_eval.csv from meshnav_eval")
     ap.add_argument("--groundtruth", help="groundtruth.csv (TUM)")
     ap.add_argument("--estimate", help="estimate.csv")
+    ap.add_argument("--anchor-track", help="anchors.csv of the run (anchor estimates over time)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     gt = read_csv(args.groundtruth)
@@ -204,6 +257,10 @@ def main():
                     "Orientation error Log(R_est^T R_true) (body frame) with ±3σ")
         plot_nees(args.out, err)
         written += ["position_error.png", "orientation_error.png", "nees.png"]
+    tracks = anchor_tracks(read_csv(args.anchor_track), anchors)
+    if tracks:
+        plot_anchor_errors(args.out, tracks)
+        written.append("anchor_errors.png")
     if not written:
         print("plot_run.py: nothing to plot (no trajectory, no errors)", file=sys.stderr)
         return 1
