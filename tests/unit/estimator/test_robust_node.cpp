@@ -147,8 +147,8 @@ TEST(RobustNode, UnderstatedImuNoiseIsScaledUpFromTheRangeInnovations) {
   // An IMU with the white noise of a hand-held rig whose setup.yaml states densities 10× too
   // small (a datasheet figure used in motion): without adaptation the filter trusts dead
   // reckoning and gates the ranges that should correct it; with it the scale grows until the
-  // innovations fit (measured: max error 2.13 m fixed, 0.49 m adaptive; 30× too small: 2.43 m
-  // and 1.87 m, the adaptation is slower than that divergence).
+  // innovations fit (measured with the defaults: max error 2.13 m fixed, 0.49 m adaptive; with
+  // the upper bound at 2.8 or 3 instead of 2.2 the growth comes too late here: 1.83 m).
   sim::SimulationOptions so;
   so.seed = 6;
   so.duration_scale = 80.0 / 140.0;
