@@ -46,6 +46,10 @@ void forEachField(Opt& o, Visitor&& v) {
   v("init.motion_min_ranges", o.init.motion_min_ranges, "in-motion alignment ranges needed [-]");
   v("init.motion_max_sigma_yaw_deg", o.init.motion_max_sigma_yaw_deg, "in-motion alignment refused above [deg]");
   v("init.motion_max_sigma_p_m", o.init.motion_max_sigma_p_m, "in-motion alignment refused above [m]");
+  v("init.resume_max_age_s", o.init.resume_max_age_s, "a restart resumes from a checkpoint at most this old [s]");
+  v("init.resume_max_outage_s", o.init.resume_max_outage_s, "longer restart outages re-initialize the pose (anchors kept) [s]");
+  v("init.resume_max_acc_m_s2", o.init.resume_max_acc_m_s2, "largest acceleration during a restart's outage [m/s^2]");
+  v("init.resume_max_rate_deg_s", o.init.resume_max_rate_deg_s, "largest rotation rate during a restart's outage [deg/s]");
   v("baro.enabled", o.baro.enabled, "");
   v("baro.pressure_sigma_pa", o.baro.pressure_sigma_pa, "[Pa]");
   v("baro.bias_rw_m_per_sqrt_s", o.baro.bias_rw_m_per_sqrt_s, "height bias random walk [m/sqrt(s)]");
@@ -157,7 +161,8 @@ void EstimatorOptions::validate() const {
   need(imu.gap_sigma_acc_m_s2 >= 0.0 && imu.gap_sigma_gyro_rad_s >= 0.0, "imu.gap_sigma_* >= 0");
   need(init.static_max_sigma_yaw_deg > 0 && init.ambiguity_chi2 > 0 && init.motion_window_s >= init.motion_min_span_s &&
            init.motion_min_span_s > 0 && init.motion_min_ranges >= 8 && init.motion_max_sigma_yaw_deg > 0 &&
-           init.motion_max_sigma_p_m > 0,
+           init.motion_max_sigma_p_m > 0 && init.resume_max_age_s >= 0 && init.resume_max_acc_m_s2 >= 0 &&
+           init.resume_max_rate_deg_s >= 0 && init.resume_max_outage_s >= 0,
        "init.motion_* (window >= min span > 0, min_ranges >= 8, sigmas > 0)");
   need(health.window_s > 0 && health.min_ranges >= 1 && health.min_anchors >= 1 &&
            health.degraded_gated_fraction > 0 && health.degraded_gated_fraction <= health.lost_gated_fraction &&

@@ -53,6 +53,10 @@ struct InitOptions {
   int motion_min_ranges = 20;              ///< in-motion alignment: tag–anchor ranges needed [-]
   double motion_max_sigma_yaw_deg = 25.0;  ///< in-motion alignment: refuse above [deg]
   double motion_max_sigma_p_m = 0.5;       ///< in-motion alignment: refuse above [m]
+  double resume_max_age_s = 5.0;           ///< a checkpoint (resumeFrom) older than this is not used [s]
+  double resume_max_outage_s = 0.3;        ///< longer outages re-initialize the pose (anchors still kept) [s]
+  double resume_max_acc_m_s2 = 3.0;        ///< largest acceleration assumed during the outage [m/s²]
+  double resume_max_rate_deg_s = 30.0;     ///< largest rotation rate assumed during the outage [deg/s]
 };
 
 struct BaroOptions {

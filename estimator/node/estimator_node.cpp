@@ -151,6 +151,10 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   feedAligner(in);
   if (!initialized()) {
     newest_ = newest_ ? std::max(*newest_, t) : t;
+    if (const auto* s = std::get_if<ImuSample>(&in); s && resume_ && tryResume(*s)) {
+      publishPeriodic();
+      return;
+    }
     feedInitializer(in);
     publishPeriodic();
     return;

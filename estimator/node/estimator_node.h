@@ -42,6 +42,7 @@
 #include "estimator/baro/baro_model.h"
 #include "estimator/core/estimator_options.h"
 #include "estimator/filter/fusion_strategy.h"
+#include "estimator/node/checkpoint.h"
 #include "estimator/node/estimator_input.h"
 #include "estimator/health/health_monitor.h"
 #include "estimator/imu/process_noise_adapter.h"
@@ -95,6 +96,14 @@ class EstimatorNode {
   const HealthMonitor& healthMonitor() const { return health_; }
   /// Why the node is not initialized yet (empty once it is).
   std::string waitingFor() const;
+  /// The state to persist for a restart (initialized only): IMU state and covariance, baro
+  /// reference and bias, estimated anchors with their marginal covariance and pair biases.
+  EstimatorCheckpoint checkpoint() const;
+  /// Before any input: a restart. At the first IMU sample, if it is at most `init.resume_max_age_s`
+  /// newer than c.t, the estimated anchors and the baro reference and bias come back from `c`, and
+  /// the pose too when the outage is at most `init.resume_max_outage_s` (else the pose is
+  /// initialized as usual: in flight by the MotionAligner). Older: counted "resume_refused".
+  void resumeFrom(EstimatorCheckpoint c) { resume_ = std::move(c); }
   /// Fault injection for tests and drills: moves the pose estimate by `dp_m` (G) and turns it by
   /// `dyaw_rad` about z, keeping its covariance, as a corrupted state would look to the filter.
   void injectPoseError(const Eigen::Vector3d& dp_m, double dyaw_rad);
@@ -154,6 +163,10 @@ class EstimatorNode {
   StepTimings timings_;
   std::unique_ptr<StaticInitializer> initializer_;
   std::vector<AnchorInit> pending_anchor_inits_;
+  std::optional<EstimatorCheckpoint> resume_;  ///< resumeFrom, until the first IMU sample
+  std::optional<EstimatorCheckpoint> resume_baro_;  ///< its baro reference and bias, until initialized
+  /// Initializes from resume_ at IMU sample `s` when it is fresh enough; true if it did.
+  bool tryResume(const ImuSample& s);
   BaroModel baro_model_;
   ZuptModel zupt_model_;
   double range_gate_ = 0.0, baro_gate_ = 0.0;

@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <stdexcept>
 
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/node/estimator_node.h"
@@ -45,7 +46,11 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   if (options_.baro.enabled && b.baro_reference_pa) {
     baro_reference_pa_ = b.baro_reference_pa;
     filter->addBaro(setup_.baro_id, b.baro_bias_m, b.baro_bias_var_m2);
+  } else if (options_.baro.enabled && resume_baro_) {  // a restart in flight: the predecessor's reference
+    baro_reference_pa_ = resume_baro_->baro_reference_pa;
+    filter->addBaro(setup_.baro_id, resume_baro_->baro_bias_m, resume_baro_->baro_bias_var_m2);
   }
+  resume_baro_.reset();
   for (const auto& [id, p] : setup_.abs_anchor_positions) {
     auto sig = setup_.abs_anchor_sigmas_m.find(id);
     if (sig != setup_.abs_anchor_sigmas_m.end())
@@ -82,7 +87,7 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   spdlog::info(
       "estimator: initialized at t={} from {} p_IinG=[{:.3f}, {:.3f}, {:.3f}] m, yaw {:.1f} deg (σ_p {:.2f} m, "
       "σ_yaw {:.1f} deg){}",
-      formatSeconds(b.t), b.from_ranges ? "ranges" : "initial_pose", b.imu.p_IinG.x(), b.imu.p_IinG.y(),
+      formatSeconds(b.t), b.from_ranges ? "ranges" : (b.from_checkpoint ? "a checkpoint" : "initial_pose"), b.imu.p_IinG.x(), b.imu.p_IinG.y(),
       b.imu.p_IinG.z(), yaw_deg, weakestPositionAxis(b.cov.block<3, 3>(ImuErr::kP, ImuErr::kP)).first,
       sigma_yaw_deg,
       b.from_ranges ? fmt::format(", {} ranges, rms {:.3f} m", b.n_ranges_used, b.range_fit_rms_m) : "");
@@ -293,6 +298,96 @@ void EstimatorNode::injectPoseError(const Eigen::Vector3d& dp_m, double dyaw_rad
   replaceImu(x, P, t, last);
   health_ = keep_health;  // the fault is not a re-initialization
   diag_.count("injected_pose_error");
+}
+
+}  // namespace meshnav::estimator
+
+namespace meshnav::estimator {
+
+EstimatorCheckpoint EstimatorNode::checkpoint() const {
+  if (!initialized()) throw std::logic_error("EstimatorNode::checkpoint: not initialized");
+  const FusionStrategy& f = *cur_.filter;
+  const NominalState& x = f.state();
+  EstimatorCheckpoint c;
+  c.t = x.t;
+  c.imu = x.imu;
+  c.cov_imu = f.covariance(x.imu_id, x.imu_id);
+  c.landed = cur_.landed;
+  c.baro_reference_pa = baro_reference_pa_;
+  if (auto it = x.baro_bias_m.find(setup_.baro_id); it != x.baro_bias_m.end()) {
+    c.baro_bias_m = it->second;
+    c.baro_bias_var_m2 = f.covariance(setup_.baro_id, setup_.baro_id)(0, 0);
+  }
+  // Every device an anchor may have a pair bias with.
+  std::vector<SensorId> devices;
+  for (const auto& [id, p] : cur_.network->tags()) devices.push_back(id);
+  for (const auto& [id, p] : cur_.network->exactAnchors()) devices.push_back(id);
+  for (const auto& [id, p] : x.anchor_p_AinG) devices.push_back(id);
+  for (const auto& [id, p] : x.anchor_p_AinG) {
+    AnchorInit a;
+    a.t = x.t;
+    a.id = id;
+    a.p_AinG = p;
+    a.cov_p_m2 = f.covariance(id, id);
+    for (SensorId d : devices) {
+      if (d == id || !cur_.network->hasPairBias(d, id)) continue;
+      PairBias pb = cur_.network->pairBias(d, id);
+      pb.a = d;
+      pb.b = id;
+      a.biases.push_back(pb);
+    }
+    c.anchors.push_back(std::move(a));
+  }
+  return c;
+}
+
+bool EstimatorNode::tryResume(const ImuSample& s) {
+  EstimatorCheckpoint c = std::move(*resume_);
+  resume_.reset();
+  const double dt = (s.t - c.t).sec();
+  if (dt < 0.0 || dt > options_.init.resume_max_age_s) {
+    diag_.report("resume_refused", "estimator: checkpoint of t=" + formatSeconds(c.t) + " not used at t=" +
+                                       formatSeconds(s.t) + " (" + std::to_string(dt) + " s old, limit " +
+                                       std::to_string(options_.init.resume_max_age_s) + " s); initializing anew");
+    return false;
+  }
+  // Anchors (through the ANCHOR_INIT path once the filter exists) and the baro's reference and
+  // bias come back whatever the outage; the pose only across a short one.
+  const size_t n_anchors = c.anchors.size();
+  for (auto& a : c.anchors) pending_anchor_inits_.push_back(std::move(a));
+  if (c.baro_reference_pa) resume_baro_ = c;
+  diag_.count("resumed");
+  if (dt > options_.init.resume_max_outage_s) {
+    spdlog::warn("estimator: restart {:.3f} s after the checkpoint of t={}: {} anchors and the baro reference kept, "
+                 "the pose is initialized anew (outage longer than {} s)",
+                 dt, formatSeconds(c.t), n_anchors, options_.init.resume_max_outage_s);
+    return false;
+  }
+  // Across the outage: position moved with the velocity (Φ_pv = I·dt); what the body did meanwhile
+  // is unknown, bounded by a largest acceleration a and rotation rate ω: velocity σ += a·dt,
+  // position σ += a·dt²/2, attitude σ += ω·dt about each axis.
+  ImuMatrix Phi = ImuMatrix::Identity();
+  Phi.block<3, 3>(ImuErr::kP, ImuErr::kV) = Eigen::Matrix3d::Identity() * dt;
+  InitialBelief b;
+  b.t = s.t;
+  b.imu = c.imu;
+  b.imu.p_IinG += c.imu.v_IinG * dt;
+  b.cov = Phi * c.cov_imu * Phi.transpose();
+  const double a = options_.init.resume_max_acc_m_s2, w = options_.init.resume_max_rate_deg_s * M_PI / 180.0;
+  const Eigen::Matrix3d I3 = Eigen::Matrix3d::Identity();
+  b.cov.block<3, 3>(ImuErr::kV, ImuErr::kV) += I3 * std::pow(a * dt, 2);
+  b.cov.block<3, 3>(ImuErr::kP, ImuErr::kP) += I3 * std::pow(0.5 * a * dt * dt, 2);
+  b.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) += I3 * std::pow(w * dt, 2);
+  b.from_checkpoint = true;
+  b.baro_reference_pa = c.baro_reference_pa;
+  b.baro_bias_m = c.baro_bias_m;
+  b.baro_bias_var_m2 = c.baro_bias_var_m2;
+  b.last_imu = s;
+  b.landed = c.landed;
+  spdlog::warn("estimator: resuming from the checkpoint of t={} ({:.3f} s before the first IMU sample), {} anchors",
+               formatSeconds(c.t), dt, n_anchors);
+  initialize(b);
+  return true;
 }
 
 }  // namespace meshnav::estimator

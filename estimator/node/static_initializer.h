@@ -33,6 +33,7 @@ struct InitialBelief {
   ImuState imu;
   ImuMatrix cov = ImuMatrix::Identity();
   bool from_ranges = false;
+  bool from_checkpoint = false;      ///< resumed from an EstimatorCheckpoint (a restart)
   double range_fit_rms_m = 0.0;      ///< RMS residual of the range fit [m]
   int n_ranges_used = 0;
   std::optional<double> baro_reference_pa;  ///< none: no baro data and none in setup

@@ -4,9 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
 
 #include "estimator/node/estimator_node.h"
 #include "sim/scenario_simulator.h"
+#include "sim/uncertain_anchors.h"
+
 
 using namespace meshnav;
 using namespace meshnav::estimator;
@@ -176,4 +181,148 @@ TEST(RobustNode, UnderstatedImuNoiseIsScaledUpFromTheRangeInnovations) {
   EXPECT_GT(fixed.max_error_after_m, 1.5);  // the case is a real divergence
   EXPECT_LT(adaptive.max_error_after_m, 0.6);
   EXPECT_LT(gated_adaptive, gated_fixed);
+}
+
+namespace {
+/// The inputs of `ds` from `t0_s` on (a process started at t0 sees nothing earlier).
+Dataset from(const Dataset& ds, double t0_s) {
+  Dataset out = ds;
+  auto cut = [&](auto& v) {
+    v.erase(std::remove_if(v.begin(), v.end(), [&](const auto& s) { return s.t.sec() < t0_s; }), v.end());
+  };
+  cut(out.imu);
+  cut(out.baro);
+  cut(out.ranges);
+  cut(out.flight_states);
+  return out;
+}
+}  // namespace
+
+namespace {
+struct RestartResult {
+  double first_pose_s = -1.0;
+  RunResult run;
+  std::map<SensorId, AnchorEstimate> anchors;  ///< at the end
+  int64_t resumed = 0;
+};
+
+/// The estimator dies at t = 60 s of a paper flight whose anchors 106–110 are estimated (known
+/// but uncertain, σ 0.3 m); the new process starts `outage_s` later, from the inputs after that
+/// only, with (or without) the checkpoint its predecessor wrote (through the files).
+RestartResult restart(const sim::SimulationResult& r, double outage_s, bool with_checkpoint) {
+  EstimatorNode before(EstimatorOptions{}, r.dataset.setup);
+  for (const auto& in : mergeInTimeOrder(r.dataset)) {
+    if (inputTime(in).sec() > 60.0) break;
+    before.onInput(in);
+  }
+  EXPECT_TRUE(before.initialized());
+  const std::string dir = ::testing::TempDir() + "/meshnav_checkpoint_test";
+  writeCheckpoint(before.checkpoint(), dir);
+  EstimatorNode after(EstimatorOptions{}, r.dataset.setup);
+  if (with_checkpoint) after.resumeFrom(*readCheckpoint(dir));
+  RestartResult res;
+  const double t_restart = 60.0 + outage_s;
+  res.run = run(after, from(r.dataset, t_restart), t_restart + 10.0, [&](EstimatorNode& n, Timestamp t) {
+    if (res.first_pose_s < 0.0 && n.initialized()) res.first_pose_s = t.sec();
+  });
+  for (const auto& a : after.anchors()) res.anchors[a.id] = a;
+  res.resumed = after.diagnostics().get("resumed");
+  std::cout << "outage " << outage_s << " s, " << (with_checkpoint ? "with" : "without")
+            << " checkpoint: first pose " << res.first_pose_s - t_restart << " s after the restart, max error from "
+            << "10 s after it " << res.run.max_error_after_m << " m" << std::endl;
+  return res;
+}
+
+sim::SimulationResult uncertainAnchorFlight() {
+  auto r = simulate(5, 100.0);
+  const sim::SimulationOptions so;
+  sim::makeAnchorsUncertain(r.dataset, sim::UncertainAnchorOptions{0.3, false, 5}, so.hardware, so.uwb.sigma_range_m);
+  return r;
+}
+}  // namespace
+
+TEST(RobustNode, CheckpointFilesRoundTrip) {
+  const auto r = uncertainAnchorFlight();
+  EstimatorNode node(EstimatorOptions{}, r.dataset.setup);
+  for (const auto& in : mergeInTimeOrder(r.dataset)) {
+    if (inputTime(in).sec() > 30.0) break;
+    node.onInput(in);
+  }
+  const EstimatorCheckpoint c = node.checkpoint();
+  ASSERT_EQ(c.anchors.size(), 5u);
+  const std::string dir = ::testing::TempDir() + "/meshnav_checkpoint_roundtrip";
+  writeCheckpoint(c, dir);
+  const auto back = readCheckpoint(dir);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->t, c.t);
+  EXPECT_NEAR((back->imu.p_IinG - c.imu.p_IinG).norm(), 0.0, 1e-9);
+  EXPECT_NEAR(back->imu.q_ItoG.angularDistance(c.imu.q_ItoG), 0.0, 1e-9);
+  EXPECT_NEAR((back->cov_imu - c.cov_imu).norm(), 0.0, 1e-12);
+  ASSERT_TRUE(back->baro_reference_pa.has_value());
+  EXPECT_DOUBLE_EQ(*back->baro_reference_pa, *c.baro_reference_pa);
+  ASSERT_EQ(back->anchors.size(), c.anchors.size());
+  for (size_t i = 0; i < c.anchors.size(); ++i) {
+    EXPECT_EQ(back->anchors[i].id, c.anchors[i].id);
+    EXPECT_NEAR((back->anchors[i].cov_p_m2 - c.anchors[i].cov_p_m2).norm(), 0.0, 1e-12);
+    EXPECT_EQ(back->anchors[i].biases.size(), c.anchors[i].biases.size());
+  }
+}
+
+TEST(RobustNode, RestartAfterAShortOutageResumesThePoseAtOnce) {
+  const auto r = uncertainAnchorFlight();
+  const RestartResult res = restart(r, 0.1, true);
+  EXPECT_EQ(res.resumed, 1);
+  EXPECT_LE(res.first_pose_s, 60.1 + 0.01);  // the first IMU sample
+  EXPECT_LT(res.run.max_error_after_m, 0.3);
+  EXPECT_NE(res.run.final_health, Health::Lost);
+}
+
+TEST(RobustNode, RestartAfterALongOutageKeepsTheAnchorsAndReinitializesThePose) {
+  // 1 s: the body turned and banked meanwhile (paper spiral); the pose comes from the in-flight
+  // alignment, the refined anchors from the checkpoint (not the setup's 0.3 m prior).
+  const auto r = uncertainAnchorFlight();
+  const RestartResult with = restart(r, 1.0, true), without = restart(r, 1.0, false);
+  EXPECT_EQ(with.resumed, 1);
+  EXPECT_GT(with.first_pose_s, 0.0);
+  EXPECT_LE(with.first_pose_s - 61.0, 4.0);
+  EXPECT_LT(with.run.max_error_after_m, 0.3);
+  for (SensorId id : {106, 107, 108, 109, 110}) {
+    ASSERT_TRUE(with.anchors.count(id)) << id;
+    const double err = (with.anchors.at(id).p_AinG - r.dataset.truth->anchor_positions.at(id)).norm();
+    EXPECT_LT(err, 0.15) << id;
+    // Without the checkpoint the anchor starts again from its setup prior (σ 0.3 m per axis).
+    EXPECT_LT(with.anchors.at(id).cov_p_m2.trace(), without.anchors.at(id).cov_p_m2.trace()) << id;
+  }
+}
+
+TEST(RobustNode, AStaleCheckpointIsNotUsed) {
+  auto r = simulate(5, 100.0);
+  EstimatorNode before(EstimatorOptions{}, r.dataset.setup);
+  for (const auto& in : mergeInTimeOrder(r.dataset)) {
+    if (inputTime(in).sec() > 40.0) break;
+    before.onInput(in);
+  }
+  ASSERT_TRUE(before.initialized());
+  EstimatorNode later(EstimatorOptions{}, r.dataset.setup);
+  later.resumeFrom(before.checkpoint());
+  run(later, from(r.dataset, 60.0), 60.0, [](EstimatorNode&, Timestamp) {});  // 20 s > resume_max_age_s
+  EXPECT_EQ(later.diagnostics().get("resume_refused"), 1);
+  EXPECT_EQ(later.diagnostics().get("resumed"), 0);
+}
+
+TEST(RobustNode, MalformedCheckpointIsRefusedNamingFileAndKey) {
+  const std::string dir = ::testing::TempDir() + "/meshnav_bad_checkpoint";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream f(dir + "/estimator_state.yaml");
+    f << "t: 1.0\np_IinG: [0, 0, .nan]\n";
+  }
+  try {
+    readCheckpoint(dir);
+    FAIL() << "a NaN position was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("estimator_state.yaml"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("p_IinG"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(readCheckpoint(dir + "/absent").has_value());
 }
