@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "common/time.h"
 
 namespace meshnav {
 
@@ -50,6 +51,12 @@ class CsvReader {
   std::vector<std::string> header_;
   std::map<std::string, int> columns_;
 };
+
+/// Time column `col` [s] of a row. A value that is missing, not a finite number, or beyond
+/// ±kMaxTimeSeconds (common/time.h: it would not fit a Timestamp) is reported with file:line as
+/// "<key>:bad_time" and gives nullopt (the caller skips the row).
+std::optional<Timestamp> parseRowTime(const CsvRow& r, const std::string& key, Diagnostics& d,
+                                      const std::string& col = "t");
 
 /// Base name of a path, for counter keys ("ranges.csv").
 std::string baseName(const std::string& path);

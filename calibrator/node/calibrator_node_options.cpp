@@ -24,6 +24,8 @@ void visitOptions(Opts& o, F&& f) {
   f("history_window", o.history_window_s);
   f("max_ranges_per_anchor", o.max_ranges_per_anchor);
   f("status_period", o.status_period_s);
+  f("time_max_offset", o.time.max_offset_s);
+  f("time_rebase_after", o.time.rebase_after);
 }
 
 }  // namespace
@@ -78,6 +80,8 @@ void CalibratorNodeOptions::validate() const {
   require(history_window_s > 0.0, "history_window", "> 0");
   require(max_ranges_per_anchor >= 1, "max_ranges_per_anchor", ">= 1");
   require(status_period_s > 0.0, "status_period", "> 0");
+  require(time.max_offset_s > 0.0 && time.max_offset_s <= kMaxTimeSeconds, "time_max_offset", "> 0");
+  require(time.rebase_after >= 1, "time_rebase_after", ">= 1");
 }
 
 std::string CalibratorNodeOptions::toString() const {

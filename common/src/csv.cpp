@@ -40,6 +40,20 @@ std::string baseName(const std::string& path) {
   return p == std::string::npos ? path : path.substr(p + 1);
 }
 
+std::optional<Timestamp> parseRowTime(const CsvRow& r, const std::string& key, Diagnostics& d,
+                                      const std::string& col) {
+  const auto s = r.number(col);
+  if (!s) {
+    d.report(key + ":bad_time", r.where() + ": time '" + r.text(col) + "' is not a finite number; row skipped");
+    return std::nullopt;
+  }
+  const auto t = Timestamp::tryFromSec(*s);
+  if (!t)
+    d.report(key + ":bad_time", r.where() + ": time '" + r.text(col) + "' s does not fit a time stamp (|t| <= " +
+                                    std::to_string(static_cast<long long>(kMaxTimeSeconds)) + " s); row skipped");
+  return t;
+}
+
 std::string CsvRow::where() const { return (file_ ? *file_ : std::string("?")) + ":" + std::to_string(line_); }
 
 bool CsvRow::has(const std::string& name) const { return columns_->count(name) > 0; }

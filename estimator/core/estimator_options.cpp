@@ -80,6 +80,10 @@ void forEachField(Opt& o, Visitor&& v) {
   v("recovery.retry_s", o.recovery.retry_s, "between two attempts while lost or degraded [s]");
   v("recovery.degraded_disagreement_chi2", o.recovery.degraded_disagreement_chi2,
     "degraded: re-initialize when the aligned pose disagrees beyond this chi^2 (4 dof), 0 = off [-]");
+  v("time.max_offset_s", o.time.max_offset_s,
+    "an input stamped farther than this from the current (newest) time is refused and counted [s]");
+  v("time.rebase_after", o.time.rebase_after,
+    "this many consecutive refused inputs agreeing among themselves move the clock (a real jump) [-]");
 }
 
 std::vector<std::string> splitKey(const std::string& key) {
@@ -168,6 +172,8 @@ void EstimatorOptions::validate() const {
   need(baro.gate_probability >= 0 && baro.gate_probability < 1, "baro.gate_probability in [0, 1)");
   need(uwb.sigma_range_m > 0 && uwb.max_range_m > 0, "uwb.sigma_range_m > 0, uwb.max_range_m > 0");
   need(uwb.gate_probability >= 0 && uwb.gate_probability < 1, "uwb.gate_probability in [0, 1)");
+  need(time.max_offset_s >= window_s && time.max_offset_s <= kMaxTimeSeconds && time.rebase_after >= 1,
+       "time.max_offset_s >= window_s, time.rebase_after >= 1");
   need(zupt.rate_hz > 0 && zupt.sigma_acc_m_s2 > 0 && zupt.sigma_gyro_rad_s > 0 && zupt.sigma_vel_m_s > 0,
        "zupt rate and sigmas > 0");
 }

@@ -8,6 +8,7 @@
 
 #include "common/chi_square.h"
 #include "common/setup.h"
+#include "common/time_guard.h"
 #include "estimator/health/health_monitor.h"
 
 namespace meshnav::estimator {
@@ -117,6 +118,9 @@ struct EstimatorOptions {
   ZuptOptions zupt;
   HealthOptions health;
   RecoveryOptions recovery;
+  /// Inputs stamped far from the node's current time (common/time_guard.h): `time.max_offset_s`
+  /// (>= window_s) and `time.rebase_after`.
+  TimeGuardOptions time;
 
   /// Loads every key from `path`; throws std::runtime_error("<path>: missing key 'a.b'") etc.
   static EstimatorOptions fromYaml(const std::string& path);

@@ -58,7 +58,9 @@ Options:
 
 Errors are truth minus estimate. RMSE = sqrt(mean |e|^2); ARMSE = mean |e| (the toolbox's
 "ARMSE"); NEES = e^T P^-1 e per sample (chi2, 3 dof), ANEES its mean with the 95 % interval.
-Exit status: 0 ok, 1 nothing could be evaluated, 2 usage error.
+Exit status: 0 ok, 1 nothing could be evaluated, 2 usage error, 3 evaluated, but rows of the
+ground truth or the estimate were skipped for a time stamp that is not a number or does not fit
+(the figures leave those rows out: do not trust them before the file is fixed).
 )";
 
 EvalOptions optionsFrom(const Cli& cli) {
@@ -107,6 +109,16 @@ int runBaselineOnly(const std::string& dataset, const EvalOptions& options, cons
   return ev.baseline && ev.baseline->trajectory.n_selected > 0 ? 0 : 1;
 }
 
+/// Rows skipped for an unusable time stamp ("<file>:bad_time"): reported, and a failed exit.
+bool badTimeRows(const RunEvaluation& ev) {
+  const int64_t n = skippedTimeRows(ev);
+  if (n > 0)
+    spdlog::error("{} input row(s) skipped for a time stamp that is not a number or does not fit (see the "
+                  "messages above): the figures leave them out; exit status 3",
+                  n);
+  return n > 0;
+}
+
 int runSingle(const Cli& cli) {
   if (!cli.has("dataset")) {
     std::cerr << "meshnav_eval: --dataset is required (or --batch ROOT)\n\n" << cli.usage();
@@ -136,7 +148,8 @@ int runSingle(const Cli& cli) {
     spdlog::error("{}", ex.what());
     return 1;
   }
-  return (ev.trajectory.n_selected > 0 || ev.anchors) ? 0 : 1;
+  if (!(ev.trajectory.n_selected > 0 || ev.anchors)) return 1;
+  return badTimeRows(ev) ? 3 : 0;
 }
 
 int runBatch(const Cli& cli) {
