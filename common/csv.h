@@ -2,6 +2,7 @@
 /// @file csv.h
 /// @brief Small CSV reader that knows file and line of every value, for clear bad-input messages.
 
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <optional>
@@ -34,12 +35,19 @@ class CsvRow {
   std::vector<std::string> fields_;
 };
 
+/// Largest CSV file a reader accepts [bytes]: 64 MiB by default, about an hour of 200 Hz IMU rows.
+/// The readers keep every sample in memory (and the estimator's replay merges them once more), so
+/// a larger file is refused up front with a message instead of taking several times its size in
+/// memory (a 100 MB ranges.csv took 665 MB). The environment variable MESHNAV_MAX_CSV_MB raises or
+/// lowers it (whole MiB, > 0); docs/faults.md.
+uint64_t maxCsvBytes();
+
 /// Reads a comma separated file with a header line. A leading '#' on the header is ignored
 /// (TUM files). Blank lines and lines starting with '#' after the header are skipped.
 class CsvReader {
  public:
   /// Opens and reads the header. Throws std::runtime_error("file: ...") when missing/unreadable,
-  /// empty, or when a column of `required` is absent.
+  /// empty, larger than maxCsvBytes(), or when a column of `required` is absent.
   CsvReader(const std::string& path, const std::vector<std::string>& required);
   /// Calls `fn` for every data row. Rows with a wrong field count are reported to `diag` as
   /// "<basename>:bad_row" and skipped.

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -73,9 +74,27 @@ std::optional<double> CsvRow::number(const std::string& name) const {
   return v;
 }
 
+uint64_t maxCsvBytes() {
+  constexpr uint64_t kDefaultMiB = 64;
+  uint64_t mib = kDefaultMiB;
+  if (const char* env = std::getenv("MESHNAV_MAX_CSV_MB"); env && *env) {
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(env, &end, 10);
+    if (end != env && *end == '\0' && v > 0 && v < (1ull << 40)) mib = v;
+  }
+  return mib << 20;
+}
+
 CsvReader::CsvReader(const std::string& path, const std::vector<std::string>& required) : path_(path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open file");
+  std::error_code ec;
+  const uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > maxCsvBytes())
+    throw std::runtime_error(path + ": " + std::to_string(bytes >> 20) + " MiB is more than the " +
+                             std::to_string(maxCsvBytes() >> 20) +
+                             " MiB a dataset file may hold (every sample is kept in memory); split the "
+                             "recording, or raise the limit with MESHNAV_MAX_CSV_MB (docs/faults.md)");
   std::string line;
   bool got = false;
   while (std::getline(in, line)) {
