@@ -3,6 +3,8 @@
 
 #include <Eigen/Cholesky>
 #include <chrono>
+#include <cerrno>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -12,6 +14,7 @@
 #include "calibrator/anchor_calibrator.h"
 #include "calibrator/calibration_io.h"
 #include "calibrator/calibration_problem.h"
+#include "calibrator/node/calibrator_config.h"
 #include "calibrator/observation_builder.h"
 #include "calibrator/range_model.h"
 #include "common/cli.h"
@@ -45,12 +48,22 @@ Usage: meshnav_calibrate --dataset DIR --anchors ID,ID,... --out FILE.yaml [opti
   --help               this text
 )";
 
+/// "106,107" → ids; a token that is not a whole number in 1..INT32_MAX is an error naming it
+/// (4294967297 used to wrap to anchor 1).
 std::vector<SensorId> parseIds(const std::string& s) {
   std::vector<SensorId> ids;
   std::stringstream ss(s);
   std::string tok;
-  while (std::getline(ss, tok, ','))
-    if (!tok.empty()) ids.push_back(static_cast<SensorId>(std::stol(tok)));
+  while (std::getline(ss, tok, ',')) {
+    if (tok.empty()) continue;
+    errno = 0;
+    char* end = nullptr;
+    const long long v = std::strtoll(tok.c_str(), &end, 10);
+    if (end == tok.c_str() || *end != '\0' || errno == ERANGE || v < 1 || v > INT32_MAX)
+      throw std::invalid_argument("--anchors: '" + tok + "' is not an anchor id (an integer in 1.." +
+                                  std::to_string(INT32_MAX) + ")");
+    ids.push_back(static_cast<SensorId>(v));
+  }
   return ids;
 }
 
@@ -78,8 +91,9 @@ int main(int argc, char** argv) {
   }
   const std::string dir = cli.get("dataset");
   try {
+    const std::vector<SensorId> anchor_ids = parseIds(cli.get("anchors"));
     Diagnostics diag;
-    CalibratorOptions opt = cli.has("config") ? CalibratorOptions::load(cli.get("config")) : CalibratorOptions{};
+    CalibratorOptions opt = cli.has("config") ? CalibratorConfig::load(cli.get("config")).calibrator : CalibratorOptions{};
     const SystemSetup setup = loadSetup(dir + "/setup.yaml");
     if (cli.has("sigma-range")) {
       opt.sigma_range_m = cli.getDouble("sigma-range", opt.sigma_range_m);
@@ -122,7 +136,7 @@ int main(int argc, char** argv) {
                 "sigma xyz [m]");
     if (truth) std::printf(" %8s %8s %8s", "err [m]", "NEES", "CRB [m]");
     std::printf("\n");
-    for (SensorId id : parseIds(cli.get("anchors"))) {
+    for (SensorId id : anchor_ids) {
       if (setup.isTag(id)) {
         spdlog::warn("{} is a tag in setup.yaml; skipped", id);
         continue;

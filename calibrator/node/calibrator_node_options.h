@@ -63,8 +63,6 @@ struct CalibratorNodeOptions {
   /// Reads the keys present under `node` (the `calibrator_node:` map). Throws std::runtime_error
   /// naming `where` and the key on an unknown key or a bad value.
   static CalibratorNodeOptions fromYaml(const YAML::Node& node, const std::string& where);
-  /// Loads `path`; uses its `calibrator_node:` map when present, else defaults.
-  static CalibratorNodeOptions load(const std::string& path);
   /// Throws std::invalid_argument naming the first invalid option.
   void validate() const;
   /// Multi-line "key: value" listing.

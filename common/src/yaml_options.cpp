@@ -38,10 +38,10 @@ YAML::Node YamlOptions::find(const std::string& key) const {
   std::stringstream ss(key);
   std::string part;
   while (std::getline(ss, part, '.')) {
-    if (!node || !node.IsMap()) return YAML::Node();
+    if (!node || !node.IsMap()) return YAML::Node(YAML::NodeType::Undefined);
     const YAML::Node& cnode = node;  // const lookups: the non-const operator[] inserts keys
     const YAML::Node child = cnode[part];
-    if (!child) return YAML::Node();
+    if (!child) return YAML::Node(YAML::NodeType::Undefined);
     node.reset(child);
   }
   return node;

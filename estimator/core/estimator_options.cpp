@@ -1,6 +1,7 @@
 #include "estimator/core/estimator_options.h"
 
-#include <yaml-cpp/yaml.h>
+#include "common/yaml_options.h"
+
 
 #include <cmath>
 #include <sstream>
@@ -109,27 +110,12 @@ std::string formatValue(double v) {
 }  // namespace
 
 EstimatorOptions EstimatorOptions::fromYaml(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": cannot read estimator options: " + e.what());
-  }
+  // The one rule of common/yaml_options.h: unknown keys and bad values are errors naming the file
+  // and the key; a missing key keeps its default (the defaults are the shipped file).
+  YamlOptions yaml(YamlOptions::loadFile(path), path);
   EstimatorOptions o;
-  forEachField(o, [&](const std::string& key, auto& field, const char*) {
-    YAML::Node node;
-    node.reset(root);  // (Node::operator= would overwrite the content of root)
-    for (const auto& part : splitKey(key)) {
-      const YAML::Node child = node.IsMap() ? node[part] : YAML::Node();
-      if (!child) throw std::runtime_error(path + ": missing key '" + key + "'");
-      node.reset(child);
-    }
-    try {
-      field = node.as<std::remove_reference_t<decltype(field)>>();
-    } catch (const std::exception& e) {
-      throw std::runtime_error(path + ": key '" + key + "' has a malformed value: " + e.what());
-    }
-  });
+  forEachField(o, [&](const std::string& key, auto& field, const char*) { yaml.read(key, field); });
+  yaml.rejectUnknown();
   try {
     o.validate();
   } catch (const std::exception& e) {
