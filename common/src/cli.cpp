@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
 
@@ -68,8 +70,8 @@ double Cli::getDouble(const std::string& name, double fallback) const {
   if (it == values_.end()) return fallback;
   char* end = nullptr;
   double v = std::strtod(it->second.c_str(), &end);
-  if (end == it->second.c_str() || *end != '\0') {
-    throw std::runtime_error(program_ + ": option --" + name + " expects a number, got '" + it->second + "'");
+  if (end == it->second.c_str() || *end != '\0' || !std::isfinite(v)) {
+    throw std::runtime_error(program_ + ": option --" + name + " expects a finite number, got '" + it->second + "'");
   }
   return v;
 }
@@ -78,8 +80,9 @@ int64_t Cli::getInt(const std::string& name, int64_t fallback) const {
   auto it = values_.find(name);
   if (it == values_.end()) return fallback;
   char* end = nullptr;
+  errno = 0;
   long long v = std::strtoll(it->second.c_str(), &end, 10);
-  if (end == it->second.c_str() || *end != '\0') {
+  if (end == it->second.c_str() || *end != '\0' || errno == ERANGE) {
     throw std::runtime_error(program_ + ": option --" + name + " expects an integer, got '" + it->second + "'");
   }
   return v;

@@ -3,6 +3,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cmath>
 #include <stdexcept>
 
 namespace meshnav::transport {
@@ -49,8 +51,8 @@ double OptionSource::getDouble(const std::string& name, double fallback) const {
   const std::string& v = config_.at(name);
   char* end = nullptr;
   const double d = std::strtod(v.c_str(), &end);
-  if (end == v.c_str() || *end != '\0')
-    throw std::runtime_error(config_path_ + ": option '" + name + "' expects a number, got '" + v + "'");
+  if (end == v.c_str() || *end != '\0' || !std::isfinite(d))
+    throw std::runtime_error(config_path_ + ": option '" + name + "' expects a finite number, got '" + v + "'");
   return d;
 }
 
@@ -58,8 +60,9 @@ int64_t OptionSource::getInt(const std::string& name, int64_t fallback) const {
   if (cli_.has(name) || !config_.count(name)) return cli_.getInt(name, fallback);
   const std::string& v = config_.at(name);
   char* end = nullptr;
+  errno = 0;
   const long long i = std::strtoll(v.c_str(), &end, 10);
-  if (end == v.c_str() || *end != '\0')
+  if (end == v.c_str() || *end != '\0' || errno == ERANGE)
     throw std::runtime_error(config_path_ + ": option '" + name + "' expects an integer, got '" + v + "'");
   return i;
 }

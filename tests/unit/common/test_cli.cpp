@@ -29,4 +29,12 @@ TEST(Cli, ParsesValuesFlagsAndRejectsUnknown) {
   const char* nonum[] = {"prog", "--rate=abc"};
   ASSERT_TRUE(c4.parse(2, const_cast<char**>(nonum), code));
   EXPECT_THROW(c4.getDouble("rate", 1.0), std::runtime_error);
+
+  // Values that are numbers but not usable ones (issue 12, bad configuration).
+  Cli c5("prog", "usage");
+  c5.option("rate").option("count");
+  const char* unusable[] = {"prog", "--rate=inf", "--count=99999999999999999999"};
+  ASSERT_TRUE(c5.parse(3, const_cast<char**>(unusable), code));
+  EXPECT_THROW(c5.getDouble("rate", 1.0), std::runtime_error);
+  EXPECT_THROW(c5.getInt("count", 1), std::runtime_error);
 }
