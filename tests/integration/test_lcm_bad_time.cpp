@@ -6,8 +6,7 @@
 
 #include <random>
 
-#include "estimator/node/estimator_node.h"
-#include "estimator/testing/synthetic_scenario.h"
+#include "tests/unit/estimator/node_test_helpers.h"
 #include "transport/channels.h"
 #include "transport/lcm_node.h"
 
@@ -16,13 +15,7 @@ using namespace meshnav::estimator;
 
 namespace {
 
-synthetic::SyntheticOptions scenario() {
-  synthetic::SyntheticOptions o;
-  o.duration_s = 10.0;
-  o.noise = true;
-  o.seed = 9;
-  return o;
-}
+synthetic::SyntheticOptions scenario() { return test::shortNoisyFlight(9); }
 
 /// Publishes every input of `ds` over memq into an EstimatorNode; `inject(lcm, t_s)` before each.
 template <class Inject>

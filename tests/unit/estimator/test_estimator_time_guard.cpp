@@ -12,14 +12,7 @@ using namespace meshnav::estimator;
 
 namespace {
 
-synthetic::SyntheticOptions scenario() {
-  synthetic::SyntheticOptions o;
-  o.duration_s = 10.0;
-  o.landed_s = 3.0;
-  o.noise = true;
-  o.seed = 5;
-  return o;
-}
+synthetic::SyntheticOptions scenario() { return test::shortNoisyFlight(5); }
 
 /// Runs `inputs` through a node, calling `inject(node, t_s)` before every input.
 template <class Inject>
