@@ -2,7 +2,9 @@
 /// @file calibrator_options.h
 /// @brief Tuning of the anchor calibration (paper §III-C). Loads from YAML, prints itself.
 ///
-/// YAML layout (every key optional; unknown keys are an error naming the key):
+/// YAML layout (the one rule of common/yaml_options.h: every key optional, an unknown key or a bad
+/// value is an error naming the file and the key). Files are loaded by CalibratorConfig::load
+/// (calibrator/node/calibrator_config.h), the one loader of config/calibrator.yaml:
 /// @code
 /// calibrator:
 ///   sigma_range: 0.1            # σ_d [m]; default: setup.yaml noise.sigma_range, else 0.1
@@ -74,8 +76,6 @@ struct CalibratorOptions {
   /// Reads the keys present under `node` (the `calibrator:` map). Throws std::runtime_error naming
   /// `where` and the key on an unknown key or a value of the wrong type/range.
   static CalibratorOptions fromYaml(const YAML::Node& node, const std::string& where);
-  /// Loads `path`; uses its `calibrator:` map when present, else the root map.
-  static CalibratorOptions load(const std::string& path);
   /// Multi-line "key: value" listing.
   std::string toString() const;
 };

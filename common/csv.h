@@ -2,6 +2,7 @@
 /// @file csv.h
 /// @brief Small CSV reader that knows file and line of every value, for clear bad-input messages.
 
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <optional>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "common/time.h"
 
 namespace meshnav {
 
@@ -33,12 +35,19 @@ class CsvRow {
   std::vector<std::string> fields_;
 };
 
+/// Largest CSV file a reader accepts [bytes]: 64 MiB by default, about an hour of 200 Hz IMU rows.
+/// The readers keep every sample in memory (and the estimator's replay merges them once more), so
+/// a larger file is refused up front with a message instead of taking several times its size in
+/// memory (a 100 MB ranges.csv took 665 MB). The environment variable MESHNAV_MAX_CSV_MB raises or
+/// lowers it (whole MiB, > 0); docs/faults.md.
+uint64_t maxCsvBytes();
+
 /// Reads a comma separated file with a header line. A leading '#' on the header is ignored
 /// (TUM files). Blank lines and lines starting with '#' after the header are skipped.
 class CsvReader {
  public:
   /// Opens and reads the header. Throws std::runtime_error("file: ...") when missing/unreadable,
-  /// empty, or when a column of `required` is absent.
+  /// empty, larger than maxCsvBytes(), or when a column of `required` is absent.
   CsvReader(const std::string& path, const std::vector<std::string>& required);
   /// Calls `fn` for every data row. Rows with a wrong field count are reported to `diag` as
   /// "<basename>:bad_row" and skipped.
@@ -50,6 +59,12 @@ class CsvReader {
   std::vector<std::string> header_;
   std::map<std::string, int> columns_;
 };
+
+/// Time column `col` [s] of a row. A value that is missing, not a finite number, or beyond
+/// ±kMaxTimeSeconds (common/time.h: it would not fit a Timestamp) is reported with file:line as
+/// "<key>:bad_time" and gives nullopt (the caller skips the row).
+std::optional<Timestamp> parseRowTime(const CsvRow& r, const std::string& key, Diagnostics& d,
+                                      const std::string& col = "t");
 
 /// Base name of a path, for counter keys ("ranges.csv").
 std::string baseName(const std::string& path);

@@ -41,4 +41,9 @@ struct RunEvaluation {
 RunEvaluation evaluateRun(const std::string& dataset_dir, const std::string& run_dir,
                           const EvalOptions& options, const std::string& calibration_yaml = "");
 
+/// Rows skipped for a time stamp that is not a number or does not fit ("<file>:bad_time"). The
+/// figures leave them out; meshnav_eval then fails (exit status 3) instead of reporting them as
+/// healthy.
+int64_t skippedTimeRows(const RunEvaluation& ev);
+
 }  // namespace meshnav::eval

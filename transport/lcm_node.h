@@ -7,7 +7,16 @@
 ///
 /// Counter keys in diagnostics(): "<CHANNEL>:decode_error" (bytes that do not decode as the
 /// channel's type), "<CHANNEL>:invalid_message" (decoded, but NaN / unknown code),
-/// "<CHANNEL>:handler_error" (the callback threw), "lcm:publish_error".
+/// "<CHANNEL>:handler_error" (the callback threw), "lcm:publish_error", "<CHANNEL>:oversized"
+/// (a received message above kMaxMessageBytes, dropped before decoding) and
+/// "<CHANNEL>:oversized_publish" (a message of ours above it, not sent).
+///
+/// Size: meshnav's messages are small (the largest, ANCHORS or a status with many counters, is a
+/// few KiB). Over udpm, LCM itself drops a message larger than its receive ring buffer (about
+/// 1000 KiB in LCM 1.3) before any subscriber sees it, with a line on stderr only; such a message
+/// cannot be counted by the receiver. So every LcmNode refuses to publish a message above
+/// kMaxMessageBytes (counted at the sender), and counts and drops one it receives (a message that
+/// LCM still delivers, e.g. from a foreign publisher over memq or a larger buffer).
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -38,6 +47,9 @@ class LcmNode {
 
   /// Messages LCM queues per subscription before it drops (LCM's default is 30).
   static constexpr int kQueueCapacity = 10000;
+  /// Largest message published or accepted [bytes] (256 KiB: far above any meshnav message, far
+  /// below what LCM's udpm receive buffer drops silently).
+  static constexpr size_t kMaxMessageBytes = 256 * 1024;
 
   /// Raw subscription (channel is a regex, as in LCM): the callback gets the undecoded bytes.
   using RawHandler = std::function<void(const lcm::ReceiveBuffer& rbuf, const std::string& channel)>;
@@ -67,6 +79,12 @@ class LcmNode {
 
   template <class Msg>
   bool publishLcm(const std::string& channel, const Msg& msg) {
+    if (const int64_t size = msg.getEncodedSize(); size < 0 || static_cast<size_t>(size) > kMaxMessageBytes) {
+      diag_.report(channel + ":oversized_publish", "publish on " + channel + ": " + std::to_string(size) +
+                                                       " bytes is above the limit of " +
+                                                       std::to_string(kMaxMessageBytes) + "; not sent");
+      return false;
+    }
     const int rc = lcm_->publish(channel, &msg);
     if (rc != 0) diag_.report("lcm:publish_error", "publish on " + channel + " failed");
     return rc == 0;
@@ -101,6 +119,7 @@ class LcmNode {
  private:
   template <class Msg>
   bool decode(const lcm::ReceiveBuffer& rbuf, const std::string& ch, Msg& msg) {
+    if (!sizeOk(rbuf, ch)) return false;
     int rc = -1;
     std::string what = "not a valid " + std::string(Msg::getTypeName());
     try {
@@ -118,6 +137,8 @@ class LcmNode {
     return true;
   }
   void guarded(const std::string& ch, const std::function<void()>& body);
+  /// False (counted "<CHANNEL>:oversized") for a message above kMaxMessageBytes.
+  bool sizeOk(const lcm::ReceiveBuffer& rbuf, const std::string& ch);
   void runHeartbeatIfDue();
 
   struct RawSub {

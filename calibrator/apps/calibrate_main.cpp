@@ -3,6 +3,8 @@
 
 #include <Eigen/Cholesky>
 #include <chrono>
+#include <cerrno>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +15,7 @@
 #include "calibrator/anchor_calibrator.h"
 #include "calibrator/calibration_io.h"
 #include "calibrator/calibration_problem.h"
+#include "calibrator/node/calibrator_config.h"
 #include "calibrator/observation_builder.h"
 #include "calibrator/range_model.h"
 #include "common/cli.h"
@@ -65,11 +68,10 @@ void declareOptions(Cli& cli, CalibrateCli& c) {
 
 /// The calibrator options: --config, then the command line; σ_d from setup.yaml when neither sets it.
 CalibratorOptions calibratorOptions(const Cli& cli, const CalibrateCli& c, const SystemSetup& setup) {
-  CalibratorOptions opt = c.config.empty() ? CalibratorOptions{} : CalibratorOptions::load(c.config);
-  if (cli.given("sigma-range"))
-    opt.sigma_range_m = c.sigma_range_m;
-  else if (c.config.empty() && setup.noise.sigma_range_m)
-    opt.sigma_range_m = *setup.noise.sigma_range_m;
+  CalibratorConfig config = CalibratorConfig::load(c.config);  // "" = the built-in defaults
+  config.applySetup(setup);  // σ_d from setup.yaml unless the file sets it
+  CalibratorOptions opt = config.calibrator;
+  if (cli.given("sigma-range")) opt.sigma_range_m = c.sigma_range_m;
   if (!(opt.sigma_range_m > 0)) throw std::runtime_error("sigma_range must be > 0");
   if (!c.loss.empty()) opt.robust_loss = robustLossFromString(c.loss);
   if (c.no_ransac) opt.ransac = false;

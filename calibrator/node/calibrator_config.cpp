@@ -1,10 +1,9 @@
 #include "calibrator/node/calibrator_config.h"
 
 #include <spdlog/spdlog.h>
-#include <yaml-cpp/yaml.h>
+#include "common/yaml_options.h"
 
 #include <cmath>
-#include <filesystem>
 #include <stdexcept>
 
 namespace meshnav::calib {
@@ -12,27 +11,20 @@ namespace meshnav::calib {
 CalibratorConfig CalibratorConfig::load(const std::string& path) {
   CalibratorConfig c;
   if (path.empty()) return c;
-  if (!std::filesystem::exists(path)) throw std::runtime_error(path + ": no such file");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": cannot read (" + e.what() + ")");
-  }
+  const YAML::Node root = YamlOptions::loadFile(path);
   if (!root || root.IsNull()) return c;  // empty file: defaults
   if (!root.IsMap()) throw std::runtime_error(path + ": expected a map with 'calibrator' and/or 'calibrator_node'");
   const YAML::Node& croot = root;  // const lookups: yaml-cpp's non-const operator[] inserts keys
   const bool sections = croot["calibrator"] || croot["calibrator_node"];
+  YAML::Node cal;
+  cal.reset(croot);  // (Node::operator= would overwrite the content of root)
   if (sections) {
-    for (const auto& kv : croot) {
-      const auto key = kv.first.as<std::string>();
-      if (key != "calibrator" && key != "calibrator_node")
-        throw std::runtime_error(path + ": unknown top-level key '" + key + "' (expected calibrator, calibrator_node)");
-    }
+    YamlOptions top(root, path);
+    cal.reset(top.take("calibrator"));
+    c.node = CalibratorNodeOptions::fromYaml(top.take("calibrator_node"), path);
+    top.rejectUnknown();
   }
-  const YAML::Node cal = sections ? croot["calibrator"] : croot;
   c.calibrator = CalibratorOptions::fromYaml(cal, path);
-  c.node = CalibratorNodeOptions::fromYaml(croot["calibrator_node"], path);
   c.sigma_range_from_config = cal && cal.IsMap() && cal["sigma_range"];
   if (c.sigma_range_from_config) c.sigma_range_source = path;
   return c;

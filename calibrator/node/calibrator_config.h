@@ -3,7 +3,8 @@
 /// @brief The calibrator's configuration file (config/calibrator.yaml): a `calibrator:` map
 /// (CalibratorOptions) and a `calibrator_node:` map (CalibratorNodeOptions); another top-level key
 /// is an error so that a typo does not silently leave defaults. A file with neither map is read as
-/// a flat `calibrator:` map. Used by the calibrator process and by `meshnav_run`.
+/// a flat `calibrator:` map. The one loader of the file (the calibrator process, `meshnav_run`,
+/// `meshnav_calibrate`), following the rule of common/yaml_options.h.
 
 #include <string>
 

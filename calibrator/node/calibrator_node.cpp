@@ -33,6 +33,14 @@ int64_t wallUtime() {
       .count();
 }
 
+/// Poses and ranges within the history window are data, however late: behind, the guard refuses
+/// only beyond the window plus the offset (within that, "pose_too_old" says more).
+TimeGuardOptions guardOptions(const CalibratorNodeOptions& o) {
+  TimeGuardOptions g = o.time;
+  g.max_behind_s = std::max(g.max_behind_s, o.history_window_s + o.time.max_offset_s);
+  return g;
+}
+
 }  // namespace
 
 const char* CalibratorNode::toString(State s) {
@@ -52,7 +60,8 @@ CalibratorNode::CalibratorNode(const CalibratorOptions& options, const SystemSet
       sinks_(std::move(sinks)),
       calibrator_(options),
       prior_source_(setup, options),
-      collect_new_anchors_(node_options.collect_from_start) {
+      collect_new_anchors_(node_options.collect_from_start),
+      time_guard_(guardOptions(node_options)) {
   node_options_.validate();
   if (!(options.sigma_range_m > 0.0)) throw std::invalid_argument("calibrator option sigma_range must be > 0");
 }
@@ -85,6 +94,7 @@ CalibratorNode::Track& CalibratorNode::track(SensorId x) {
 
 void CalibratorNode::onRange(const RangeSample& r) {
   diag_.count("ranges_received");
+  if (!admitTime("RANGE", r.t)) return;
   if (!std::isfinite(r.range_m) || r.range_m < kMinRangeM || r.range_m > kMaxRangeM) {
     diag_.report("bad_range", describe(r) + ": range " + std::to_string(r.range_m) + " m is not finite or absurd");
     return;
@@ -144,6 +154,7 @@ void CalibratorNode::onPose(const PoseEstimate& p_in) {
     diag_.report("bad_pose", "pose at t=" + formatSeconds(p.t) + " has a non-finite value or a bad quaternion");
     return;
   }
+  if (!admitTime("POSE", p.t)) return;
   p.q_ItoG.normalize();
   const Duration window = Duration::fromSec(node_options_.history_window_s);
   if (!poses_.empty() && p.t < poses_.back().t - window) {
@@ -251,6 +262,10 @@ void CalibratorNode::tick(Timestamp now) {
     runPeriodic();
     return;
   }
+  if (!admitTime("tick", now)) {
+    runPeriodic();
+    return;
+  }
   advance(now);
   runPeriodic();
 }
@@ -279,6 +294,22 @@ void CalibratorNode::stopCollecting(Track& tr) {
 
 void CalibratorNode::advance(Timestamp t) {
   if (!newest_ || t > *newest_) newest_ = t;
+}
+
+bool CalibratorNode::admitTime(const std::string& kind, Timestamp t) {
+  const TimeGuard::Verdict v = time_guard_.admit(kind, t, diag_);
+  if (v == TimeGuard::Verdict::Ahead || v == TimeGuard::Verdict::Behind) return false;
+  if (v == TimeGuard::Verdict::Rebased && time_guard_.lastJump().us < 0) {
+    // The data time was ahead of every input: follow the inputs back; poses from beyond go.
+    newest_ = t;
+    next_status_.reset();
+    next_prune_.reset();
+    poses_.erase(std::upper_bound(poses_.begin(), poses_.end(), t,
+                                  [](Timestamp x, const PoseEstimate& p) { return x < p.t; }),
+                 poses_.end());
+    for (auto& [id, tr] : tracks_) tr.next_auto_check = t;
+  }
+  return true;
 }
 
 // --------------------------------------------------------------------------------------------

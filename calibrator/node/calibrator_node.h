@@ -38,7 +38,9 @@
 /// in calibrator_node_options.h, checked every `auto_check_period_s` of data time.
 ///
 /// **Time.** Data time is the newest time of any range or pose seen (commands do not advance it:
-/// they may come from a wall clock). Calibration results are stamped with the data time.
+/// they may come from a wall clock). A range or pose (or a tick) stamped farther than
+/// `time_max_offset` ahead of it (behind: `history_window` + `time_max_offset`) is refused and counted ("RANGE:time_ahead", "POSE:time_behind",
+/// "tick:time_ahead", ...; common/time_guard.h), so it never moves the data time. Calibration results are stamped with the data time.
 /// CALIB_STATUS is published whenever data time passes the next multiple of `status_period_s`
 /// (driven by the inputs, or by `tick()` when no input flows), and right after every Calibrate
 /// command. Counters (`CalibStatus::counters`, also `diagnostics()`): ranges_received,
@@ -66,6 +68,7 @@
 #include "common/diagnostics.h"
 #include "common/messages.h"
 #include "common/setup.h"
+#include "common/time_guard.h"
 #include "common/types.h"
 
 namespace meshnav::calib {
@@ -142,6 +145,8 @@ class CalibratorNode {
   void addRange(SensorId x, Track& track, const RangeSample& r);
   Track& track(SensorId x);
   void advance(Timestamp t);
+  /// The time guard on an input of `kind` at `t`; false: refused and counted.
+  bool admitTime(const std::string& kind, Timestamp t);
   void runPeriodic();
   void checkAuto(SensorId x, Track& track);
   void keepResult(CalibrationResult res);
@@ -161,6 +166,7 @@ class CalibratorNode {
   bool collect_new_anchors_ = true;
   std::vector<CalibrationResult> results_;
   std::optional<Timestamp> newest_;
+  TimeGuard time_guard_;
   std::optional<Timestamp> next_status_;
   std::optional<Timestamp> next_prune_;
   int64_t last_waiting_for_pose_ = 0;       ///< at the last calibration attempt

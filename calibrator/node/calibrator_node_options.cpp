@@ -1,8 +1,7 @@
 #include "calibrator/node/calibrator_node_options.h"
 
-#include <yaml-cpp/yaml.h>
+#include "common/yaml_options.h"
 
-#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -24,45 +23,24 @@ void visitOptions(Opts& o, F&& f) {
   f("history_window", o.history_window_s);
   f("max_ranges_per_anchor", o.max_ranges_per_anchor);
   f("status_period", o.status_period_s);
+  f("time_max_offset", o.time.max_offset_s);
+  f("time_rebase_after", o.time.rebase_after);
 }
 
 }  // namespace
 
 CalibratorNodeOptions CalibratorNodeOptions::fromYaml(const YAML::Node& node, const std::string& where) {
+  // The one rule of common/yaml_options.h (missing: default; unknown or bad: file and key).
   CalibratorNodeOptions o;
-  if (!node || node.IsNull()) return o;
-  if (!node.IsMap()) throw std::runtime_error(where + ": 'calibrator_node' must be a map");
-  std::set<std::string> known;
-  visitOptions(o, [&](const char* key, auto& ref) {
-    known.insert(key);
-    if (const auto v = node[key]) {
-      try {
-        ref = v.template as<std::remove_reference_t<decltype(ref)>>();
-      } catch (const std::exception& e) {
-        throw std::runtime_error(where + ": key 'calibrator_node." + key + "' has a bad value (" + e.what() + ")");
-      }
-    }
-  });
-  for (const auto& kv : node) {
-    const auto key = kv.first.as<std::string>();
-    if (!known.count(key)) throw std::runtime_error(where + ": unknown key 'calibrator_node." + key + "'");
-  }
+  YamlOptions yaml(node, where, "calibrator_node");
+  visitOptions(o, [&](const char* key, auto& ref) { yaml.read(key, ref); });
+  yaml.rejectUnknown();
   try {
     o.validate();
   } catch (const std::exception& e) {
     throw std::runtime_error(where + ": " + e.what());
   }
   return o;
-}
-
-CalibratorNodeOptions CalibratorNodeOptions::load(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": cannot read (" + e.what() + ")");
-  }
-  return fromYaml(root["calibrator_node"], path);
 }
 
 void CalibratorNodeOptions::validate() const {
@@ -78,6 +56,8 @@ void CalibratorNodeOptions::validate() const {
   require(history_window_s > 0.0, "history_window", "> 0");
   require(max_ranges_per_anchor >= 1, "max_ranges_per_anchor", ">= 1");
   require(status_period_s > 0.0, "status_period", "> 0");
+  require(time.max_offset_s > 0.0 && time.max_offset_s <= kMaxTimeSeconds, "time_max_offset", "> 0");
+  require(time.rebase_after >= 1, "time_rebase_after", ">= 1");
 }
 
 std::string CalibratorNodeOptions::toString() const {

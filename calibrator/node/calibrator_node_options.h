@@ -17,6 +17,8 @@
 ///   history_window: 300.0         # pose history and tag ranges kept [s]
 ///   max_ranges_per_anchor: 20000  # the oldest range is evicted beyond this [-]
 ///   status_period: 1.0            # CALIB_STATUS period (data time) [s]
+///   time_max_offset: 10.0         # RANGE/POSE stamped farther from the data time: refused [s]
+///   time_rebase_after: 50         # agreeing refused inputs in a row that move the clock [-]
 /// @endcode
 ///
 /// **Automatic criterion** (auto_mode): an anchor that is collecting (or was refused more than
@@ -30,6 +32,8 @@
 ///     just the plane of a hover or the line of a take-off.
 
 #include <string>
+
+#include "common/time_guard.h"
 
 namespace YAML { class Node; }
 
@@ -53,11 +57,12 @@ struct CalibratorNodeOptions {
   // --- output ------------------------------------------------------------------------------
   double status_period_s = 1.0;     ///< CALIB_STATUS heartbeat period in data time [s]
 
+  // --- time guard (common/time_guard.h) ------------------------------------------------------
+  TimeGuardOptions time;            ///< keys time_max_offset [s], time_rebase_after [-]
+
   /// Reads the keys present under `node` (the `calibrator_node:` map). Throws std::runtime_error
   /// naming `where` and the key on an unknown key or a bad value.
   static CalibratorNodeOptions fromYaml(const YAML::Node& node, const std::string& where);
-  /// Loads `path`; uses its `calibrator_node:` map when present, else defaults.
-  static CalibratorNodeOptions load(const std::string& path);
   /// Throws std::invalid_argument naming the first invalid option.
   void validate() const;
   /// Multi-line "key: value" listing.

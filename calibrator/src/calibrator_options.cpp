@@ -1,9 +1,7 @@
 #include "calibrator/calibrator_options.h"
 
-#include <yaml-cpp/yaml.h>
+#include "common/yaml_options.h"
 
-#include <functional>
-#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -64,19 +62,6 @@ void visitOptions(Opts& o, F&& f) {
 }
 
 template <typename T>
-void readValue(const YAML::Node& n, T& dst, const std::string& where, const std::string& key) {
-  try {
-    if constexpr (std::is_same_v<T, RobustLoss>) {
-      dst = robustLossFromString(n.as<std::string>());
-    } else {
-      dst = n.as<T>();
-    }
-  } catch (const std::exception& e) {
-    throw std::runtime_error(where + ": key 'calibrator." + key + "' has a bad value (" + e.what() + ")");
-  }
-}
-
-template <typename T>
 std::string printValue(const T& v) {
   std::ostringstream s;
   if constexpr (std::is_same_v<T, RobustLoss>) {
@@ -92,18 +77,23 @@ std::string printValue(const T& v) {
 }  // namespace
 
 CalibratorOptions CalibratorOptions::fromYaml(const YAML::Node& node, const std::string& where) {
+  // The one rule of common/yaml_options.h (missing: default; unknown or bad: file and key).
   CalibratorOptions o;
-  if (!node || node.IsNull()) return o;
-  if (!node.IsMap()) throw std::runtime_error(where + ": 'calibrator' must be a map");
-  std::map<std::string, bool> known;
+  YamlOptions yaml(node, where, "calibrator");
   visitOptions(o, [&](const char* key, auto& ref) {
-    known[key] = true;
-    if (const auto v = node[key]) readValue(v, ref, where, key);
+    if constexpr (std::is_same_v<std::remove_reference_t<decltype(ref)>, RobustLoss>) {
+      std::string name = calib::toString(ref);
+      yaml.read(key, name);
+      try {
+        ref = robustLossFromString(name);
+      } catch (const std::exception& e) {
+        yaml.fail(key, e.what());
+      }
+    } else {
+      yaml.read(key, ref);
+    }
   });
-  for (const auto& kv : node) {
-    const auto key = kv.first.as<std::string>();
-    if (!known.count(key)) throw std::runtime_error(where + ": unknown key 'calibrator." + key + "'");
-  }
+  yaml.rejectUnknown();
   auto positive = [&](double v, const char* key) {
     if (!(v > 0.0)) throw std::runtime_error(where + ": key 'calibrator." + std::string(key) + "' must be > 0");
   };
@@ -117,20 +107,6 @@ CalibratorOptions CalibratorOptions::fromYaml(const YAML::Node& node, const std:
   if (o.ransac_min_iterations < 1 || o.ransac_max_iterations < o.ransac_min_iterations)
     throw std::runtime_error(where + ": need 1 <= ransac_min_iterations <= ransac_max_iterations");
   return o;
-}
-
-CalibratorOptions CalibratorOptions::load(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": cannot read (" + e.what() + ")");
-  }
-  // config/calibrator.yaml holds `calibrator:` and `calibrator_node:` maps; a flat file is the
-  // `calibrator:` map itself; a file with only `calibrator_node:` leaves these at their defaults.
-  if (root["calibrator"]) return fromYaml(root["calibrator"], path);
-  if (root["calibrator_node"]) return fromYaml(YAML::Node(YAML::NodeType::Map), path);
-  return fromYaml(root, path);
 }
 
 std::string CalibratorOptions::toString() const {

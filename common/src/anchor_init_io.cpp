@@ -110,6 +110,8 @@ std::vector<AnchorInit> readAnchorInitsYaml(const std::string& path) {
       a.n_outliers = n["n_outliers"] ? n["n_outliers"].as<int>() : 0;
     } catch (const YAML::Exception& ex) {
       fail(path, "entry '" + pre + "' has a malformed scalar (" + ex.what() + ")");
+    } catch (const std::out_of_range& ex) {
+      fail(path, "key '" + pre + "t': " + ex.what());
     }
     const auto p = numbers(n["p_AinG"], path, pre + "p_AinG", 3);
     a.p_AinG = Eigen::Vector3d(p[0], p[1], p[2]);

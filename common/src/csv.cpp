@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -40,6 +41,20 @@ std::string baseName(const std::string& path) {
   return p == std::string::npos ? path : path.substr(p + 1);
 }
 
+std::optional<Timestamp> parseRowTime(const CsvRow& r, const std::string& key, Diagnostics& d,
+                                      const std::string& col) {
+  const auto s = r.number(col);
+  if (!s) {
+    d.report(key + ":bad_time", r.where() + ": time '" + r.text(col) + "' is not a finite number; row skipped");
+    return std::nullopt;
+  }
+  const auto t = Timestamp::tryFromSec(*s);
+  if (!t)
+    d.report(key + ":bad_time", r.where() + ": time '" + r.text(col) + "' s does not fit a time stamp (|t| <= " +
+                                    std::to_string(static_cast<long long>(kMaxTimeSeconds)) + " s); row skipped");
+  return t;
+}
+
 std::string CsvRow::where() const { return (file_ ? *file_ : std::string("?")) + ":" + std::to_string(line_); }
 
 bool CsvRow::has(const std::string& name) const { return columns_->count(name) > 0; }
@@ -59,9 +74,27 @@ std::optional<double> CsvRow::number(const std::string& name) const {
   return v;
 }
 
+uint64_t maxCsvBytes() {
+  constexpr uint64_t kDefaultMiB = 64;
+  uint64_t mib = kDefaultMiB;
+  if (const char* env = std::getenv("MESHNAV_MAX_CSV_MB"); env && *env) {
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(env, &end, 10);
+    if (end != env && *end == '\0' && v > 0 && v < (1ull << 40)) mib = v;
+  }
+  return mib << 20;
+}
+
 CsvReader::CsvReader(const std::string& path, const std::vector<std::string>& required) : path_(path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open file");
+  std::error_code ec;
+  const uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > maxCsvBytes())
+    throw std::runtime_error(path + ": " + std::to_string(bytes >> 20) + " MiB is more than the " +
+                             std::to_string(maxCsvBytes() >> 20) +
+                             " MiB a dataset file may hold (every sample is kept in memory); split the "
+                             "recording, or raise the limit with MESHNAV_MAX_CSV_MB (docs/faults.md)");
   std::string line;
   bool got = false;
   while (std::getline(in, line)) {

@@ -18,16 +18,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// Reads column `t` [s] of a row; reports and returns nullopt when missing or not finite.
-std::optional<Timestamp> rowTime(const CsvRow& r, const std::string& key, Diagnostics& d, const char* col = "t") {
-  auto t = r.number(col);
-  if (!t) {
-    d.report(key + ":bad_time", r.where() + ": time '" + r.text(col) + "' is not a finite number; row skipped");
-    return std::nullopt;
-  }
-  return Timestamp::fromSec(*t);
-}
-
 /// Reports samples whose time goes backwards and sorts them (stable).
 template <typename T>
 void checkOrder(std::vector<T>& v, const std::string& path, Diagnostics& d) {
@@ -78,7 +68,7 @@ std::vector<T> readTimeValueCsv(const std::string& path, const char* column, dou
   std::vector<T> out;
   reader.forEach(
       [&](const CsvRow& r) {
-        auto t = rowTime(r, key, diag);
+        auto t = parseRowTime(r, key, diag);
         if (!t) return;
         auto v = r.number(column);
         if (!v || *v < lo || *v > hi) {
@@ -102,7 +92,7 @@ std::vector<ImuSample> readImuCsv(const std::string& path, Diagnostics& diag) {
   std::vector<ImuSample> out;
   reader.forEach(
       [&](const CsvRow& r) {
-        auto t = rowTime(r, key, diag);
+        auto t = parseRowTime(r, key, diag);
         if (!t) return;
         double v[6];
         for (int i = 0; i < 6; ++i) {
@@ -137,7 +127,7 @@ std::vector<RangeSample> readRangesCsv(const std::string& path, Diagnostics& dia
   std::vector<RangeSample> out;
   reader.forEach(
       [&](const CsvRow& r) {
-        auto t = rowTime(r, key, diag);
+        auto t = parseRowTime(r, key, diag);
         if (!t) return;
         RangeSample s;
         s.t = *t;
@@ -201,7 +191,7 @@ std::vector<FlightStateSample> readFlightStateCsv(const std::string& path, Diagn
   std::vector<FlightStateSample> out;
   reader.forEach(
       [&](const CsvRow& r) {
-        auto t = rowTime(r, key, diag);
+        auto t = parseRowTime(r, key, diag);
         if (!t) return;
         const std::string l = r.text("landed");
         bool landed;
@@ -229,7 +219,7 @@ std::vector<PoseSample> readTumCsv(const std::string& path, Diagnostics& diag) {
   std::vector<PoseSample> out;
   reader.forEach(
       [&](const CsvRow& r) {
-        auto t = rowTime(r, key, diag);
+        auto t = parseRowTime(r, key, diag);
         if (!t) return;
         double v[7];
         for (int i = 0; i < 7; ++i) {

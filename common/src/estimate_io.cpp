@@ -75,17 +75,18 @@ std::vector<PoseEstimate> readEstimateCsv(const std::string& path, Diagnostics& 
   std::vector<PoseEstimate> out;
   reader.forEach(
       [&](const CsvRow& r) {
-        auto t = r.number("t");
+        auto t = parseRowTime(r, key, diag);
+        if (!t) return;
         auto tx = r.number("tx"), ty = r.number("ty"), tz = r.number("tz");
         auto qx = r.number("qx"), qy = r.number("qy"), qz = r.number("qz"), qw = r.number("qw");
         auto P = upper(r, kP);
         auto Q = upper(r, kQ);
-        if (!t || !tx || !ty || !tz || !qx || !qy || !qz || !qw || !P || !Q) {
+        if (!tx || !ty || !tz || !qx || !qy || !qz || !qw || !P || !Q) {
           diag.report(key + ":bad_value", r.where() + ": a value is missing or not finite; row skipped");
           return;
         }
         PoseEstimate e;
-        e.t = Timestamp::fromSec(*t);
+        e.t = *t;
         e.p_IinG = {*tx, *ty, *tz};
         e.q_ItoG = Eigen::Quaterniond(*qw, *qx, *qy, *qz).normalized();
         e.cov_p_m2 = *P;
@@ -103,13 +104,15 @@ std::vector<AnchorEstimate> readAnchorsCsv(const std::string& path, Diagnostics&
   std::vector<AnchorEstimate> out;
   reader.forEach(
       [&](const CsvRow& r) {
-        auto t = r.number("t"), id = r.number("id"), x = r.number("x"), y = r.number("y"), z = r.number("z");
+        auto t = parseRowTime(r, key, diag);
+        if (!t) return;
+        auto id = r.number("id"), x = r.number("x"), y = r.number("y"), z = r.number("z");
         auto P = upper(r, kP);
-        if (!t || !id || !x || !y || !z || !P) {
+        if (!id || !x || !y || !z || !P) {
           diag.report(key + ":bad_value", r.where() + ": a value is missing or not finite; row skipped");
           return;
         }
-        out.push_back({Timestamp::fromSec(*t), static_cast<SensorId>(*id), {*x, *y, *z}, *P});
+        out.push_back({*t, static_cast<SensorId>(*id), {*x, *y, *z}, *P});
       },
       diag);
   return out;

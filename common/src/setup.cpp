@@ -1,5 +1,6 @@
 #include "common/setup.h"
 
+#include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
@@ -7,6 +8,10 @@
 #include <regex>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
+
+#include "common/plausibility.h"
+#include "common/yaml_options.h"
 
 namespace meshnav {
 
@@ -18,20 +23,41 @@ namespace {
 
 Eigen::Vector3d vec3(const YAML::Node& n, const std::string& path, const std::string& key) {
   if (!n || !n.IsSequence() || n.size() != 3) fail(path, "key '" + key + "' must be a list of 3 numbers [m]");
-  try {
-    return {n[0].as<double>(), n[1].as<double>(), n[2].as<double>()};
-  } catch (const YAML::Exception&) {
-    fail(path, "key '" + key + "' must be a list of 3 numbers [m]");
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) {
+    try {
+      v[i] = n[i].as<double>();
+    } catch (const YAML::Exception&) {
+      fail(path, "key '" + key + "' must be a list of 3 numbers [m], got '" + yamlText(n[i]) + "'");
+    }
+    if (!std::isfinite(v[i])) fail(path, "key '" + key + "' must be a list of 3 finite numbers [m], got '" + yamlText(n[i]) + "'");
   }
+  return v;
 }
 
 double num(const YAML::Node& n, const std::string& path, const std::string& key) {
   if (!n || !n.IsScalar()) fail(path, "missing or non-scalar key '" + key + "'");
+  double v = 0.0;
   try {
-    return n.as<double>();
+    v = n.as<double>();
   } catch (const YAML::Exception&) {
     fail(path, "key '" + key + "' must be a number, got '" + n.Scalar() + "'");
   }
+  if (!std::isfinite(v)) fail(path, "key '" + key + "' must be a finite number, got '" + n.Scalar() + "'");
+  return v;
+}
+
+/// A device id (a map key or list entry): an integer in 0..INT32_MAX.
+SensorId deviceId(const YAML::Node& n, const std::string& path, const std::string& key) {
+  int64_t id = -1;
+  try {
+    id = n.as<int64_t>();
+  } catch (const YAML::Exception&) {
+  }
+  if (id < 0 || id > INT32_MAX)
+    fail(path, "key '" + key + "': id '" + yamlText(n) + "' is not a device id (an integer in 0.." +
+                   std::to_string(INT32_MAX) + ")");
+  return static_cast<SensorId>(id);
 }
 
 std::map<SensorId, Eigen::Vector3d> idVecMap(const YAML::Node& n, const std::string& path, const std::string& key) {
@@ -39,12 +65,8 @@ std::map<SensorId, Eigen::Vector3d> idVecMap(const YAML::Node& n, const std::str
   if (!n) return out;
   if (!n.IsMap()) fail(path, "key '" + key + "' must be a map {id: [x, y, z]}");
   for (const auto& kv : n) {
-    SensorId id;
-    try {
-      id = kv.first.as<SensorId>();
-    } catch (const YAML::Exception&) {
-      fail(path, "key '" + key + "': id '" + kv.first.Scalar() + "' is not an integer");
-    }
+    const SensorId id = deviceId(kv.first, path, key);
+    if (out.count(id)) fail(path, "key '" + key + "." + std::to_string(id) + "' is given twice");
     out[id] = vec3(kv.second, path, key + "." + std::to_string(id));
   }
   return out;
@@ -76,18 +98,24 @@ std::vector<PairBias> readPairBiases(const YAML::Node& n, const std::string& pat
   int i = 0;
   for (const auto& e : n) {
     const std::string k = key + "[" + std::to_string(i++) + "]";
-    const auto ids = e["ids"];
+    if (!e.IsMap()) fail(path, "key '" + k + "' must be a map {ids: [a, b], gamma, beta, sigma}");
+    YamlOptions entry(e, path, k);
+    const auto ids = entry.take("ids");
     if (!ids || !ids.IsSequence() || ids.size() != 2) fail(path, "key '" + k + ".ids' must be [a, b]");
-    PairBias b;
-    b.a = ids[0].as<SensorId>();
-    b.b = ids[1].as<SensorId>();
+    PairBias b;  // defaults: gamma 0, beta 1, sigma 0.1, no uncertainty of gamma and beta
+    b.a = deviceId(ids[0], path, k + ".ids");
+    b.b = deviceId(ids[1], path, k + ".ids");
     if (b.a == b.b) fail(path, "key '" + k + ".ids' names the same device twice");
-    b.gamma_m = e["gamma"] ? num(e["gamma"], path, k + ".gamma") : 0.0;
-    b.beta = e["beta"] ? num(e["beta"], path, k + ".beta") : 1.0;
-    b.sigma_m = e["sigma"] ? num(e["sigma"], path, k + ".sigma") : 0.1;
-    b.sigma_gamma_m = e["sigma_gamma"] ? num(e["sigma_gamma"], path, k + ".sigma_gamma") : 0.0;
-    b.sigma_beta = e["sigma_beta"] ? num(e["sigma_beta"], path, k + ".sigma_beta") : 0.0;
-    if (b.sigma_m <= 0.0) fail(path, "key '" + k + ".sigma' must be > 0 [m]");
+    entry.read("gamma", b.gamma_m);
+    entry.read("beta", b.beta);
+    entry.read("sigma", b.sigma_m);
+    entry.read("sigma_gamma", b.sigma_gamma_m);
+    entry.read("sigma_beta", b.sigma_beta);
+    entry.rejectUnknown();
+    if (b.sigma_m <= 0.0) entry.fail("sigma", "must be > 0 [m]");
+    if (b.beta <= 0.0) entry.fail("beta", "must be > 0 [-]");
+    if (b.sigma_gamma_m < 0.0) entry.fail("sigma_gamma", "must be >= 0 [m]");
+    if (b.sigma_beta < 0.0) entry.fail("sigma_beta", "must be >= 0 [-]");
     out.push_back(b);
   }
   return out;
@@ -120,6 +148,35 @@ void writeText(const std::string& path, const std::string& header, const char* b
   out << header << body << "\n";
 }
 
+/// Every id names one device: a collision is an error naming both roles. imu_id and baro_id left
+/// out of the file default to 1 and 2; when a tag or anchor of the file uses that id, the smallest
+/// free id is taken instead (the published toolbox's config.yaml numbers anchors 1, 2, 3).
+void checkIds(SystemSetup& s, const std::string& path, bool imu_given, bool baro_given) {
+  auto role = [&](SensorId id) -> std::string {
+    if (s.rel_tag_positions.count(id)) return "a tag (rel_tag_positions." + std::to_string(id) + ")";
+    if (s.abs_anchor_positions.count(id)) return "an anchor (abs_anchor_positions." + std::to_string(id) + ")";
+    return "";
+  };
+  for (const auto& [id, p] : s.rel_tag_positions)
+    if (s.abs_anchor_positions.count(id)) fail(path, "id " + std::to_string(id) + " is both a tag and an anchor");
+  auto freeId = [&](SensorId avoid) {
+    SensorId id = 1;
+    while (!role(id).empty() || id == avoid) ++id;
+    return id;
+  };
+  for (auto [key, given, id] : {std::tuple{"imu_id", imu_given, &s.imu_id}, {"baro_id", baro_given, &s.baro_id}}) {
+    if (*id < 0) fail(path, std::string("key '") + key + "' must be an id >= 0, got " + std::to_string(*id));
+    const std::string other = role(*id);
+    if (other.empty()) continue;
+    if (given) fail(path, std::string("key '") + key + "' = " + std::to_string(*id) + " is also " + other);
+    const SensorId moved = freeId(id == &s.imu_id ? s.baro_id : s.imu_id);
+    spdlog::info("{}: {} not given and its default {} is {}: using {}", path, key, *id, other, moved);
+    *id = moved;
+  }
+  if (s.imu_id == s.baro_id)
+    fail(path, "key 'imu_id' and key 'baro_id' are the same id " + std::to_string(s.imu_id));
+}
+
 }  // namespace
 
 std::optional<PairBias> SystemSetup::findPairBias(SensorId a, SensorId b) const {
@@ -132,15 +189,21 @@ std::optional<PairBias> SystemSetup::findPairBias(SensorId a, SensorId b) const 
 SystemSetup loadSetup(const std::string& path) {
   const YAML::Node root = loadYamlFile(path);
   if (!root.IsMap()) fail(path, "top level must be a map");
+  // The one rule of common/yaml_options.h: unknown keys and bad values name the file and the key,
+  // a missing key keeps its default (docs/configuration.md).
+  YamlOptions y(root, path);
+  for (const char* section : {"baro", "initial_pose", "noise"})
+    if (root[section] && root[section].IsNull()) y.take(section);  // `key:` with nothing: defaults
+  for (const char* ignored : {"tag_topics", "anchor_topics", "pose_topics"}) y.take(ignored);  // toolbox config.yaml
   SystemSetup s;
-  if (root["imu_id"]) s.imu_id = root["imu_id"].as<SensorId>();
-  if (root["baro_id"]) s.baro_id = root["baro_id"].as<SensorId>();
-  s.rel_tag_positions = idVecMap(root["rel_tag_positions"], path, "rel_tag_positions");
-  s.abs_anchor_positions = idVecMap(root["abs_anchor_positions"], path, "abs_anchor_positions");
-  if (const auto sig = root["abs_anchor_sigmas"]) {
+  y.read("imu_id", s.imu_id);
+  y.read("baro_id", s.baro_id);
+  s.rel_tag_positions = idVecMap(y.take("rel_tag_positions"), path, "rel_tag_positions");
+  s.abs_anchor_positions = idVecMap(y.take("abs_anchor_positions"), path, "abs_anchor_positions");
+  if (const auto sig = y.take("abs_anchor_sigmas"); sig && !sig.IsNull()) {
     if (!sig.IsMap()) fail(path, "key 'abs_anchor_sigmas' must be a map {id: sigma_m}");
     for (const auto& kv : sig) {
-      const SensorId id = kv.first.as<SensorId>();
+      const SensorId id = deviceId(kv.first, path, "abs_anchor_sigmas");
       if (!s.abs_anchor_positions.count(id)) {
         fail(path, "key 'abs_anchor_sigmas." + std::to_string(id) + "' names an anchor missing in abs_anchor_positions");
       }
@@ -149,35 +212,38 @@ SystemSetup loadSetup(const std::string& path) {
       s.abs_anchor_sigmas_m[id] = v;
     }
   }
-  for (const auto& [id, p] : s.rel_tag_positions) {
-    if (s.abs_anchor_positions.count(id)) fail(path, "id " + std::to_string(id) + " is both a tag and an anchor");
-  }
-  s.pair_biases = readPairBiases(root["pair_biases"], path, "pair_biases");
-  if (const auto baro = root["baro"]) {
-    if (baro["p_IP"]) s.baro_p_IP = vec3(baro["p_IP"], path, "baro.p_IP");
-    const auto rp = baro["reference_pressure"];
-    if (rp && !rp.IsNull()) s.baro_reference_pressure_pa = num(rp, path, "baro.reference_pressure");
-  }
-  if (const auto ip = root["initial_pose"]; ip && !ip.IsNull()) {
-    InitialPose p;
-    p.p_IinG = vec3(ip["p_IinG"], path, "initial_pose.p_IinG");
-    p.yaw_deg = num(ip["yaw_deg"], path, "initial_pose.yaw_deg");
-    p.sigma_p_m = num(ip["sigma_p"], path, "initial_pose.sigma_p");
-    p.sigma_yaw_deg = num(ip["sigma_yaw_deg"], path, "initial_pose.sigma_yaw_deg");
-    if (p.sigma_p_m <= 0 || p.sigma_yaw_deg <= 0) fail(path, "initial_pose sigmas must be > 0");
+  s.pair_biases = readPairBiases(y.take("pair_biases"), path, "pair_biases");
+  y.read("baro.p_IP", s.baro_p_IP);
+  y.read("baro.reference_pressure", s.baro_reference_pressure_pa);
+  if (s.baro_reference_pressure_pa &&
+      !(*s.baro_reference_pressure_pa >= plausible::kMinPressure_pa && *s.baro_reference_pressure_pa <= plausible::kMaxPressure_pa))
+    y.fail("baro.reference_pressure", "must be a plausible pressure in Pa (or null: taken on the ground)");
+  if (y.has("initial_pose")) {
+    InitialPose p;  // p_IinG and yaw_deg have no sensible default: required
+    y.require("initial_pose.p_IinG", p.p_IinG);
+    y.require("initial_pose.yaw_deg", p.yaw_deg);
+    y.read("initial_pose.sigma_p", p.sigma_p_m);
+    y.read("initial_pose.sigma_yaw_deg", p.sigma_yaw_deg);
+    if (p.sigma_p_m <= 0) y.fail("initial_pose.sigma_p", "must be > 0 [m]");
+    if (p.sigma_yaw_deg <= 0) y.fail("initial_pose.sigma_yaw_deg", "must be > 0 [deg]");
     s.initial_pose = p;
   }
-  if (const auto n = root["noise"]; n && n.IsMap()) {
-    auto opt = [&](const char* key, std::optional<double>& dst) {
-      if (n[key] && !n[key].IsNull()) dst = num(n[key], path, std::string("noise.") + key);
-    };
-    opt("sigma_range", s.noise.sigma_range_m);
-    opt("imu_acc_noise_density", s.noise.imu_acc_noise_density);
-    opt("imu_gyro_noise_density", s.noise.imu_gyro_noise_density);
-    opt("imu_acc_bias_rw", s.noise.imu_acc_bias_rw);
-    opt("imu_gyro_bias_rw", s.noise.imu_gyro_bias_rw);
-    opt("baro_pressure_sigma", s.noise.baro_pressure_sigma_pa);
-  }
+  y.read("noise.sigma_range", s.noise.sigma_range_m);
+  y.read("noise.imu_acc_noise_density", s.noise.imu_acc_noise_density);
+  y.read("noise.imu_gyro_noise_density", s.noise.imu_gyro_noise_density);
+  y.read("noise.imu_acc_bias_rw", s.noise.imu_acc_bias_rw);
+  y.read("noise.imu_gyro_bias_rw", s.noise.imu_gyro_bias_rw);
+  y.read("noise.baro_pressure_sigma", s.noise.baro_pressure_sigma_pa);
+  for (const auto& [key, v] : {std::pair{"noise.sigma_range", s.noise.sigma_range_m},
+                               {"noise.imu_acc_noise_density", s.noise.imu_acc_noise_density},
+                               {"noise.imu_gyro_noise_density", s.noise.imu_gyro_noise_density},
+                               {"noise.baro_pressure_sigma", s.noise.baro_pressure_sigma_pa}})
+    if (v && !(*v > 0.0)) y.fail(key, "must be > 0");
+  for (const auto& [key, v] : {std::pair{"noise.imu_acc_bias_rw", s.noise.imu_acc_bias_rw},
+                               {"noise.imu_gyro_bias_rw", s.noise.imu_gyro_bias_rw}})
+    if (v && !(*v >= 0.0)) y.fail(key, "must be >= 0");
+  y.rejectUnknown();
+  checkIds(s, path, y.has("imu_id"), y.has("baro_id"));
   return s;
 }
 

@@ -1,6 +1,7 @@
 #include "estimator/core/estimator_options.h"
 
-#include <yaml-cpp/yaml.h>
+#include "common/yaml_options.h"
+
 
 #include <cmath>
 #include <sstream>
@@ -93,6 +94,10 @@ void forEachField(Opt& o, Visitor&& v) {
   v("recovery.retry_s", o.recovery.retry_s, "between two attempts while lost or degraded [s]");
   v("recovery.degraded_disagreement_chi2", o.recovery.degraded_disagreement_chi2,
     "degraded: re-initialize when the aligned pose disagrees beyond this chi^2 (4 dof), 0 = off [-]");
+  v("time.max_offset_s", o.time.max_offset_s,
+    "an input stamped farther than this from the current (newest) time is refused and counted [s]");
+  v("time.rebase_after", o.time.rebase_after,
+    "this many consecutive refused inputs agreeing among themselves move the clock (a real jump) [-]");
 }
 
 std::vector<std::string> splitKey(const std::string& key) {
@@ -118,27 +123,12 @@ std::string formatValue(double v) {
 }  // namespace
 
 EstimatorOptions EstimatorOptions::fromYaml(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": cannot read estimator options: " + e.what());
-  }
+  // The one rule of common/yaml_options.h: unknown keys and bad values are errors naming the file
+  // and the key; a missing key keeps its default (the defaults are the shipped file).
+  YamlOptions yaml(YamlOptions::loadFile(path), path);
   EstimatorOptions o;
-  forEachField(o, [&](const std::string& key, auto& field, const char*) {
-    YAML::Node node;
-    node.reset(root);  // (Node::operator= would overwrite the content of root)
-    for (const auto& part : splitKey(key)) {
-      const YAML::Node child = node.IsMap() ? node[part] : YAML::Node();
-      if (!child) throw std::runtime_error(path + ": missing key '" + key + "'");
-      node.reset(child);
-    }
-    try {
-      field = node.as<std::remove_reference_t<decltype(field)>>();
-    } catch (const std::exception& e) {
-      throw std::runtime_error(path + ": key '" + key + "' has a malformed value: " + e.what());
-    }
-  });
+  forEachField(o, [&](const std::string& key, auto& field, const char*) { yaml.read(key, field); });
+  yaml.rejectUnknown();
   try {
     o.validate();
   } catch (const std::exception& e) {
@@ -183,8 +173,11 @@ void EstimatorOptions::validate() const {
   need(uwb.sigma_range_m > 0 && uwb.max_range_m > 0, "uwb.sigma_range_m > 0, uwb.max_range_m > 0");
   need(uwb.gate_probability >= 0 && uwb.gate_probability < 1, "uwb.gate_probability in [0, 1)");
   need(process_noise.batch >= 5 && process_noise.upper_ratio > 1.0 && process_noise.lower_ratio > 0.0 &&
-           process_noise.lower_ratio < 1.0 && process_noise.max_grow > 1.0 && process_noise.max_shrink > 1.0 && process_noise.max_scale >= 1.0 && process_noise.max_prior_ratio > 0.0,
+           process_noise.lower_ratio < 1.0 && process_noise.max_grow > 1.0 && process_noise.max_shrink > 1.0 &&
+           process_noise.max_scale >= 1.0 && process_noise.max_prior_ratio > 0.0,
        "process_noise: batch >= 5, lower_ratio in (0, 1), upper_ratio > 1, max_grow > 1, max_shrink > 1, max_scale >= 1, max_prior_ratio > 0");
+  need(time.max_offset_s >= window_s && time.max_offset_s <= kMaxTimeSeconds && time.rebase_after >= 1,
+       "time.max_offset_s >= window_s, time.rebase_after >= 1");
   need(zupt.rate_hz > 0 && zupt.sigma_acc_m_s2 > 0 && zupt.sigma_gyro_rad_s > 0 && zupt.sigma_vel_m_s > 0,
        "zupt rate and sigmas > 0");
 }

@@ -1,13 +1,15 @@
 #pragma once
 /// @file estimator_options.h
-/// @brief Tuning of the estimator (config/estimator.yaml). Every key is required when loading
-/// from YAML; the defaults here equal the shipped file. Setup noise figures (setup.yaml `noise:`)
+/// @brief Tuning of the estimator (config/estimator.yaml). Loading follows the one rule of
+/// common/yaml_options.h: an unknown key or a bad value is an error naming the file and the key, a
+/// missing key keeps its default; the defaults here equal the shipped file. Setup noise figures (setup.yaml `noise:`)
 /// override the matching defaults at construction of the node (see `applySetupNoise`).
 
 #include <string>
 
 #include "common/chi_square.h"
 #include "common/setup.h"
+#include "common/time_guard.h"
 #include "estimator/health/health_monitor.h"
 #include "estimator/imu/process_noise_adapter.h"
 
@@ -123,8 +125,12 @@ struct EstimatorOptions {
   HealthOptions health;
   ProcessNoiseAdaptOptions process_noise;
   RecoveryOptions recovery;
+  /// Inputs stamped far from the node's current time (common/time_guard.h): `time.max_offset_s`
+  /// (>= window_s) and `time.rebase_after`.
+  TimeGuardOptions time;
 
-  /// Loads every key from `path`; throws std::runtime_error("<path>: missing key 'a.b'") etc.
+  /// Loads `path` (missing keys: defaults); throws std::runtime_error naming the file and the key
+  /// for an unknown key, a value of the wrong type, a non-finite number or an out-of-range value.
   static EstimatorOptions fromYaml(const std::string& path);
   /// Throws std::invalid_argument naming the first out-of-range value.
   void validate() const;

@@ -65,7 +65,8 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       aligner_(alignerOptions(options_), setup.rel_tag_positions),
       still_detector_(StillnessOptions{}, options_.imu.acc_noise_density, options_.imu.gyro_noise_density,
                       options_.gravity_m_s2),
-      health_(options_.health) {
+      health_(options_.health),
+      time_guard_(options_.time) {
   options_.validate();
   if (!strategyImplemented(options_.strategy))
     throw std::invalid_argument("strategy '" + options_.strategy + "' is not implemented yet (next issue)");
@@ -136,6 +137,7 @@ bool EstimatorNode::validate(const EstimatorInput& in) {
 void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   if (!validate(in_raw)) return;
   EstimatorInput in = in_raw;
+  if (!admitTime(in)) return;
   // Commands are not measurements: they apply now (at the newest time) unless they are newer.
   if (newest_ && (std::holds_alternative<AnchorInit>(in) || std::holds_alternative<EstimatorCommand>(in))) {
     if (auto* a = std::get_if<AnchorInit>(&in)) a->t = std::max(a->t, *newest_);

@@ -10,6 +10,12 @@
 ///   snapshot before its place and re-processes the rest in the canonical order
 ///   (estimator_input.h), so the result equals in-order processing. Older than the window:
 ///   rejected ("rejected_too_old"). Bad values: "bad_input". Unknown range ids: "unknown_id".
+/// - Time stamps far from the node's current time (`time.max_offset_s`) are refused before all
+///   of this and counted per input kind ("IMU:time_ahead", "RANGE:time_behind", ...), so they never
+///   move the filter's clock; a jump of the whole stream is taken after `time.rebase_after`
+///   agreeing inputs ("time_rebased"; backwards: the node starts over). ANCHOR_INIT and
+///   ESTIMATOR_CMD stamped that far apply at the current time ("<KIND>:time_clamped").
+///   estimator_node_time.cpp, common/time_guard.h.
 ///   A snapshot is `FusionStrategy::clone()`: for dp/dah O(#instances) pointer copies
 ///   (copy-on-write instances), so the history is also each instance's belief/factor history.
 ///   Step timings include "rewind" (restore + re-processing of one late input).
@@ -38,6 +44,7 @@
 #include "common/diagnostics.h"
 #include "common/messages.h"
 #include "common/setup.h"
+#include "common/time_guard.h"
 #include "common/types.h"
 #include "estimator/baro/baro_model.h"
 #include "estimator/core/estimator_options.h"
@@ -126,6 +133,8 @@ class EstimatorNode {
   };
 
   bool validate(const EstimatorInput& in);
+  /// The time guard on `in` (may restamp a command); false: refused and counted.
+  bool admitTime(EstimatorInput& in);
   void feedInitializer(const EstimatorInput& in);
   void initialize(const InitialBelief& b);
   /// Processes one input on `cur_`; `first` = first time (count events, publish).
@@ -184,6 +193,7 @@ class EstimatorNode {
   Snapshot cur_;
   std::deque<Entry> history_;
   std::optional<Timestamp> newest_;   ///< newest input time seen (also before init)
+  TimeGuard time_guard_;
   Timestamp init_time_;
   std::optional<double> baro_reference_pa_;
   std::map<SensorId, InstanceStatus> instance_stats_;

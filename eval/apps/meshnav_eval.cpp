@@ -115,6 +115,16 @@ int runBaselineOnly(const std::string& dataset, const EvalOptions& options, cons
   return ev.baseline && ev.baseline->trajectory.n_selected > 0 ? 0 : 1;
 }
 
+/// Rows skipped for an unusable time stamp ("<file>:bad_time"): reported, and a failed exit.
+bool badTimeRows(const RunEvaluation& ev) {
+  const int64_t n = skippedTimeRows(ev);
+  if (n > 0)
+    spdlog::error("{} input row(s) skipped for a time stamp that is not a number or does not fit (see the "
+                  "messages above): the figures leave them out; exit status 3",
+                  n);
+  return n > 0;
+}
+
 int runSingle(const EvalCli& cli) {
   if (cli.dataset.empty()) {
     std::cerr << "meshnav_eval: --dataset is required (or --batch ROOT); see --help\n";
@@ -137,7 +147,8 @@ int runSingle(const EvalCli& cli) {
     spdlog::error("{}", ex.what());
     return 1;
   }
-  return (ev.trajectory.n_selected > 0 || ev.anchors) ? 0 : 1;
+  if (!(ev.trajectory.n_selected > 0 || ev.anchors)) return 1;
+  return badTimeRows(ev) ? 3 : 0;
 }
 
 int runBatch(const EvalCli& cli) {

@@ -102,6 +102,8 @@ std::map<SensorId, AnchorEstimate> readCalibrationYaml(const std::string& path) 
       out[a.id] = a;
     } catch (const YAML::Exception& ex) {
       throw std::runtime_error(where + ": " + ex.what());
+    } catch (const std::out_of_range& ex) {
+      throw std::runtime_error(where + ": key 't': " + ex.what());
     }
   }
   return out;

@@ -196,4 +196,13 @@ RunEvaluation evaluateRun(const std::string& dataset_dir, const std::string& run
   return ev;
 }
 
+int64_t skippedTimeRows(const RunEvaluation& ev) {
+  static const std::string kSuffix = ":bad_time";
+  int64_t n = 0;
+  for (const auto& [key, count] : ev.diagnostics)
+    if (key.size() > kSuffix.size() && key.compare(key.size() - kSuffix.size(), kSuffix.size(), kSuffix) == 0)
+      n += count;
+  return n;
+}
+
 }  // namespace meshnav::eval

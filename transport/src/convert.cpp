@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "common/plausibility.h"
+
 namespace meshnav::transport {
 namespace {
 
@@ -42,6 +44,14 @@ void requireFinite(const double (&a)[N], const char* what) {
 }
 void requireFinite(double v, const char* what) {
   if (!std::isfinite(v)) throw InvalidMessage(std::string("non-finite ") + what);
+}
+
+/// Plausibility limits of common/plausibility.h on a decoded field (bad bytes behind a valid
+/// fingerprint decode to anything).
+void requireWithin(double v, double lo, double hi, const char* what) {
+  if (!(v >= lo && v <= hi))
+    throw InvalidMessage(std::string(what) + " " + std::to_string(v) + " outside the plausible [" + std::to_string(lo) +
+                         ", " + std::to_string(hi) + "]");
 }
 
 UwbType uwbTypeFromCode(int8_t code, const char* what) {
@@ -90,6 +100,8 @@ ImuSample fromLcm(const imu_t& m) {
   s.t = Timestamp::fromUtime(m.utime);
   s.acc_m_s2 = get3(m.lin_acc);
   s.gyro_rad_s = get3(m.ang_vel);
+  requireWithin(s.acc_m_s2.norm(), 0.0, plausible::kMaxSpecificForce_m_s2, "|lin_acc| [m/s^2]");
+  requireWithin(s.gyro_rad_s.norm(), 0.0, plausible::kMaxAngularRate_rad_s, "|ang_vel| [rad/s]");
   return s;
 }
 
@@ -101,6 +113,7 @@ baro_t toLcm(const BaroSample& s) {
 }
 BaroSample fromLcm(const baro_t& m) {
   requireFinite(m.pressure, "pressure");
+  requireWithin(m.pressure, plausible::kMinPressure_pa, plausible::kMaxPressure_pa, "pressure [Pa]");
   BaroSample s;
   s.t = Timestamp::fromUtime(m.utime);
   s.pressure_pa = m.pressure;
@@ -124,6 +137,8 @@ RangeSample fromLcm(const range_t& m) {
   requireFinite(m.range, "range");
   requireFinite(m.range_corr, "range_corr");
   requireFinite(m.variance, "variance");
+  requireWithin(m.range, plausible::kMinRange_m, plausible::kMaxRange_m, "range [m]");
+  requireWithin(m.variance, 0.0, plausible::kMaxRange_m * plausible::kMaxRange_m, "variance [m^2]");
   RangeSample s;
   s.t = Timestamp::fromUtime(m.utime);
   s.id_initiator = m.id_initiator;

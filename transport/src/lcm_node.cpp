@@ -64,6 +64,13 @@ void LcmNode::runHeartbeatIfDue() {
   guarded("heartbeat", heartbeat_);
 }
 
+bool LcmNode::sizeOk(const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+  if (rbuf.data_size <= kMaxMessageBytes) return true;
+  diag_.report(ch + ":oversized", "channel " + ch + ": dropped a message of " + std::to_string(rbuf.data_size) +
+                                      " bytes (limit " + std::to_string(kMaxMessageBytes) + ")");
+  return false;
+}
+
 bool LcmNode::stopRequested() const { return stop_ || StopSignal::requested(); }
 
 int64_t LcmNode::received(const std::string& channel) const {

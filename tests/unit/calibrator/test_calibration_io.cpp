@@ -6,6 +6,7 @@
 
 #include "calibrator/anchor_calibrator.h"
 #include "calibrator/calibration_io.h"
+#include "calibrator/node/calibrator_config.h"
 #include "common/anchor_init_io.h"
 #include "calibrator/observation_builder.h"
 #include "calibrator/synthetic_scene.h"
@@ -73,7 +74,7 @@ TEST(CalibrationIo, OptionsFromYaml) {
   {
     std::ofstream(path) << "calibrator:\n  sigma_range: 0.2\n  robust_loss: huber\n  ransac: false\n";
   }
-  const auto o = CalibratorOptions::load(path);
+  const auto o = CalibratorConfig::load(path).calibrator;
   EXPECT_DOUBLE_EQ(o.sigma_range_m, 0.2);
   EXPECT_EQ(o.robust_loss, RobustLoss::Huber);
   EXPECT_FALSE(o.ransac);
@@ -82,7 +83,7 @@ TEST(CalibrationIo, OptionsFromYaml) {
     std::ofstream(path) << "calibrator:\n  sigma_rnage: 0.2\n";
   }
   try {
-    CalibratorOptions::load(path);
+    CalibratorConfig::load(path).calibrator;
     FAIL() << "no throw";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("sigma_rnage"), std::string::npos);
@@ -90,7 +91,29 @@ TEST(CalibrationIo, OptionsFromYaml) {
   {
     std::ofstream(path) << "calibrator:\n  sigma_range: -1\n";
   }
-  EXPECT_THROW(CalibratorOptions::load(path), std::runtime_error);
+  EXPECT_THROW(CalibratorConfig::load(path).calibrator, std::runtime_error);
+  // The one rule (issue 11, issue 12 item 5): non-finite and mistyped values name file and key,
+  // unknown keys in either map or at the top are refused.
+  auto error = [&](const std::string& text) -> std::string {
+    std::ofstream(path) << text;
+    try {
+      CalibratorConfig::load(path);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_NE(error("calibrator:\n  sigma_range: .inf\n").find(path + ": key 'calibrator.sigma_range' must be a finite number"),
+            std::string::npos);
+  EXPECT_NE(error("calibrator:\n  min_measurements: thirty\n").find("key 'calibrator.min_measurements' must be an integer"),
+            std::string::npos);
+  EXPECT_NE(error("calibrator:\n  robust_loss: tukey\n").find("key 'calibrator.robust_loss' robust_loss must be"),
+            std::string::npos);
+  EXPECT_NE(error("calibrator_node:\n  auto_mod: true\n").find("unknown key 'calibrator_node.auto_mod'"),
+            std::string::npos);
+  EXPECT_NE(error("calibrator: {}\ncalibratr_node: {}\n").find("unknown key 'calibratr_node'"), std::string::npos);
+  EXPECT_NE(error("calibrator_node:\n  time_max_offset: 0\n").find("calibrator_node.time_max_offset"), std::string::npos);
+  EXPECT_EQ(error("calibrator_node:\n  auto_mode: true\n"), "");  // the other map keeps its defaults
 }
 
 TEST(ObservationBuilder, TagsAtLeverArmKnownAnchorsAndDiagnostics) {

@@ -339,9 +339,16 @@ TEST(CalibratorNode, PosesOlderThanTheWindowAreDroppedAndHistoryIsBounded) {
   // 60 Hz ground truth: at most window + prune slack (10 s) of poses.
   EXPECT_LE(node.poseHistorySize(), static_cast<size_t>(60 * 31));
   EXPECT_GE(node.poseHistorySize(), static_cast<size_t>(60 * 19));
+  const Timestamp newest = seed1().dataset.ground_truth.back().t;
   PoseEstimate old = asEstimate(seed1().dataset.ground_truth.front());
+  old.t = newest - Duration::fromSec(25.0);  // beyond the 20 s window
   node.onPose(old);
   EXPECT_EQ(node.diagnostics().get("pose_too_old"), 1);
+  // Far beyond the window and the time guard's offset: refused by the guard (issue 12).
+  old.t = newest - Duration::fromSec(100.0);
+  node.onPose(old);
+  EXPECT_EQ(node.diagnostics().get("pose_too_old"), 1);
+  EXPECT_EQ(node.diagnostics().get("POSE:time_behind"), 1);
 }
 
 TEST(CalibratorNode, RangesWithoutAPoseWaitUntilThePosesArrive) {
@@ -521,6 +528,43 @@ TEST(CalibratorNode, StatusHeartbeatAtOneHertzOfDataTime) {
   EXPECT_EQ(out.statuses.size(), n + 1);
   node.tick(t_jump + Duration::fromSec(1.0));
   EXPECT_EQ(out.statuses.size(), n + 2);
+}
+
+TEST(CalibratorNode, FarStampedInputsAreRefusedAndChangeNothing) {
+  // Issue 12, finding 1: a RANGE or POSE stamped +1 h (or random bytes decoding to any utime) must
+  // not move the data time; the calibration comes out exactly as without it.
+  const auto cmds = std::vector<TimedCommand>{{80.0, command(CalibCommand::Action::Calibrate, {106})}};
+  Outputs clean_out, out;
+  CalibratorNode clean(CalibratorOptions{}, setup(), sinksInto(clean_out));
+  replay(clean, seed1().dataset, cmds, 80.0);
+  CalibratorNode node(CalibratorOptions{}, setup(), sinksInto(out));
+  bool injected = false;
+  replay(node, seed1().dataset, cmds, 80.0, [&](PoseEstimate& p) {
+    if (injected || p.t.sec() < 30.0) return true;
+    injected = true;
+    const Timestamp future = p.t + Duration::fromSec(3600.0);
+    RangeSample r = seed1().dataset.ranges.front();
+    r.t = future;
+    node.onRange(r);
+    PoseEstimate q = p;
+    q.t = future;
+    node.onPose(q);
+    node.tick(future);
+    r.t = Timestamp{INT64_MIN};
+    node.onRange(r);
+    return true;
+  });
+  ASSERT_TRUE(injected);
+  EXPECT_EQ(node.diagnostics().get("RANGE:time_ahead"), 1);
+  EXPECT_EQ(node.diagnostics().get("RANGE:time_behind"), 1);
+  EXPECT_EQ(node.diagnostics().get("POSE:time_ahead"), 1);
+  EXPECT_EQ(node.diagnostics().get("tick:time_ahead"), 1);
+  EXPECT_EQ(node.dataTime(), clean.dataTime());
+  ASSERT_EQ(clean_out.inits.size(), 1u);
+  ASSERT_EQ(out.inits.size(), 1u);
+  EXPECT_EQ(out.inits[0].p_AinG, clean_out.inits[0].p_AinG);
+  EXPECT_EQ(out.inits[0].t, clean_out.inits[0].t);
+  EXPECT_EQ(out.statuses.size(), clean_out.statuses.size());
 }
 
 TEST(CalibratorNodeOptions, YamlRejectsUnknownKeysAndBadValues) {

@@ -88,3 +88,26 @@ TEST(Csv, TumHeaderWithHashAndSpaces) {
   }, diag);
   EXPECT_EQ(n, 1);
 }
+
+TEST(Csv, FilesAboveTheSizeLimitAreRefusedWithAMessage) {
+  // Issue 12, finding 5: a 100 MB ranges.csv took 665 MB. Above maxCsvBytes() a file is refused
+  // up front. The limit is lowered to 1 MiB here so that the test file stays small.
+  ASSERT_EQ(setenv("MESHNAV_MAX_CSV_MB", "1", 1), 0);
+  EXPECT_EQ(maxCsvBytes(), 1u << 20);
+  auto d = test::tempDir("csv");
+  std::string text = "t,range_raw,UWB_ID1,UWB_ID2,type_ID1,type_ID2\n";
+  while (text.size() <= (1u << 20)) text += "1.000000,4.000000,100,101,T,A\n";
+  const auto f = test::writeFile(d / "ranges.csv", text);
+  try {
+    CsvReader r(f, {"t"});
+    ADD_FAILURE() << "a file above the limit was accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(f + ": 1 MiB is more than the 1 MiB"), std::string::npos) << what;
+    EXPECT_NE(what.find("MESHNAV_MAX_CSV_MB"), std::string::npos) << what;
+  }
+  ASSERT_EQ(setenv("MESHNAV_MAX_CSV_MB", "2", 1), 0);
+  EXPECT_NO_THROW(CsvReader(f, {"t"}));
+  ASSERT_EQ(unsetenv("MESHNAV_MAX_CSV_MB"), 0);
+  EXPECT_EQ(maxCsvBytes(), 64u << 20);
+}

@@ -75,11 +75,61 @@ TEST(Setup, MalformedFilesNameFileAndKey) {
   expectError("abs_anchor_positions: {101: [1, 2, x]}\n", "abs_anchor_positions.101");
   expectError("pair_biases: [{ids: [1]}]\n", "pair_biases[0].ids");
   expectError("pair_biases: [{ids: [1, 1]}]\n", "same device");
-  expectError("initial_pose: {p_IinG: [0, 0, 0], yaw_deg: 0, sigma_p: 0.1}\n", "sigma_yaw_deg");
+  expectError("initial_pose: {p_IinG: [0, 0, 0], sigma_p: 0.1}\n", "initial_pose.yaw_deg");
   expectError("rel_tag_positions: {5: [0,0,0]}\nabs_anchor_positions: {5: [0,0,0]}\n", "both a tag and an anchor");
   expectError("a: [1, 2\n", "YAML syntax error");
   expectError("abs_anchor_sigmas: {7: 0.3}\n", "abs_anchor_sigmas.7");
   EXPECT_THROW(loadSetup((d / "missing.yaml").string()), std::runtime_error);
+}
+
+TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
+  // Issue 12, finding 4 and item 5; issue 11 "options files: one rule".
+  auto d = test::tempDir("setup");
+  const std::string base =
+      "rel_tag_positions: {100: [0, 0, 0], 105: [0.1, 0, 0]}\n"
+      "abs_anchor_positions: {101: [1, 2, 3], 102: [3, 2, 1]}\n";
+  auto error = [&](const std::string& text) -> std::string {
+    const auto f = test::writeFile(d / "setup.yaml", text);
+    try {
+      loadSetup(f);
+    } catch (const std::runtime_error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find(f), std::string::npos) << m;  // always the file
+      return m;
+    }
+    return "";
+  };
+  EXPECT_NE(error(base + "abs_anchor_positons: {103: [0, 0, 0]}\n").find("unknown key 'abs_anchor_positons'"),
+            std::string::npos);
+  EXPECT_NE(error(base + "initial_pose: {p_IinG: [.inf, 0, 0], yaw_deg: 0}\n").find("initial_pose.p_IinG[0]' must be a finite number"),
+            std::string::npos);
+  EXPECT_NE(error(base + "pair_biases: [{ids: [100, 101], gamma: 0.1, sigma_gamma: -0.02}]\n")
+                .find("key 'pair_biases[0].sigma_gamma' must be >= 0"),
+            std::string::npos);
+  EXPECT_NE(error(base + "pair_biases: [{ids: [100, 101], gama: 0.1}]\n").find("unknown key 'pair_biases[0].gama'"),
+            std::string::npos);
+  EXPECT_NE(error(base + "imu_id: one\n").find("key 'imu_id' must be an integer, got 'one'"), std::string::npos);
+  EXPECT_NE(error(base + "baro_id: 105\n").find("key 'baro_id' = 105 is also a tag (rel_tag_positions.105)"),
+            std::string::npos);
+  EXPECT_NE(error(base + "imu_id: 101\n").find("key 'imu_id' = 101 is also an anchor (abs_anchor_positions.101)"),
+            std::string::npos);
+  EXPECT_NE(error(base + "imu_id: 7\nbaro_id: 7\n").find("same id 7"), std::string::npos);
+  EXPECT_NE(error(base + "noise: {sigma_range: -0.1}\n").find("key 'noise.sigma_range' must be > 0"), std::string::npos);
+  EXPECT_NE(error(base + "noise: {sigma_rnage: 0.1}\n").find("unknown key 'noise.sigma_rnage'"), std::string::npos);
+  EXPECT_NE(error(base + "baro: {reference_pressure: 1e9}\n").find("key 'baro.reference_pressure'"), std::string::npos);
+  EXPECT_NE(error("abs_anchor_positions: {4294967297: [0, 0, 0]}\n").find("'4294967297' is not a device id"),
+            std::string::npos);
+  EXPECT_NE(error(base + "abs_anchor_sigmas: {101: .nan}\n").find("abs_anchor_sigmas.101' must be a finite number"),
+            std::string::npos);
+  // Missing keys take their defaults; imu_id / baro_id left out and taken by a device move aside.
+  EXPECT_EQ(error(base), "");
+  const auto f = test::writeFile(d / "setup.yaml", "rel_tag_positions: {0: [0, 0, 0]}\nabs_anchor_positions: {1: [0, 0, 1], 2: [1, 0, 0]}\n"
+                                                   "baro: {}\ninitial_pose: {p_IinG: [0, 0, 0], yaw_deg: 10}\n");
+  const SystemSetup s = loadSetup(f);
+  EXPECT_EQ(s.imu_id, 3);
+  EXPECT_EQ(s.baro_id, 4);
+  ASSERT_TRUE(s.initial_pose);
+  EXPECT_DOUBLE_EQ(s.initial_pose->sigma_p_m, InitialPose{}.sigma_p_m);
 }
 
 TEST(Truth, RoundTrip) {

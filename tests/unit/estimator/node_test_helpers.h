@@ -19,6 +19,16 @@ inline double stateDifference(const FusionStrategy& a, const FusionStrategy& b) 
   return std::max(d, (a.fullCovariance() - b.fullCovariance()).cwiseAbs().maxCoeff());
 }
 
+/// A short noisy flight (10 s, landed for the first 3 s): the scenario of the bad-input tests.
+inline synthetic::SyntheticOptions shortNoisyFlight(uint32_t seed) {
+  synthetic::SyntheticOptions o;
+  o.duration_s = 10.0;
+  o.landed_s = 3.0;
+  o.noise = true;
+  o.seed = seed;
+  return o;
+}
+
 inline EstimatorOptions testOptions() {
   EstimatorOptions o;
   o.window_s = 1.0;

@@ -1,4 +1,5 @@
-/// EstimatorOptions: the shipped YAML equals the built-in defaults, missing keys name file and key.
+/// EstimatorOptions: the shipped YAML equals the built-in defaults; the one rule of options files
+/// (common/yaml_options.h): missing keys keep defaults, unknown keys and bad values name file and key.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -33,18 +34,50 @@ TEST(EstimatorOptions, PrintedOptionsLoadBack) {
   EXPECT_FALSE(back.zupt.enabled);
 }
 
-TEST(EstimatorOptions, MissingKeyNamesFileAndKey) {
+TEST(EstimatorOptions, MissingKeyKeepsItsDefault) {
+  // One rule for every options file (issue 11): a missing key takes its documented default.
   std::string text = EstimatorOptions{}.toString();
   const auto pos = text.find("  sigma_vel_m_s");
   text.erase(pos, text.find('\n', pos) - pos + 1);
-  const std::string path = tempFile("opts_missing.yaml", text);
+  text.replace(text.find("window_s: 1.0"), 13, "window_s: 0.5");
+  const auto o = EstimatorOptions::fromYaml(tempFile("opts_missing.yaml", text));
+  EXPECT_DOUBLE_EQ(o.zupt.sigma_vel_m_s, EstimatorOptions{}.zupt.sigma_vel_m_s);
+  EXPECT_DOUBLE_EQ(o.window_s, 0.5);
+  EXPECT_EQ(EstimatorOptions::fromYaml(tempFile("opts_empty.yaml", "")).toString(), EstimatorOptions{}.toString());
+}
+
+namespace {
+/// The message of the error loading `text`, or "" when it loads.
+std::string loadError(const std::string& name, const std::string& text) {
   try {
-    EstimatorOptions::fromYaml(path);
-    FAIL() << "expected an exception";
+    EstimatorOptions::fromYaml(tempFile(name, text));
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("zupt.sigma_vel_m_s"), std::string::npos) << e.what();
+    return e.what();
   }
+  return "";
+}
+}  // namespace
+
+TEST(EstimatorOptions, UnknownKeysAndBadValuesNameFileAndKey) {
+  // Issue 12, finding 4 / issue 11: a misspelled key used to be ignored.
+  const std::string path = ::testing::TempDir() + "opts_typo.yaml";
+  std::string e = loadError("opts_typo.yaml", "uwb:\n  sigma_range_mm: 0.2\n");
+  EXPECT_NE(e.find(path), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown key 'uwb.sigma_range_mm'"), std::string::npos) << e;
+  e = loadError("opts_top.yaml", "windw_s: 1.0\n");
+  EXPECT_NE(e.find("unknown key 'windw_s'"), std::string::npos) << e;
+  e = loadError("opts_section.yaml", "zuptt:\n  enabled: false\n");
+  EXPECT_NE(e.find("unknown key 'zuptt'"), std::string::npos) << e;
+  e = loadError("opts_inf.yaml", "uwb:\n  sigma_range_m: .inf\n");
+  EXPECT_NE(e.find("key 'uwb.sigma_range_m' must be a finite number, got '.inf'"), std::string::npos) << e;
+  e = loadError("opts_type.yaml", "init:\n  min_ranges: twelve\n");
+  EXPECT_NE(e.find("key 'init.min_ranges' must be an integer, got 'twelve'"), std::string::npos) << e;
+  e = loadError("opts_list.yaml", "gravity_m_s2: [9.81]\n");
+  EXPECT_NE(e.find("key 'gravity_m_s2' must be a single value"), std::string::npos) << e;
+  e = loadError("opts_scalar_section.yaml", "uwb: 3\n");
+  EXPECT_NE(e.find("'uwb' must be a map"), std::string::npos) << e;
+  e = loadError("opts_time.yaml", "time:\n  max_offset_s: 0.5\n");  // below window_s
+  EXPECT_NE(e.find("time.max_offset_s >= window_s"), std::string::npos) << e;
 }
 
 TEST(EstimatorOptions, InvalidValuesAndFilesAreRejected) {

@@ -90,6 +90,24 @@ class RunEvaluationTest : public ::testing::Test {
 
 }  // namespace
 
+TEST_F(RunEvaluationTest, TimesThatDoNotFitAreSkippedCountedAndFlagged) {
+  // Issue 12, finding 2: a ground-truth time of 1e308 became INT64_MIN, sorted first and left one
+  // associated sample (RMSE 0.037 m, exit 0). Now the row is refused; everything else is evaluated.
+  writeAll();
+  EvalOptions opt;
+  const RunEvaluation clean = evaluateRun(ds_.string(), run_.string(), opt);
+  EXPECT_EQ(skippedTimeRows(clean), 0);
+  std::ofstream(ds_ / "groundtruth.csv", std::ios::app) << "1e308,1,0,2,0,0,0,1\n-1e308,1,0,2,0,0,0,1\n";
+  std::ofstream(run_ / "estimate.csv", std::ios::app)
+      << "1e300,0,0,2,0,0,0,1,0.04,0,0,0.04,0,0.04,1e-4,0,0,1e-4,0,1e-4\n";
+  const RunEvaluation ev = evaluateRun(ds_.string(), run_.string(), opt);
+  EXPECT_EQ(ev.diagnostics.at("groundtruth.csv:bad_time"), 2);
+  EXPECT_EQ(ev.diagnostics.at("estimate.csv:bad_time"), 1);
+  EXPECT_EQ(skippedTimeRows(ev), 3);
+  EXPECT_EQ(ev.trajectory.n_selected, clean.trajectory.n_selected);
+  EXPECT_EQ(ev.trajectory.position.rmse, clean.trajectory.position.rmse);
+}
+
 TEST_F(RunEvaluationTest, MetricsTablesAndFiles) {
   writeAll();
   EvalOptions opt;

@@ -289,6 +289,24 @@ TEST(Convert, InvalidMeasurementsThrow) {
   range = toLcm(RangeSample{});
   range.type_responder = 'X';
   EXPECT_THROW(fromLcm(range), InvalidMessage);
+  // Beyond the plausibility limits of common/plausibility.h (random bytes behind a valid
+  // fingerprint decode to such values; issue 12, finding 1).
+  imu = toLcm(ImuSample{});
+  imu.lin_acc[2] = 1e25;
+  EXPECT_THROW(fromLcm(imu), InvalidMessage);
+  imu = toLcm(ImuSample{});
+  imu.ang_vel[0] = -60.0;
+  EXPECT_THROW(fromLcm(imu), InvalidMessage);
+  baro.pressure = 3e5;
+  EXPECT_THROW(fromLcm(baro), InvalidMessage);
+  baro.pressure = -1.0;
+  EXPECT_THROW(fromLcm(baro), InvalidMessage);
+  range = toLcm(RangeSample{});
+  range.range = 1e6;
+  EXPECT_THROW(fromLcm(range), InvalidMessage);
+  range = toLcm(RangeSample{});
+  range.variance = -0.1;
+  EXPECT_THROW(fromLcm(range), InvalidMessage);
   auto cmd = toLcm(EstimatorCommand{});
   cmd.action = 42;
   EXPECT_THROW(fromLcm(cmd), InvalidMessage);

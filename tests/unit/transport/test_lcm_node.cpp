@@ -67,6 +67,29 @@ TEST(LcmNode, GarbageBytesAreCountedNotFatal) {
   EXPECT_EQ(node.received(channels::kImu), 1);
 }
 
+TEST(LcmNode, OversizedMessagesAreCounted) {
+  // Issue 12, finding 5: messages of 1 MB vanished uncounted. A received one above the limit is
+  // counted and dropped before decoding; one of ours is not sent, and counted at the sender.
+  LcmNode node("test", "memq://");
+  int imu_count = 0;
+  node.subscribe<ImuSample>(channels::kImu, [&](const ImuSample&) { ++imu_count; });
+  const auto imu = toLcm(ImuSample{});
+  std::vector<uint8_t> big(1 << 20);
+  imu.encode(big.data(), 0, imu.getEncodedSize());  // a valid imu_t followed by 1 MB of padding
+  publishBytes(node, channels::kImu, big);
+  ASSERT_TRUE(node.publish(channels::kImu, ImuSample{}));
+  drain(node);
+  EXPECT_EQ(imu_count, 1);
+  EXPECT_EQ(node.diagnostics().get("IMU:oversized"), 1);
+
+  EstimatorStatus st;
+  for (int i = 0; i < 300; ++i) st.counters[std::string(1000, 'a') + std::to_string(i)] = i;
+  EXPECT_FALSE(node.publish(channels::kEstimatorStatus, st));
+  EXPECT_EQ(node.diagnostics().get("ESTIMATOR_STATUS:oversized_publish"), 1);
+  st.counters.clear();
+  EXPECT_TRUE(node.publish(channels::kEstimatorStatus, st));
+}
+
 TEST(LcmNode, CorruptedArrayCountIsCaught) {
   // Right fingerprint, but the int16 count of anchors set to -1 and then to a count larger than
   // the buffer: decode must fail cleanly (no huge allocation, no crash).
