@@ -1,5 +1,5 @@
 /// @file meshnav_run.cpp
-/// @brief The whole pipeline in one process, deterministic and as fast as possible (DESIGN §8):
+/// @brief The whole pipeline in one process, deterministic and as fast as possible (README.md):
 /// reads a dataset, merges every sample into time order, feeds the estimator node, writes
 /// estimate.csv, anchors.csv, timings.csv and status.txt into --out. The estimator, calibrator and
 /// mission nodes run in one `pipeline::Pipeline`, wired as the processes are over LCM.

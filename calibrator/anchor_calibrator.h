@@ -1,7 +1,7 @@
 #pragma once
 /// @file anchor_calibrator.h
 /// @brief Calibrates one unknown anchor from its ranges to reference devices (paper §III-C,
-/// DESIGN §5): refusal checks → RANSAC (or all ranges) + optimal double linear step →
+/// docs/calibration.md): refusal checks → RANSAC (or all ranges) + optimal double linear step →
 /// Levenberg–Marquardt refinement (robust loss optional) → re-classification of outliers →
 /// consistent covariance Σ = s²·(JᵀWJ + H_prior)⁻¹ with W⁻¹ = σ_d² + β²uᵀΣ_R u and s² = max(1, χ²/dof).
 

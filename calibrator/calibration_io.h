@@ -1,6 +1,6 @@
 #pragma once
 /// @file calibration_io.h
-/// @brief Calibration results as YAML (DESIGN §6), one entry per anchor:
+/// @brief Calibration results as YAML (docs/formats.md), one entry per anchor:
 /// @code
 /// anchors:
 ///   - id: 106

@@ -1,7 +1,7 @@
 #pragma once
 /// @file observation_builder.h
 /// @brief Turns ranges + a pose history + the system setup into calibration observations of an
-/// unknown anchor x (DESIGN §5): a tag reference sits at p_TinG = p_IinG + R_ItoG·p_TinI at the range
+/// unknown anchor x (docs/calibration.md): a tag reference sits at p_TinG = p_IinG + R_ItoG·p_TinI at the range
 /// time (pose interpolated), with covariance Σ_p + R[p_TinI]ₓ Σ_θ [p_TinI]ₓᵀRᵀ (orientation error
 /// local, R = R̂·Exp(δθ)); a known anchor sits at its surveyed position with σ² I.
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file anchor_init_io.h
-/// @brief Calibration results file of DESIGN §6 (one entry per anchor: id, t, p_AinG, p_AinG_cov
+/// @brief Calibration results file, docs/formats.md (one entry per anchor: id, t, p_AinG, p_AinG_cov
 /// (3×3 row-major), ref_ids, const_biases, dist_biases, sigma_const_biases, sigma_dist_biases,
 /// sigma_ranges, n_inliers, n_outliers; refused anchors under `refused:`). Written by the
 /// calibrator and by the logger (ANCHOR_INIT), read by the estimator's users and the evaluation.

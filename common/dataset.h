@@ -1,6 +1,6 @@
 #pragma once
 /// @file dataset.h
-/// @brief The dataset folder of DESIGN §6: imu.csv, baro.csv, ranges.csv, flight_state.csv,
+/// @brief The dataset folder (docs/formats.md): imu.csv, baro.csv, ranges.csv, flight_state.csv,
 /// groundtruth.csv, setup.yaml, truth.yaml, and the optional height.csv (`t,range_m`, downward
 /// laser range [m], written by the MILUV importer). Readers validate every row: bad rows are reported
 /// (file:line), counted in `Diagnostics`, and dropped; they never reach an estimator.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file estimate_io.h
-/// @brief Estimate files of DESIGN §6.
+/// @brief Estimate files of a run folder (docs/formats.md).
 ///  - estimate.csv: t,tx,ty,tz,qx,qy,qz,qw,pxx,pxy,pxz,pyy,pyz,pzz,qrr,qrp,qry,qpp,qpy,qyy
 ///    (upper triangles; position covariance in G [m²], orientation error covariance local [rad²])
 ///  - anchors.csv:  t,id,x,y,z,pxx,pxy,pxz,pyy,pyz,pzz

@@ -1,6 +1,6 @@
 #pragma once
 /// @file setup.h
-/// @brief `setup.yaml` (what the system may know) and `truth.yaml` (evaluation only), DESIGN §6.
+/// @brief `setup.yaml` (what the system may know) and `truth.yaml` (evaluation only), docs/formats.md.
 
 #include <map>
 #include <optional>

@@ -108,7 +108,7 @@ inline std::pair<SensorId, SensorId> pairKey(SensorId a, SensorId b) {
   return a < b ? std::make_pair(a, b) : std::make_pair(b, a);
 }
 
-/// Result of an anchor calibration, handed to the estimator (ANCHOR_INIT; DESIGN §6 YAML).
+/// Result of an anchor calibration, handed to the estimator (ANCHOR_INIT; docs/formats.md, calibration results).
 struct AnchorInit {
   Timestamp t;                              ///< time of the calibration
   SensorId id = 0;

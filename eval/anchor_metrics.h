@@ -51,7 +51,7 @@ AnchorMetrics computeAnchorMetrics(const std::vector<AnchorEstimate>& anchor_row
                                    const std::map<SensorId, AnchorEstimate>& initial_override,
                                    Diagnostics& diag);
 
-/// Reads a calibration result YAML (DESIGN §6: a sequence of entries, or a map with key `anchors`
+/// Reads a calibration result YAML (docs/formats.md: a sequence of entries, or a map with key `anchors`
 /// holding one, each with `id`, `p_AinG`, `p_AinG_cov` (9 values row-major), optional `t`).
 /// Throws std::runtime_error naming the file and the key on a malformed file.
 std::map<SensorId, AnchorEstimate> readCalibrationYaml(const std::string& path);

@@ -1,7 +1,7 @@
 #pragma once
 /// @file baseline_evaluation.h
 /// @brief Alignment of a trajectory to ground truth in another frame, and the multilateration
-/// baseline evaluated the same way as the estimate (DESIGN §8: real recordings always show plain
+/// baseline evaluated the same way as the estimate (docs/real_data.md: real recordings always show plain
 /// multilateration beside the estimate).
 
 #include <optional>

@@ -1,7 +1,7 @@
 #pragma once
 /// @file multilateration.h
 /// @brief Plain per-epoch multilateration of tag–anchor ranges: the baseline that meshnav_eval
-/// shows beside the estimate (DESIGN §8), with no IMU, no filter and no bias model.
+/// shows beside the estimate (docs/real_data.md), with no IMU, no filter and no bias model.
 ///
 /// Epochs: for each tag of the vehicle (setup.yaml `rel_tag_positions`), its ranges to known
 /// anchors (`abs_anchor_positions`, either end of the range) are taken in time order; an epoch

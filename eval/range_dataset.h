@@ -3,7 +3,7 @@
 /// @brief Loads what a range evaluation needs from a folder: measured ranges and a true-range model.
 ///
 /// Two layouts are recognised:
-///  - a meshnav dataset (DESIGN §6): ranges.csv, truth.yaml (all anchors, true pair biases),
+///  - a meshnav dataset (docs/formats.md): ranges.csv, truth.yaml (all anchors, true pair biases),
 ///    groundtruth.csv and setup.yaml (tag lever arms) for the tag ranges;
 ///  - a toolbox recording (shared/data/real-t1-a3-loiter): *ranges*.csv measured by each device,
 ///    true_ranges*.csv (true tag-to-anchor distances), config.yaml (`abs_anchor_positions`).

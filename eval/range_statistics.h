@@ -4,7 +4,7 @@
 /// evaluation toolbox computes them: constant bias and noise standard deviation.
 ///
 /// Error of one range: e = z − d, measured minus true distance [m]. With the range model
-/// z = β·d + γ + ν (paper eq. z_kl, DESIGN §4), E[e] = γ + (β − 1)·d, i.e. γ for β = 1.
+/// z = β·d + γ + ν (paper eq. z_kl, estimator/README.md), E[e] = γ + (β − 1)·d, i.e. γ for β = 1.
 ///
 /// Three estimators of (bias, σ) from the errors of one pair:
 ///  - `Gate`:      drop gross outliers |e| > max_error, then mean and (population) std.

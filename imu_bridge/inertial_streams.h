@@ -1,6 +1,6 @@
 #pragma once
 /// @file inertial_streams.h
-/// @brief The inputs the imu_bridge replays from a dataset folder (DESIGN §6): imu.csv → IMU,
+/// @brief The inputs the imu_bridge replays from a dataset folder (docs/formats.md): imu.csv → IMU,
 /// baro.csv → BARO, flight_state.csv → FLIGHT_STATE, merged into one deterministic time line.
 
 #include <string>

@@ -1,7 +1,7 @@
 #pragma once
 /// @file run_recorder.h
 /// @brief The recorder behind the `logging` process (LCM-free): writes what the estimator and the
-/// calibrator publish into the files of DESIGN §6 and keeps a summary of the run.
+/// calibrator publish into the files of docs/formats.md and keeps a summary of the run.
 ///
 /// Files in the output folder:
 ///  - estimate.csv    every POSE (common/estimate_io.h)

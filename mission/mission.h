@@ -1,6 +1,6 @@
 #pragma once
 /// @file mission.h
-/// @brief A mission script (DESIGN §8): timed steps that drive the calibrator and the estimator.
+/// @brief A mission script (docs/formats.md, mission file): timed steps that drive the calibrator and the estimator.
 /// @code
 /// # times are the dataset's seconds relative to its first sample
 /// collect_at_start: true        # optional (default true): a Collect for all anchors at the first sample

@@ -1,6 +1,6 @@
 #pragma once
 /// @file mission_node.h
-/// @brief The `mission` node (DESIGN §3), free of LCM: runs a `Mission` in data time.
+/// @brief The `mission` node (docs/channels.md), free of LCM: runs a `Mission` in data time.
 /// Subscribes POSE (or any data time, `onTime`), CALIB_STATUS and ESTIMATOR_STATUS; publishes
 /// CALIB_CMD, ESTIMATOR_CMD and MISSION_STATUS through sinks. The same class runs behind LCM
 /// (mission/process/) and in the in-process pipeline.

@@ -1,6 +1,6 @@
 #pragma once
 /// @file pipeline.h
-/// @brief The whole system in one process (DESIGN §2, §8 `meshnav run`): the estimator, the
+/// @brief The whole system in one process (`meshnav run`, docs/architecture.md): the estimator, the
 /// calibrator and the mission sequencer node classes wired as the processes are over LCM
 /// (RANGE → estimator and calibrator, POSE/ANCHORS → calibrator and mission, CALIB_CMD,
 /// ANCHOR_INIT, ESTIMATOR_CMD, CALIB_STATUS), but deterministic: every message a node emits is

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# lcm-spy with meshnav's message types (decodes every channel of DESIGN §3 live).
+# lcm-spy with meshnav's message types (decodes every channel of docs/channels.md live).
 # Debian's lcm-spy script passes -Xincgc, which Java >= 9 rejects; this starts the same class
 # without it, with jchart2d (Debian package libjchart2d-java) and meshnav_lcmtypes.jar.
 #

@@ -4,7 +4,7 @@
 ///
 /// Kinds (hall box [min, max], height H; anchors mounted 0.1 m off a wall, 0.3 m from corners,
 /// floor and ceiling unless said otherwise):
-///  - paper:    the paper's nine anchors (DESIGN §7) mapped affinely from the paper's hall into this
+///  - paper:    the paper's nine anchors (docs/scenarios.md) mapped affinely from the paper's hall into this
 ///              one; known = the first N of 101, 102, 103, 104, 106, …, unknown = the next M;
 ///  - walls:    every anchor on a wall, the walls taken in turn from a seeded first one, random
 ///              position along the wall and random height;

@@ -11,7 +11,7 @@ struct Hall {
   Eigen::Vector3d min_m{-2.5, -4.2, 0.0};  ///< lower corner [m] (the paper's hall by default)
   Eigen::Vector3d max_m{3.0, 4.2, 8.2};    ///< upper corner [m]
 
-  /// The paper's hall (DESIGN §7).
+  /// The paper's hall (docs/scenarios.md).
   static Hall paper() { return Hall{}; }
   /// A hall of the given size [m], centred on x = y = 0, floor at z = 0.
   static Hall ofSize(const Eigen::Vector3d& size_m) {

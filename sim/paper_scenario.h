@@ -1,6 +1,6 @@
 #pragma once
 /// @file paper_scenario.h
-/// @brief Fixed geometry of the paper's flight hall (DESIGN §7): UWB tags on the UAV, anchors on
+/// @brief Fixed geometry of the paper's flight hall (docs/scenarios.md): UWB tags on the UAV, anchors on
 /// the walls, IMU/baro ids, the baro lever arm and the hall's extent.
 
 #include <Eigen/Core>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file scenario_simulator.h
-/// @brief Simulates one sequence (DESIGN §7 by default, or a generated scenario): analytic motion,
+/// @brief Simulates one sequence (the paper's scenario by default, or a generated one; docs/scenarios.md): analytic motion,
 /// IMU, barometer (flights only), meshed-TDMA UWB ranges over every tag and anchor, flight state
 /// (motions with a landed phase only), ground truth, setup.yaml and truth.yaml.
 

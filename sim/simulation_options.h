@@ -36,7 +36,7 @@ struct SimulationOptions {
   UwbHardwareOptions hardware;
   /// Spiral flight shape; nullopt: `TrajectoryOptions::randomized(seed, duration_scale)`.
   std::optional<TrajectoryOptions> trajectory;
-  // Scenario generator (defaults: the paper's scenario, DESIGN §7).
+  // Scenario generator (defaults: the paper's scenario, docs/scenarios.md).
   TrajectoryKind trajectory_kind = TrajectoryKind::Spiral;  ///< --trajectory
   std::optional<Eigen::Vector3d> hall_size_m;   ///< --hall X,Y,Z [m]; nullopt: the paper's hall
   AnchorLayoutKind anchor_layout = AnchorLayoutKind::Paper;  ///< --anchor-layout

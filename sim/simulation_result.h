@@ -21,7 +21,7 @@ struct SimulationStats {
 };
 
 struct SimulationResult {
-  Dataset dataset;                     ///< files of DESIGN §6 (setup.yaml, truth.yaml included)
+  Dataset dataset;                     ///< files of docs/formats.md (setup.yaml, truth.yaml included)
   std::vector<SimulatedRange> ranges;  ///< same order as dataset.ranges, with outlier flags
   std::string trajectory_kind;         ///< "spiral", "walk", ...
   std::string trajectory_description; ///< the motion's parameters (Trajectory::toString)

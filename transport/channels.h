@@ -1,6 +1,6 @@
 #pragma once
 /// @file channels.h
-/// @brief LCM channel names of DESIGN §3 (UPPER_SNAKE). Every process uses these constants; a
+/// @brief LCM channel names (docs/channels.md), UPPER_SNAKE. Every process uses these constants; a
 /// launch file may remap nothing, so the names are the contract between processes.
 
 namespace meshnav::channels {

@@ -1,4 +1,4 @@
-/// meshnav_calibrate: offline anchor calibration (DESIGN §5/§6/§8) on a dataset folder.
+/// meshnav_calibrate: offline anchor calibration (docs/calibration.md) on a dataset folder.
 #include <spdlog/spdlog.h>
 
 #include <Eigen/Cholesky>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file calibrator_node.h
-/// @brief The `calibrator` node (DESIGN §3, §5), free of LCM: consumes RANGE, POSE, ANCHORS and
+/// @brief The `calibrator` node (docs/channels.md, docs/calibration.md), free of LCM: consumes RANGE, POSE, ANCHORS and
 /// CALIB_CMD through `onXxx()` and publishes ANCHOR_INIT and CALIB_STATUS through sink callbacks.
 /// The same class runs behind LCM (calibrator/process/) and in the in-process pipeline.
 ///

@@ -308,7 +308,7 @@ void saveSetup(const SystemSetup& s, const std::string& path) {
     e << YAML::EndMap;
   }
   e << YAML::EndMap;
-  writeText(path, "# meshnav system setup: what the system may know (DESIGN §6)\n", e.c_str());
+  writeText(path, "# meshnav system setup: what the system may know (docs/formats.md)\n", e.c_str());
 }
 
 Truth loadTruth(const std::string& path) {

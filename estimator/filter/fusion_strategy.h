@@ -1,6 +1,6 @@
 #pragma once
 /// @file fusion_strategy.h
-/// @brief The interface behind which the fusion strategies live (DESIGN §4): `centralized` (a
+/// @brief The interface behind which the fusion strategies live (docs/modular_estimator.md): `centralized` (a
 /// plain full-covariance error-state EKF, the reference), `dp` and `dah` over isolated instances
 /// with factorized cross-covariances (ModularFilter, docs/modular_estimator.md). The node (instance handler) only talks to this interface.
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file modular_filter.h
-/// @brief Strategies `dp` and `dah` (DESIGN §4, docs/modular_estimator.md): the nominal state of
+/// @brief Strategies `dp` and `dah` (docs/modular_estimator.md): the nominal state of
 /// every instance (NominalState, addressed by id) plus the isolated instance beliefs with
 /// factorized cross-covariances (FactorizedCovariance).
 ///

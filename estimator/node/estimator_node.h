@@ -1,6 +1,6 @@
 #pragma once
 /// @file estimator_node.h
-/// @brief The estimator node (instance handler, DESIGN §4), free of LCM: consumes IMU, baro,
+/// @brief The estimator node (instance handler, docs/modular_estimator.md), free of LCM: consumes IMU, baro,
 /// range, flight state, ANCHOR_INIT and ESTIMATOR_CMD inputs, publishes POSE, ANCHORS and
 /// ESTIMATOR_STATUS through callbacks.
 ///

@@ -1,6 +1,6 @@
 /// @file meshnav_sim_main.cpp
 /// @brief `meshnav_sim --seed N --out DIR ...`: writes one simulated sequence as a dataset folder
-/// (DESIGN §6): the paper's scenario (DESIGN §7) by default, or a generated scenario
+/// (docs/formats.md): the paper's scenario by default, or a generated scenario
 /// (docs/scenarios.md: trajectory kind, hall, anchor layout, tags, noise, IMU grade, duration).
 
 #include <spdlog/spdlog.h>

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Integration of the full fly-by system over LCM (DESIGN §1, §3, §5): simulate a sequence, run the
+# Integration of the full fly-by system over LCM (docs/channels.md, docs/calibration.md): simulate a sequence, run the
 # launch file config/launch/flyby.yaml through scripts/supervisor.py (estimator, calibrator,
 # mission with config/missions/paper_s2.yaml, logging, imu_bridge and uwb_bridge at 10x), inject
 # malformed messages on CALIB_CMD and CALIB_STATUS once everything runs, wait for the supervisor to

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Integration over LCM (DESIGN §3): simulate a sequence, run estimator + logging + imu_bridge +
+# Integration over LCM (docs/channels.md): simulate a sequence, run estimator + logging + imu_bridge +
 # uwb_bridge as separate processes over udpm (bridges at 10x, waiting for the estimator's
 # heartbeat, in step from a shared t0; malformed messages injected on RANGE and IMU), wait for
 # the bridges to finish and the estimate to reach the end of the data, stop estimator and logger

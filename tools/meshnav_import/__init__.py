@@ -1,1 +1,1 @@
-"""meshnav importers: real recordings into the dataset folder of DESIGN §6 (docs/real_data.md)."""
+"""meshnav importers: real recordings into the dataset folder of docs/formats.md (docs/real_data.md)."""

@@ -9,7 +9,7 @@ from . import miluv_importer, rosbag_importer
 
 def main(argv=None):
     p = argparse.ArgumentParser(prog="meshnav import", description=(
-        "Real recordings into a meshnav dataset folder (DESIGN §6); time stamps stay as recorded. "
+        "Real recordings into a meshnav dataset folder (docs/formats.md); time stamps stay as recorded. "
         "See docs/real_data.md."))
     sub = p.add_subparsers(dest="kind", required=True)
     rosbag_importer.add_arguments(sub.add_parser(

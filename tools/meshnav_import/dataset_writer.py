@@ -1,5 +1,5 @@
 """Helpers shared by every importer: counters of dropped input, progress, and writers of the
-dataset files of DESIGN §6 (imu.csv, ranges.csv, groundtruth.csv, height.csv, setup.yaml,
+dataset files of docs/formats.md (imu.csv, ranges.csv, groundtruth.csv, height.csv, setup.yaml,
 truth.yaml).
 
 Time stamps are passed around as *text* (e.g. "1664959676.989318950") so that the recording's own
@@ -118,7 +118,7 @@ def _vec(v):
 
 
 def write_setup_yaml(path, tags, anchors, imu_id=1, noise=None, comments=()):
-    """setup.yaml (DESIGN §6) without baro and pair_biases: `tags` {id: p_TinI}, `anchors`
+    """setup.yaml (docs/formats.md) without baro and pair_biases: `tags` {id: p_TinI}, `anchors`
     {id: p_AinG}, `noise` {key: value} (only the keys given), `comments` lines at the top."""
     lines = [f"# {c}" for c in comments]
     lines.append(f"imu_id: {int(imu_id)}")

@@ -1,4 +1,4 @@
-"""One robot of a MILUV experiment folder -> meshnav dataset folder (DESIGN §6).
+"""One robot of a MILUV experiment folder -> meshnav dataset folder (docs/formats.md).
 
 Layout read: DIR/anchors.yaml ({id: [x, y, z]}, Vicon world frame), DIR/tags.yaml
 ({robot: {tag id: [x, y, z]}}, body = PX4 IMU frame), DIR/<robot>/imu_px4.csv, uwb_range.csv,

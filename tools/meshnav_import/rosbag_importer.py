@@ -1,4 +1,4 @@
-"""ROS 1 bag (e.g. ISAS-Walk1.bag) -> meshnav dataset folder (DESIGN §6).
+"""ROS 1 bag (e.g. ISAS-Walk1.bag) -> meshnav dataset folder (docs/formats.md).
 
 Reads the bag with Debian's python3-rosbag (the bag embeds its message definitions, so no ROS
 installation and no message packages are needed). Topics are found by message type unless given:

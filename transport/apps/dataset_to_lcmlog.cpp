@@ -1,4 +1,4 @@
-/// dataset_to_lcmlog: writes every measurement of a dataset folder (DESIGN §6) into an LCM log,
+/// dataset_to_lcmlog: writes every measurement of a dataset folder (docs/formats.md) into an LCM log,
 /// time-sorted, with event timestamps = data utime, so that `lcm-logplayer FILE` replays the
 /// sequence into a running system (IMU, BARO, FLIGHT_STATE, RANGE and GROUND_TRUTH).
 #include <lcm/lcm-cpp.hpp>
