@@ -327,6 +327,20 @@ def _arg_text(a):
     return str(a)
 
 
+def _number(d, key, default, where, kind=float, minimum=0):
+    """d[key] (or `default`) as a finite `kind` >= minimum; LaunchError naming `where` and the key."""
+    v = d.get(key, default)
+    try:
+        if isinstance(v, bool):
+            raise ValueError
+        out = kind(v)
+        if not (minimum <= out < float('inf')):
+            raise ValueError
+    except (TypeError, ValueError, OverflowError):
+        raise LaunchError('%s: %s must be a number >= %s, got %r' % (where, key, minimum, v))
+    return out
+
+
 class ProcSpec:
     KEYS = {'name', 'command', 'args', 'required', 'respawn', 'respawn_delay', 'max_respawns',
             'delay', 'env', 'cwd'}
@@ -352,10 +366,13 @@ class ProcSpec:
         self.respawn = bool(d.get('respawn', False))
         if self.required and self.respawn:
             raise LaunchError('%s: %s cannot be both required and respawn' % (where, self.name))
-        self.respawn_delay = float(d.get('respawn_delay', 1.0))
-        self.max_respawns = int(d.get('max_respawns', 10))
-        self.delay = float(d.get('delay', 0.0))
-        self.env = {str(k): '' if v is None else str(v) for k, v in (d.get('env') or {}).items()}
+        self.respawn_delay = _number(d, 'respawn_delay', 1.0, where)
+        self.max_respawns = _number(d, 'max_respawns', 10, where, int, minimum=-1)
+        self.delay = _number(d, 'delay', 0.0, where)
+        env = d.get('env') or {}
+        if not isinstance(env, dict):
+            raise LaunchError('%s: env of %s must be a map NAME: value' % (where, self.name))
+        self.env = {str(k): '' if v is None else str(v) for k, v in env.items()}
         self.cwd = d.get('cwd')
 
 
@@ -368,6 +385,8 @@ class Launch:
                 text = f.read()
         except OSError as e:
             raise LaunchError('%s: %s' % (path, e.strerror))
+        except UnicodeDecodeError as e:
+            raise LaunchError('%s: not UTF-8 text (byte %d)' % (path, e.start))
         doc = load_yaml_subset(text, path)
         if not isinstance(doc, dict):
             raise LaunchError('%s: expected a map with processes:' % path)
@@ -376,17 +395,13 @@ class Launch:
             raise LaunchError('%s: unknown key(s) %s' % (path, ', '.join(sorted(unknown))))
         # Built-in T0_UTIME: a wall time shortly after the launch [us since the Unix epoch], for
         # bridges that replay in step (--t0-utime ${T0_UTIME}); VAR=value or the environment win.
-        margin = doc.get('t0_margin', 3.0)
-        try:
-            margin = float(margin)
-        except (TypeError, ValueError):
-            raise LaunchError('%s: t0_margin must be seconds' % path)
+        margin = _number(doc, 't0_margin', 3.0, path)
         variables = dict(variables)
         variables.setdefault('T0_UTIME', str(int(time.time() * 1e6 + margin * 1e6)))
         doc = substitute(doc, variables, path)
         self.name = str(doc.get('name') or os.path.basename(path))
-        self.stop_timeout = float(doc.get('stop_timeout', 5.0))
-        self.shutdown_delay = float(doc.get('shutdown_delay', 1.0))
+        self.stop_timeout = _number(doc, 'stop_timeout', 5.0, path)
+        self.shutdown_delay = _number(doc, 'shutdown_delay', 1.0, path)
         procs = doc.get('processes')
         if not isinstance(procs, list) or not procs:
             raise LaunchError('%s: processes: must be a non-empty list' % path)

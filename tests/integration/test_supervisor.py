@@ -122,10 +122,27 @@ class Substitution(unittest.TestCase):
                           ('processes:\n  - {name: a, command: x, bogus: 1}\n', 'bogus'),
                           ('processes:\n  - {name: a, command: x}\n  - {name: a, command: y}\n', 'duplicate'),
                           ('shutdown_after: [z]\nprocesses:\n  - {name: a, command: x}\n', "'z'"),
-                          ('processes:\n  - {name: a, command: "${NOPE}"}\n', 'NOPE')]:
+                          ('processes:\n  - {name: a, command: "${NOPE}"}\n', 'NOPE'),
+                          # found by fuzz/launch_yaml_fuzz.py: these raised TypeError/ValueError
+                          ('stop_timeout:\nprocesses:\n  - {name: a, command: x}\n', 'stop_timeout must be a number'),
+                          ('processes:\n  - {name: a, command: x, delay: soon}\n', 'delay must be a number'),
+                          ('processes:\n  - {name: a, command: x, max_respawns: -2}\n', 'max_respawns must be a number >= -1'),
+                          ('processes:\n  - {name: a, command: x, env: [1]}\n', 'env of a must be a map')]:
             rc, out, err = run_launch(text)
             self.assertEqual(rc, 2, text)
             self.assertIn(msg, err, text)
+
+    def test_launch_file_not_utf8(self):
+        # found by fuzz/launch_yaml_fuzz.py: a UnicodeDecodeError traceback before
+        with tempfile.NamedTemporaryFile('wb', suffix='.yaml', delete=False) as f:
+            f.write(b'processes:\n  - {name: a, command: "\xbf\xff"}\n')
+            path = f.name
+        try:
+            p = subprocess.run([sys.executable, SUPERVISOR, path, '--dry-run'], capture_output=True, text=True)
+        finally:
+            os.unlink(path)
+        self.assertEqual(p.returncode, 2, p.stderr)
+        self.assertIn(path + ': not UTF-8 text (byte', p.stderr)
 
 
 class Supervision(unittest.TestCase):
