@@ -26,7 +26,7 @@ while [[ $# -gt 0 ]]; do
     --jobs) JOBS="$2"; shift 2 ;;
     --keep-going) keep_going=1; shift ;;
     --list) tr ' ' '\n' <<<"$all_targets"; exit 0 ;;
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     -*) echo "fuzz: unknown option $1" >&2; exit 2 ;;
     *) [[ " $all_targets " == *" $1 "* ]] || { echo "fuzz: unknown target $1 (one of: $all_targets)" >&2; exit 2; }
        targets+=("$1"); shift ;;
