@@ -1,5 +1,7 @@
 #include "common/estimate_io.h"
 
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -107,6 +109,11 @@ std::vector<AnchorEstimate> readAnchorsCsv(const std::string& path, Diagnostics&
         auto P = upper(r, kP);
         if (!t || !id || !x || !y || !z || !P) {
           diag.report(key + ":bad_value", r.where() + ": a value is missing or not finite; row skipped");
+          return;
+        }
+        // a cast of anything but a whole number in [0, INT32_MAX] to SensorId is undefined
+        if (*id != std::floor(*id) || *id < 0 || *id > INT32_MAX) {
+          diag.report(key + ":bad_id", r.where() + ": id '" + r.text("id") + "' is not a device id; row skipped");
           return;
         }
         out.push_back({Timestamp::fromSec(*t), static_cast<SensorId>(*id), {*x, *y, *z}, *P});
