@@ -35,6 +35,7 @@ respawns) without stopping the others. Exit code: 0 when every required process 
 shutdown_after process exited with 0 (or was stopped cleanly by the supervisor), else 1; 2 for a
 bad launch file or arguments.
 """
+import math
 import os
 import re
 import shlex
@@ -148,7 +149,10 @@ class ProcSpec:
                                          minimum=self.respawn_delay)
         self.max_respawns = int(_number(d, 'max_respawns', 10, where, minimum=-1, integer=True))
         self.delay = _number(d, 'delay', 0.0, where, minimum=0.0)
-        self.env = {str(k): '' if v is None else str(v) for k, v in (d.get('env') or {}).items()}
+        env = d.get('env') or {}
+        if not isinstance(env, dict):
+            raise LaunchError('%s: env must be a map NAME: value' % where)
+        self.env = {str(k): '' if v is None else str(v) for k, v in env.items()}
         self.cwd = d.get('cwd')
 
     def restarts_after(self, code):
@@ -170,7 +174,7 @@ def _flag(d, key, where):
 def _number(d, key, default, where, minimum, integer=False):
     v = d.get(key, default)
     ok = isinstance(v, int) if integer else isinstance(v, (int, float))
-    if isinstance(v, bool) or not ok or v < minimum:
+    if isinstance(v, bool) or not ok or not math.isfinite(v) or v < minimum:
         raise LaunchError('%s: %s must be %s >= %s, got %r' % (where, key, 'an integer' if integer else 'a number',
                                                                minimum, v))
     return v
@@ -185,6 +189,8 @@ class Launch:
                 text = f.read()
         except OSError as e:
             raise LaunchError('%s: %s' % (path, e.strerror))
+        except UnicodeDecodeError as e:
+            raise LaunchError('%s: not UTF-8 text (byte %d)' % (path, e.start))
         doc = load_yaml(text, path)
         if not isinstance(doc, dict):
             raise LaunchError('%s: expected a map with processes:' % path)
@@ -193,17 +199,13 @@ class Launch:
             raise LaunchError('%s: unknown key(s) %s' % (path, ', '.join(sorted(unknown))))
         # Built-in T0_UTIME: a wall time shortly after the launch [us since the Unix epoch], for
         # bridges that replay in step (--t0-utime ${T0_UTIME}); VAR=value or the environment win.
-        margin = doc.get('t0_margin', 3.0)
-        try:
-            margin = float(margin)
-        except (TypeError, ValueError):
-            raise LaunchError('%s: t0_margin must be seconds' % path)
+        margin = _number(doc, 't0_margin', 3.0, path, minimum=0.0)
         variables = dict(variables)
         variables.setdefault('T0_UTIME', str(int(time.time() * 1e6 + margin * 1e6)))
         doc = substitute(doc, variables, path)
         self.name = str(doc.get('name') or os.path.basename(path))
-        self.stop_timeout = float(doc.get('stop_timeout', 5.0))
-        self.shutdown_delay = float(doc.get('shutdown_delay', 1.0))
+        self.stop_timeout = _number(doc, 'stop_timeout', 5.0, path, minimum=0.0)
+        self.shutdown_delay = _number(doc, 'shutdown_delay', 1.0, path, minimum=0.0)
         procs = doc.get('processes')
         if not isinstance(procs, list) or not procs:
             raise LaunchError('%s: processes: must be a non-empty list' % path)

@@ -43,8 +43,11 @@ class SerialLineParser {
   int64_t linesSeen() const { return line_; }
   int64_t rangesParsed() const { return n_ranges_; }
   int64_t malformed() const { return n_malformed_; }
-  /// Lines lost according to the sequence numbers (gaps between consecutive seq) [-].
+  /// Lines lost according to the sequence numbers (gaps between consecutive seq) [-]. A forward
+  /// jump of more than kMaxSeqGap lines is a corrupted or reset counter: reported as
+  /// "serial:seq_jump", not counted here.
   int64_t seqGaps() const { return n_gap_; }
+  static constexpr int64_t kMaxSeqGap = 65535;
 
  private:
   Result fail(const std::string& kind, const std::string& reason);

@@ -2,6 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -32,8 +34,20 @@ std::vector<double> numbers(const YAML::Node& n, const std::string& path, const 
     } catch (const std::exception&) {
       fail(path, "key '" + key + "' holds a non-number");
     }
+    if (!std::isfinite(v.back())) fail(path, "key '" + key + "' holds a value that is not finite (" + x.Scalar() + ")");
   }
   return v;
+}
+
+/// Device ids: whole numbers in [0, INT32_MAX] (a cast of anything else to SensorId is undefined).
+std::vector<SensorId> ids(const YAML::Node& n, const std::string& path, const std::string& key) {
+  std::vector<SensorId> out;
+  for (double x : numbers(n, path, key, 0)) {
+    if (x != std::floor(x) || x < 0 || x > INT32_MAX)
+      fail(path, "key '" + key + "' holds '" + std::to_string(x) + "', not a device id");
+    out.push_back(static_cast<SensorId>(x));
+  }
+  return out;
 }
 
 }  // namespace
@@ -118,8 +132,8 @@ std::vector<AnchorInit> readAnchorInitsYaml(const std::string& path) {
     const auto c = numbers(n["p_AinG_cov"], path, pre + "p_AinG_cov", 9);
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) a.cov_p_m2(i, j) = c[static_cast<size_t>(3 * i + j)];
-    const auto ids = numbers(n["ref_ids"], path, pre + "ref_ids", 0);
-    const size_t m = ids.size();
+    const auto refs = ids(n["ref_ids"], path, pre + "ref_ids");
+    const size_t m = refs.size();
     const auto g = numbers(n["const_biases"], path, pre + "const_biases", m);
     const auto b = numbers(n["dist_biases"], path, pre + "dist_biases", m);
     const auto sg = numbers(n["sigma_const_biases"], path, pre + "sigma_const_biases", m);
@@ -127,7 +141,7 @@ std::vector<AnchorInit> readAnchorInitsYaml(const std::string& path) {
     const auto sr = n["sigma_ranges"] ? numbers(n["sigma_ranges"], path, pre + "sigma_ranges", m) : std::vector<double>(m, 0.1);
     for (size_t i = 0; i < m; ++i) {
       PairBias pbias;
-      pbias.a = static_cast<SensorId>(ids[i]);
+      pbias.a = refs[i];
       pbias.b = a.id;
       pbias.gamma_m = g[i];
       pbias.beta = b[i];

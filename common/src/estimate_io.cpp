@@ -1,5 +1,8 @@
 #include "common/estimate_io.h"
 
+#include <climits>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -110,6 +113,11 @@ std::vector<AnchorEstimate> readAnchorsCsv(const std::string& path, Diagnostics&
         auto P = upper(r, kP);
         if (!id || !x || !y || !z || !P) {
           diag.report(key + ":bad_value", r.where() + ": a value is missing or not finite; row skipped");
+          return;
+        }
+        // a cast of anything but a whole number in [0, INT32_MAX] to SensorId is undefined
+        if (*id != std::floor(*id) || *id < 0 || *id > INT32_MAX) {
+          diag.report(key + ":bad_id", r.where() + ": id '" + r.text("id") + "' is not a device id; row skipped");
           return;
         }
         out.push_back({*t, static_cast<SensorId>(*id), {*x, *y, *z}, *P});

@@ -43,12 +43,19 @@ std::string at(const std::string& source, const YAML::Node& n) {
   throw std::runtime_error(where + ": key '" + key + "' " + what);
 }
 
+/// Text of a map key; a key that is not a plain scalar (a list, a map, null) is refused with its
+/// file and line (yaml-cpp's own "bad conversion" names neither).
+std::string keyText(const YAML::Node& k, const std::string& source, const std::string& in) {
+  if (!k.IsScalar()) throw std::runtime_error(at(source, k) + ": a key of " + in + " is not a plain name");
+  return k.Scalar();
+}
+
 MissionStep parseStep(const YAML::Node& n, size_t i, const std::string& source) {
   const std::string key = "steps[" + std::to_string(i) + "]";
   const std::string where = at(source, n);
   if (!n.IsMap()) fail(where, key, "must be a map {t: seconds, action: name, anchors: [ids]}");
   for (const auto& kv : n) {
-    const auto k = kv.first.as<std::string>();
+    const auto k = keyText(kv.first, source, key);
     if (k != "t" && k != "action" && k != "anchors")
       throw std::runtime_error(at(source, kv.first) + ": unknown key '" + key + "." + k + "' (expected t, action, anchors)");
   }
@@ -105,7 +112,7 @@ Mission parseRoot(const YAML::Node& root, const std::string& source) {
   m.source = source;
   if (!root.IsMap()) throw std::runtime_error(source + ": expected a map with the key 'steps'");
   for (const auto& kv : root) {
-    const auto k = kv.first.as<std::string>();
+    const auto k = keyText(kv.first, source, "the mission");
     if (k != "steps" && k != "collect_at_start")
       throw std::runtime_error(at(source, kv.first) + ": unknown key '" + k + "' (expected steps, collect_at_start)");
   }

@@ -131,10 +131,27 @@ class Substitution(unittest.TestCase):
                           ('processes:\n  - {name: a, command: x, respawn: sometimes}\n', 'respawn must be'),
                           ('processes:\n  - {name: a, command: x, max_respawns: 1.5}\n', 'max_respawns'),
                           ('processes:\n  - {name: a, command: x, respawn_delay: -1}\n', 'respawn_delay'),
-                          ('processes:\n  - {name: a, command: x, required: maybe}\n', 'required')]:
+                          ('processes:\n  - {name: a, command: x, required: maybe}\n', 'required'),
+                          # found by fuzz/launch_yaml_fuzz.py: these raised TypeError/ValueError
+                          ('stop_timeout:\nprocesses:\n  - {name: a, command: x}\n', 'stop_timeout must be a number'),
+                          ('processes:\n  - {name: a, command: x, delay: soon}\n', 'delay must be a number'),
+                          ('processes:\n  - {name: a, command: x, max_respawns: -2}\n', 'max_respawns must be an integer >= -1'),
+                          ('processes:\n  - {name: a, command: x, env: [1]}\n', 'env must be a map')]:
             rc, out, err = run_launch(text)
             self.assertEqual(rc, 2, text)
             self.assertIn(msg, err, text)
+
+    def test_launch_file_not_utf8(self):
+        # found by fuzz/launch_yaml_fuzz.py: a UnicodeDecodeError traceback before
+        with tempfile.NamedTemporaryFile('wb', suffix='.yaml', delete=False) as f:
+            f.write(b'processes:\n  - {name: a, command: "\xbf\xff"}\n')
+            path = f.name
+        try:
+            p = subprocess.run([sys.executable, SUPERVISOR, path, '--dry-run'], capture_output=True, text=True)
+        finally:
+            os.unlink(path)
+        self.assertEqual(p.returncode, 2, p.stderr)
+        self.assertIn(path + ': not UTF-8 text (byte', p.stderr)
 
 
 class Supervision(unittest.TestCase):

@@ -54,6 +54,14 @@ void requireWithin(double v, double lo, double hi, const char* what) {
                          ", " + std::to_string(hi) + "]");
 }
 
+/// A string field as received. LCM's encoder writes a string up to its first NUL but sizes the
+/// message by the whole string, so a string holding a NUL would not convert back (the message
+/// published would end in garbage): refused.
+const std::string& text(const std::string& s, const char* what) {
+  if (s.find('\0') != std::string::npos) throw InvalidMessage(std::string("NUL byte inside the text of ") + what);
+  return s;
+}
+
 UwbType uwbTypeFromCode(int8_t code, const char* what) {
   if (code == range_t::TYPE_TAG) return UwbType::Tag;
   if (code == range_t::TYPE_ANCHOR) return UwbType::Anchor;
@@ -78,7 +86,7 @@ std::vector<counter_t> countersToLcm(const std::map<std::string, int64_t>& m) {
 }
 std::map<std::string, int64_t> countersFromLcm(const std::vector<counter_t>& v) {
   std::map<std::string, int64_t> m;
-  for (const auto& c : v) m[c.name] = c.value;
+  for (const auto& c : v) m[text(c.name, "a counter name")] = c.value;
   return m;
 }
 
@@ -350,19 +358,19 @@ EstimatorStatus fromLcm(const estimator_status_t& m) {
   s.t = Timestamp::fromUtime(m.utime);
   s.wall_utime = m.wall_utime;
   s.initialized = m.initialized;
-  s.strategy = m.strategy;
+  s.strategy = text(m.strategy, "strategy");
   for (const auto& in : m.instances) {
     InstanceStatus o;
     o.id = in.id;
-    o.type = in.type;
+    o.type = text(in.type, "an instance type");
     o.n_updates = in.num_updates;
     o.n_rejected = in.num_rejected;
     s.instances.push_back(o);
   }
   s.counters = countersFromLcm(m.counters);
-  for (const auto& t : m.timings) s.mean_step_us[t.name] = t.mean_us;
-  s.health = m.health;
-  s.health_reason = m.health_reason;
+  for (const auto& t : m.timings) s.mean_step_us[text(t.name, "a timing name")] = t.mean_us;
+  s.health = text(m.health, "health");
+  s.health_reason = text(m.health_reason, "health_reason");
   s.sigma_p_max_m = m.sigma_p_max_m;
   s.weak_axis_G = Eigen::Vector3d(m.weak_axis_G[0], m.weak_axis_G[1], m.weak_axis_G[2]);
   s.sigma_yaw_deg = m.sigma_yaw_deg;
@@ -448,10 +456,10 @@ CalibStatus fromLcm(const calib_status_t& m) {
   for (const auto& a : m.anchors) {
     CalibAnchorStatus o;
     o.id = a.id;
-    o.state = a.state;
+    o.state = text(a.state, "an anchor state");
     o.n_ranges = a.num_ranges;
     o.n_refs = a.num_refs;
-    o.reason = a.reason;
+    o.reason = text(a.reason, "an anchor reason");
     s.anchors.push_back(o);
   }
   s.counters = countersFromLcm(m.counters);
@@ -473,7 +481,7 @@ MissionStatus fromLcm(const mission_status_t& m) {
   s.wall_utime = m.wall_utime;
   s.step_index = m.step_index;
   s.n_steps = m.num_steps;
-  s.text = m.text;
+  s.text = text(m.text, "text");
   return s;
 }
 

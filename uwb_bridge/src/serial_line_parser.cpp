@@ -76,9 +76,18 @@ SerialLineParser::Result SerialLineParser::parse(const std::string& raw, Timesta
   if (!seq) return fail("malformed", "sequence number '" + fields[0] + "' is not a non-negative integer");
   // Gaps in the sequence numbers are lines lost on the way (a line that arrived but is invalid
   // is counted as malformed, not lost).
-  if (last_seq_ && *seq > *last_seq_ + 1) {
-    n_gap_ += *seq - *last_seq_ - 1;
-    diag_.count("serial:seq_gap", *seq - *last_seq_ - 1);
+  // A jump beyond kMaxSeqGap is a corrupted or reset counter, not lost lines: counted apart, so
+  // that the gap count stays meaningful (and cannot overflow).
+  if (last_seq_ && *seq > *last_seq_ && *seq - *last_seq_ > 1) {
+    const int64_t lost = *seq - *last_seq_ - 1;
+    if (lost <= kMaxSeqGap) {
+      n_gap_ += lost;
+      diag_.count("serial:seq_gap", lost);
+    } else {
+      diag_.report("serial:seq_jump", source_ + ":" + std::to_string(line_) + ": sequence number jumps from " +
+                                          std::to_string(*last_seq_) + " to " + std::to_string(*seq) +
+                                          " (not counted as lost lines)");
+    }
   }
   last_seq_ = *seq;
   const auto id1 = parseNonNegInt(fields[1], INT32_MAX);

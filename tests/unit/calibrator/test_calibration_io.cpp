@@ -69,6 +69,45 @@ TEST(CalibrationIo, MalformedYamlNamesFileAndKey) {
   EXPECT_THROW(readAnchorInitsYaml(tmpFile("missing.yaml")), std::runtime_error);
 }
 
+// Found by fuzz target anchor_init_yaml (UBSan: 1e+20 cast to int): reference ids that are not
+// device ids, and values that are not finite, are refused naming file and key.
+TEST(CalibrationIo, RefIdsAndNonFiniteValuesAreRefused) {
+  const std::string path = tmpFile("bad_ids.yaml");
+  const std::string entry = "anchors:\n  - {id: 109, p_AinG: %P, p_AinG_cov: [1, 0, 0, 0, 1, 0, 0, 0, 1], ref_ids: %R, "
+                            "const_biases: [0], dist_biases: [1], sigma_const_biases: [0], sigma_dist_biases: [0]}\n";
+  const struct {
+    const char* p;
+    const char* refs;
+    const char* key;
+  } cases[] = {{"[1, 2, 3]", "[1e20]", "anchors[0].ref_ids"},
+               {"[1, 2, 3]", "[-1]", "anchors[0].ref_ids"},
+               {"[1, 2, 3]", "[100.5]", "anchors[0].ref_ids"},
+               {"[1, 2, 3]", "[.nan]", "anchors[0].ref_ids"},
+               {"[1, .inf, 3]", "[100]", "anchors[0].p_AinG"}};
+  for (const auto& c : cases) {
+    std::string text = entry;
+    text.replace(text.find("%P"), 2, c.p);
+    text.replace(text.find("%R"), 2, c.refs);
+    std::ofstream(path) << text;
+    try {
+      readAnchorInitsYaml(path);
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path + ": key '" + c.key + "'"), std::string::npos) << e.what();
+    }
+  }
+  std::ofstream(path) << [&] {
+    std::string text = entry;
+    text.replace(text.find("%P"), 2, "[1, 2, 3]");
+    text.replace(text.find("%R"), 2, "[2147483647]");
+    return text;
+  }();
+  const auto inits = readAnchorInitsYaml(path);
+  ASSERT_EQ(inits.size(), 1u);
+  ASSERT_EQ(inits[0].biases.size(), 1u);
+  EXPECT_EQ(inits[0].biases[0].a, 2147483647);
+}
+
 TEST(CalibrationIo, OptionsFromYaml) {
   const std::string path = tmpFile("opts.yaml");
   {

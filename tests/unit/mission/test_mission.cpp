@@ -84,6 +84,10 @@ TEST(Mission, ErrorsNameFileLineAndKey) {
       {"collect_at_start: maybe\nsteps: []", "key 'collect_at_start' must be true or false"},
       {"steps: [ {t: 1, action: calibrate", "m.yaml:1: YAML syntax error"},
       {"- 1\n- 2", "m.yaml: expected a map"},
+      // found by fuzz target mission_yaml: keys that are not plain names threw yaml-cpp's bare
+      // "bad conversion" (no file, no line)
+      {"steps:\n  - {t: 1.5, action: abort,!anchors: []}", "m.yaml:2: a key of steps[0] is not a plain name"},
+      {"[1, 2]: x\nsteps: []", "m.yaml:1: a key of the mission is not a plain name"},
   };
   for (const auto& c : cases) {
     const std::string msg = errorOf(c.text);

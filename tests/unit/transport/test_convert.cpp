@@ -331,3 +331,42 @@ TEST(Convert, InvalidMeasurementsThrow) {
   add.anchor.p_AinG[1] = nan;
   EXPECT_THROW(fromLcm(add), InvalidMessage);
 }
+
+// Found by fuzz target lcm_messages (UBSan: INT32_MIN - 1 in lcm-gen's string decoder; a 2 GB read
+// in practice). lcmtypes/patch_string_decode.cmake makes a string length below 1 malformed.
+TEST(Convert, StringLengthBelowOneDoesNotDecode) {
+  mission_status_t m = toLcm(MissionStatus{Timestamp::fromUtime(5), 6, 0, 2, "step 1"});
+  std::vector<uint8_t> buf(static_cast<size_t>(m.getEncodedSize()));
+  ASSERT_EQ(m.encode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
+  // fingerprint 8, utime 8, wall_utime 8, step_index 4, num_steps 4: the text's length (big endian)
+  const size_t at = 32;
+  ASSERT_EQ(buf[at + 3], 7);  // "step 1" and its NUL
+  for (const uint32_t len : {0x80000000u, 0xffffffffu, 0u}) {
+    for (int k = 0; k < 4; ++k) buf[at + k] = static_cast<uint8_t>(len >> (24 - 8 * k));
+    mission_status_t out;
+    int rc = 0;
+    EXPECT_NO_THROW(rc = out.decode(buf.data(), 0, static_cast<int>(buf.size()))) << std::hex << len;
+    EXPECT_LT(rc, 0) << std::hex << len;
+  }
+}
+
+// Found by fuzz target lcm_messages: a NUL inside a received string converted, but LCM's encoder
+// writes strings up to their first NUL while sizing the message by the whole string, so the
+// status converted back would not encode. Refused as an invalid message instead.
+TEST(Convert, NulInsideReceivedTextIsInvalid) {
+  auto ms = toLcm(MissionStatus{Timestamp::fromUtime(5), 6, 0, 2, "ok"});
+  ms.text = std::string("st\0ep", 5);
+  EXPECT_THROW(fromLcm(ms), InvalidMessage);
+  CalibStatus cs;
+  cs.anchors = {{106, "refused", 3, 1, "reason"}};
+  auto c = toLcm(cs);
+  c.anchors[0].reason = std::string("a\0b", 3);
+  EXPECT_THROW(fromLcm(c), InvalidMessage);
+  EstimatorStatus es;
+  es.counters = {{"gated_range", 1}};
+  auto e = toLcm(es);
+  e.counters[0].name = std::string("x\0", 2);
+  EXPECT_THROW(fromLcm(e), InvalidMessage);
+  e = toLcm(es);
+  EXPECT_NO_THROW(fromLcm(e));
+}

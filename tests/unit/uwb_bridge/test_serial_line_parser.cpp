@@ -135,3 +135,27 @@ TEST(SerialLineParser, SequenceGapsCountLostLines) {
   EXPECT_EQ(p.seqGaps(), 2);
   EXPECT_EQ(diag.get("serial:seq_gap"), 2);
 }
+
+// Found by fuzz target serial_line (UBSan: signed overflow in last_seq + 1): a sequence number of
+// INT64_MAX followed by other lines. A jump beyond kMaxSeqGap is a reset or corrupted counter,
+// reported but not counted as lost lines (the count could overflow otherwise).
+TEST(SerialLineParser, LargestSequenceNumberDoesNotOverflow) {
+  Diagnostics diag;
+  SerialLineParser p(tagZero(), diag);
+  for (const char* l : {"9223372036854775807 0 1 4.0", "23 0 1 4.0", "9223372036854775807 0 1 4.0", "0 0 1 4.0",
+                        "9223372036854775807 0 1 4.0", "9223372036854775807 0 1 4.0"})
+    EXPECT_EQ(p.parse(l, Timestamp{}).outcome, Outcome::Range) << l;
+  EXPECT_EQ(p.seqGaps(), 0);
+  EXPECT_EQ(diag.get("serial:seq_jump"), 2);
+
+  // kMaxSeqGap lost lines are still counted as lost; one more is a jump.
+  Diagnostics diag2;
+  SerialLineParser q(tagZero(), diag2);
+  const int64_t k = SerialLineParser::kMaxSeqGap;
+  q.parse("0 0 1 4.0", Timestamp{});
+  q.parse(std::to_string(k + 1) + " 0 1 4.0", Timestamp{});
+  EXPECT_EQ(q.seqGaps(), k);
+  q.parse(std::to_string(2 * k + 3) + " 0 1 4.0", Timestamp{});
+  EXPECT_EQ(q.seqGaps(), k);
+  EXPECT_EQ(diag2.get("serial:seq_jump"), 1);
+}
