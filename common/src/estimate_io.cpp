@@ -91,7 +91,13 @@ std::vector<PoseEstimate> readEstimateCsv(const std::string& path, Diagnostics& 
         PoseEstimate e;
         e.t = *t;
         e.p_IinG = {*tx, *ty, *tz};
-        e.q_ItoG = Eigen::Quaterniond(*qw, *qx, *qy, *qz).normalized();
+        const Eigen::Quaterniond q(*qw, *qx, *qy, *qz);
+        if (std::abs(q.norm() - 1.0) > 0.1) {  // as groundtruth.csv: a zero quaternion stays zero
+          diag.report(key + ":bad_quaternion", r.where() + ": quaternion norm " + std::to_string(q.norm()) +
+                                                   " is far from 1; row skipped");
+          return;
+        }
+        e.q_ItoG = q.normalized();
         e.cov_p_m2 = *P;
         e.cov_theta_rad2 = *Q;
         out.push_back(e);

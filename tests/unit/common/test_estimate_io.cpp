@@ -22,3 +22,18 @@ TEST(EstimateIo, AnchorIdsThatAreNotDeviceIdsAreSkipped) {
   EXPECT_EQ(a[0].id, 2147483647);
   EXPECT_EQ(diag.get("anchors.csv:bad_id"), 3);
 }
+
+// Found by fuzz target estimate_csv: a zero quaternion came back as a zero "rotation". A quaternion
+// far from unit norm is reported and its row skipped, as in groundtruth.csv.
+TEST(EstimateIo, QuaternionFarFromUnitIsSkipped) {
+  const auto d = test::tempDir("estimate_io_q");
+  const std::string head = "t,tx,ty,tz,qx,qy,qz,qw,pxx,pxy,pxz,pyy,pyz,pzz,qrr,qrp,qry,qpp,qpy,qyy\n";
+  const std::string cov = ",0.01,0,0,0.01,0,0.02,1e-4,0,0,1e-4,0,1e-4\n";
+  const std::string path = test::writeFile(d / "estimate.csv", head + "0.5,1,2,3,0,0,0,0" + cov + "0.6,1,2,3,0,0,0,3" + cov +
+                                                                   "0.7,1,2,3,0,0,0,1.05" + cov);
+  Diagnostics diag;
+  const auto e = readEstimateCsv(path, diag);
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_DOUBLE_EQ(e[0].q_ItoG.norm(), 1.0);
+  EXPECT_EQ(diag.get("estimate.csv:bad_quaternion"), 2);
+}
