@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "common/anchor_init_io.h"
+#include "common/yaml_options.h"
 
 namespace meshnav::estimator {
 
@@ -23,35 +24,22 @@ void emitVec(YAML::Emitter& e, const char* key, const double* v, int n) {
   e << YAML::EndSeq;
 }
 
-std::vector<double> numbers(const YAML::Node& root, const std::string& path, const std::string& key, size_t n) {
-  const YAML::Node v = root[key];
-  if (!v || !v.IsSequence() || v.size() != n)
-    throw std::runtime_error(path + ": key '" + key + "' must be a list of " + std::to_string(n) + " numbers");
+/// A list of `n` finite numbers at `key` (q_ItoG, cov_imu: lengths YamlOptions has no type for).
+std::vector<double> numbers(YamlOptions& y, const std::string& key, size_t n) {
+  const YAML::Node v = y.take(key);
+  if (!v || !v.IsSequence() || v.size() != n) y.fail(key, "must be a list of " + std::to_string(n) + " numbers");
   std::vector<double> out;
   for (const auto& x : v) {
     double d = 0.0;
     try {
       d = x.as<double>();
     } catch (const YAML::Exception&) {
-      throw std::runtime_error(path + ": key '" + key + "' holds a value that is not a number");
+      y.fail(key, "holds '" + yamlText(x) + "', not a number");
     }
-    if (!std::isfinite(d)) throw std::runtime_error(path + ": key '" + key + "' holds a non-finite value");
+    if (!std::isfinite(d)) y.fail(key, "holds a non-finite value");
     out.push_back(d);
   }
   return out;
-}
-
-double number(const YAML::Node& root, const std::string& path, const std::string& key) {
-  const YAML::Node v = root[key];
-  double d = 0.0;
-  try {
-    if (!v) throw YAML::Exception(YAML::Mark::null_mark(), "missing");
-    d = v.as<double>();
-  } catch (const YAML::Exception&) {
-    throw std::runtime_error(path + ": key '" + key + "' must be a number");
-  }
-  if (!std::isfinite(d)) throw std::runtime_error(path + ": key '" + key + "' is not finite");
-  return d;
 }
 
 void writeAtomically(const fs::path& target, const std::string& text) {
@@ -101,50 +89,30 @@ std::optional<EstimatorCheckpoint> readCheckpoint(const std::string& dir) {
   const fs::path state = fs::path(dir) / kStateFile, anchors = fs::path(dir) / kAnchorsFile;
   if (!fs::exists(state)) return std::nullopt;
   const std::string path = state.string();
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& ex) {
-    throw std::runtime_error(path + ": " + ex.what());
-  }
-  if (!root.IsMap()) throw std::runtime_error(path + ": not a map of keys");
-  static const char* kKeys[] = {"t", "p_IinG", "v_IinG", "q_ItoG", "bias_gyro_rad_s", "bias_acc_m_s2",
-                                "cov_imu", "landed", "baro_reference_pa", "baro_bias_m", "baro_bias_var_m2"};
-  for (const auto& kv : root) {
-    const std::string k = kv.first.as<std::string>();
-    if (std::find(std::begin(kKeys), std::end(kKeys), k) == std::end(kKeys))
-      throw std::runtime_error(path + ": unknown key '" + k + "'");
-  }
+  YamlOptions y(YamlOptions::loadFile(path), path);
   EstimatorCheckpoint c;
-  c.t = Timestamp::fromSec(number(root, path, "t"));
-  auto v3 = [&](const char* key) {
-    const auto v = numbers(root, path, key, 3);
-    return Eigen::Vector3d(v[0], v[1], v[2]);
-  };
-  c.imu.p_IinG = v3("p_IinG");
-  c.imu.v_IinG = v3("v_IinG");
-  c.imu.bias_gyro_rad_s = v3("bias_gyro_rad_s");
-  c.imu.bias_acc_m_s2 = v3("bias_acc_m_s2");
-  const auto q = numbers(root, path, "q_ItoG", 4);
+  double t_s = 0.0;
+  y.require("t", t_s);
+  c.t = Timestamp::fromSec(t_s);
+  y.require("p_IinG", c.imu.p_IinG);
+  y.require("v_IinG", c.imu.v_IinG);
+  y.require("bias_gyro_rad_s", c.imu.bias_gyro_rad_s);
+  y.require("bias_acc_m_s2", c.imu.bias_acc_m_s2);
+  const auto q = numbers(y, "q_ItoG", 4);
   c.imu.q_ItoG = Eigen::Quaterniond(q[3], q[0], q[1], q[2]);
-  if (std::abs(c.imu.q_ItoG.norm() - 1.0) > 1e-3) throw std::runtime_error(path + ": key 'q_ItoG' is not a unit quaternion");
+  if (std::abs(c.imu.q_ItoG.norm() - 1.0) > 1e-3) y.fail("q_ItoG", "is not a unit quaternion");
   c.imu.q_ItoG.normalize();
-  const auto cov = numbers(root, path, "cov_imu", ImuErr::kDim * ImuErr::kDim);
+  const auto cov = numbers(y, "cov_imu", ImuErr::kDim * ImuErr::kDim);
   for (int i = 0; i < ImuErr::kDim; ++i)
     for (int j = 0; j < ImuErr::kDim; ++j) c.cov_imu(i, j) = cov[static_cast<size_t>(i * ImuErr::kDim + j)];
   c.cov_imu = 0.5 * (c.cov_imu + c.cov_imu.transpose());
-  if (Eigen::LLT<ImuMatrix>(c.cov_imu).info() != Eigen::Success)
-    throw std::runtime_error(path + ": key 'cov_imu' is not positive definite");
-  try {
-    c.landed = root["landed"].as<bool>();
-  } catch (const YAML::Exception&) {
-    throw std::runtime_error(path + ": key 'landed' must be true or false");
-  }
-  if (root["baro_reference_pa"] && !root["baro_reference_pa"].IsNull())
-    c.baro_reference_pa = number(root, path, "baro_reference_pa");
-  c.baro_bias_m = number(root, path, "baro_bias_m");
-  c.baro_bias_var_m2 = number(root, path, "baro_bias_var_m2");
-  if (c.baro_bias_var_m2 <= 0.0) throw std::runtime_error(path + ": key 'baro_bias_var_m2' must be > 0");
+  if (Eigen::LLT<ImuMatrix>(c.cov_imu).info() != Eigen::Success) y.fail("cov_imu", "is not positive definite");
+  y.require("landed", c.landed);
+  y.read("baro_reference_pa", c.baro_reference_pa);
+  y.require("baro_bias_m", c.baro_bias_m);
+  y.require("baro_bias_var_m2", c.baro_bias_var_m2);
+  if (c.baro_bias_var_m2 <= 0.0) y.fail("baro_bias_var_m2", "must be > 0");
+  y.rejectUnknown();
   if (fs::exists(anchors)) c.anchors = readAnchorInitsYaml(anchors.string());
   return c;
 }
