@@ -53,7 +53,9 @@ struct InitOptions {
   double motion_window_s = 12.0;            ///< in-motion alignment: data window [s]
   double motion_min_span_s = 3.0;          ///< in-motion alignment: shortest window [s]
   int motion_min_ranges = 20;              ///< in-motion alignment: tag–anchor ranges needed [-]
-  double motion_max_sigma_yaw_deg = 25.0;  ///< in-motion alignment: refuse above [deg]
+  /// In-motion alignment: refuse above [deg]. 15° rather than 25°: hover windows aligned at
+  /// σ_yaw 15–24° left the filter heading errors of 25–60° it did not pull back (docs/robustness.md)
+  double motion_max_sigma_yaw_deg = 15.0;
   double motion_max_sigma_p_m = 0.5;       ///< in-motion alignment: refuse above [m]
   double resume_max_age_s = 5.0;           ///< a checkpoint (resumeFrom) older than this is not used [s]
   double resume_max_outage_s = 0.3;        ///< longer outages re-initialize the pose (anchors still kept) [s]

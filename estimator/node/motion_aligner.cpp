@@ -308,11 +308,25 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
   Mat15 info;
   const double best_cost = fit(obs, best, &info);
   const ImuState best_end = endState(best, end, bias_gyro_rad_s);
-  // Every distinct rival (up to 4, by first-pass cost) is refitted on the same inliers: the
-  // first-pass order includes the outliers, so the closest rival need not come first (a mirror
-  // image across coplanar anchors was missed that way).
+  // Distinct rivals are refitted on the same inliers: first the best of those elsewhere (> 0.5 m
+  // away: a mirror image across nearly coplanar anchors), then by first-pass cost, up to 6 in all.
+  // The first-pass order includes the outliers, so the closest rival need not come first, and a
+  // handful of heading variants at the same place must not crowd out the mirror image (a walk
+  // under three anchors was initialized 1.15 m below the truth that way).
+  // Costs are compared in units of the residuals' own scatter: ranges that fit worse than their σ
+  // (unmodelled drift over the window, heavier noise) make a cost difference mean less.
+  const double margin = options_.ambiguity_chi2 * robustVarianceFactor(obs, best);
+  std::vector<size_t> order;
+  for (size_t k = 1; k < cands.size(); ++k)
+    if ((cands[k].end.p_IinG - best_end.p_IinG).norm() > 0.5) {
+      order.push_back(k);
+      break;
+    }
+  for (size_t k = 1; k < cands.size(); ++k)
+    if (order.empty() || order.front() != k) order.push_back(k);
   std::vector<ImuState> checked;
-  for (size_t k = 1; k < cands.size() && checked.size() < 4; ++k) {
+  for (const size_t k : order) {
+    if (checked.size() >= 6) break;
     if (!distinct(cands[k].end, best_end)) continue;
     if (std::any_of(checked.begin(), checked.end(), [&](const ImuState& c) { return !distinct(cands[k].end, c); }))
       continue;
@@ -320,7 +334,7 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
     Unknowns rival = cands[k].x;
     const double c = fit(obs, rival, nullptr);
     const ImuState rival_end = endState(rival, end, bias_gyro_rad_s);
-    if (c - best_cost < options_.ambiguity_chi2 && distinct(rival_end, best_end)) {
+    if (c - best_cost < margin && distinct(rival_end, best_end)) {
       reason_ = "motion alignment: ambiguous (two poses " + std::to_string((rival_end.p_IinG - best_end.p_IinG).norm()) +
                 " m apart fit the ranges within " + std::to_string(c - best_cost) +
                 "): anchor geometry or motion cannot fix the pose yet";
@@ -329,6 +343,17 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
   }
   (void)n_used;
   return finish(obs, best, info, end, bias_gyro_rad_s);
+}
+
+double MotionAligner::robustVarianceFactor(const std::vector<Obs>& obs, const Unknowns& x) const {
+  std::vector<double> abs_e;
+  for (const Obs& o : obs)
+    if (o.use) abs_e.push_back(std::abs(residual(o, x)) / o.r.sigma_m);
+  if (abs_e.size() < 8) return 1.0;
+  auto mid = abs_e.begin() + static_cast<std::ptrdiff_t>(abs_e.size() / 2);
+  std::nth_element(abs_e.begin(), mid, abs_e.end());
+  const double s = 1.4826 * *mid;  // robust σ of the normalized residuals (1 if the stated σ holds)
+  return std::max(1.0, s * s);
 }
 
 std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs, const Unknowns& x,

@@ -15,8 +15,8 @@
 /// Gravity fixes roll and pitch, horizontal accelerations fix yaw, the ranges fix p₀ and v₀.
 /// Gauss–Newton with Huber weights from a grid of yaw starts (and the mirror image of the start
 /// position when the anchors are nearly coplanar); a second local minimum within
-/// `ambiguity_chi2` of the best one makes the window ambiguous (refused). The covariance is
-/// (Jᵀ W J + prior)⁻¹ inflated by `cov_inflation`, carried to the window's end by the numeric
+/// `ambiguity_chi2` × v of the best one makes the window ambiguous (refused), v = max(1,
+/// (1.4826 median|e|)²) the robust variance factor of the normalized residuals. The covariance is (Jᵀ W J + prior)⁻¹ inflated by `cov_inflation`, carried to the window's end by the numeric
 /// Jacobian of the end state. Refused (with a reason) while the geometry or the motion cannot
 /// fix the pose: too few ranges or anchors, σ_yaw or σ_p above their limits, ambiguity.
 
@@ -46,7 +46,10 @@ struct MotionAlignerOptions {
   double min_span_s = 3.0;           ///< shortest window worth a fit [s]
   int min_ranges = 20;               ///< ranges needed in the window
   int min_anchors = 3;               ///< distinct anchors needed in the window
-  double max_sigma_yaw_deg = 25.0;   ///< refuse while yaw is less certain [deg]
+  /// Refuse while yaw is less certain [deg]. The fit's covariance is honest up to here (tested);
+  /// the estimator node asks for less (init.motion_max_sigma_yaw_deg, 15°) because its filter
+  /// does not pull a large heading error back.
+  double max_sigma_yaw_deg = 25.0;
   double max_sigma_p_m = 0.5;        ///< refuse while the position is less certain [m]
   double sigma_bias_acc_m_s2 = 0.2;  ///< prior σ of the accelerometer bias [m/s²]
   double outlier_m = 0.6;            ///< residual beyond max(this, 4σ) is dropped [m]
@@ -112,7 +115,10 @@ class MotionAligner {
     bool use = true;
   };
   std::vector<Obs> buildObservations(const Eigen::Vector3d& bias_gyro, Increments* end) const;
+  /// Levenberg–Marquardt with Huber weights; returns the cost (Huber terms and bias priors).
   double fit(const std::vector<Obs>& obs, Unknowns& x, Eigen::Matrix<double, 15, 15>* info) const;
+  /// max(1, (1.4826 · median|e_i|)²) over the inliers: how much noisier than their σ the ranges fit.
+  double robustVarianceFactor(const std::vector<Obs>& obs, const Unknowns& x) const;
   double residual(const Obs& o, const Unknowns& x) const;
   /// ∂residual/∂[δp₀, δv₀, δθ, δb_a, δb_ω] (analytic; the noise-free unit test converges with it).
   Eigen::Matrix<double, 1, 15> jacobian(const Obs& o, const Unknowns& x) const;

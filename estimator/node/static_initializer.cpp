@@ -1,6 +1,7 @@
 #include "estimator/node/static_initializer.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -168,6 +169,60 @@ std::optional<InitialBelief> StaticInitializer::build(const Eigen::Matrix3d& R_r
   return b;
 }
 
+double StaticInitializer::solveFit(const Eigen::Matrix3d& R_rp, const std::vector<bool>& use, Eigen::Vector3d& p,
+                                   double& yaw, Eigen::Matrix4d* cov) const {
+  double cost = 0.0;
+  for (int it = 0; it < 30; ++it) {
+    Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d g = Eigen::Vector4d::Zero();
+    cost = 0.0;
+    const Eigen::Matrix3d R = rotZ(yaw) * R_rp;
+    for (size_t i = 0; i < ranges_.size(); ++i) {
+      if (!use[i]) continue;
+      const InitRange& r = ranges_[i];
+      const Eigen::Vector3d lever = R * setup_.rel_tag_positions.at(r.tag);
+      const Eigen::Vector3d delta = setup_.abs_anchor_positions.at(r.anchor) - p - lever;
+      const double d = std::max(delta.norm(), 1e-6);
+      const Eigen::Vector3d u = delta / d;
+      const double res = r.d_m - d;
+      Eigen::Vector4d J;  // ∂res/∂[p, yaw]
+      J.head<3>() = u;
+      J(3) = u.dot(Eigen::Vector3d::UnitZ().cross(lever));
+      // Huber (k = 2σ): NLOS outliers must not pick the minimum (a 109° yaw error in hover).
+      const double e = res / r.sigma_m;
+      const double w = huber::weight(e) / (r.sigma_m * r.sigma_m);
+      A += w * J * J.transpose();
+      g += w * J * res;
+      cost += huber::cost(e);
+    }
+    A.diagonal().array() += 1e-9;
+    A(3, 3) += 1.0 / (M_PI * M_PI);  // weak yaw prior: one tag leaves yaw (nearly) unobservable
+    const Eigen::Vector4d step = -A.ldlt().solve(g);
+    p += step.head<3>();
+    yaw = std::remainder(yaw + step(3), 2.0 * M_PI);
+    if (cov) *cov = A.inverse();
+    if (step.norm() < 1e-9) break;
+  }
+  return cost;
+}
+
+double StaticInitializer::robustVarianceFactor(const Eigen::Matrix3d& R_rp, const std::vector<bool>& use,
+                                               const Eigen::Vector3d& p, double yaw) const {
+  std::vector<double> abs_e;
+  const Eigen::Matrix3d R = rotZ(yaw) * R_rp;
+  for (size_t i = 0; i < ranges_.size(); ++i) {
+    if (!use[i]) continue;
+    const InitRange& r = ranges_[i];
+    const double d = (setup_.abs_anchor_positions.at(r.anchor) - p - R * setup_.rel_tag_positions.at(r.tag)).norm();
+    abs_e.push_back(std::abs(r.d_m - d) / r.sigma_m);
+  }
+  if (abs_e.size() < 8) return 1.0;
+  auto mid = abs_e.begin() + static_cast<std::ptrdiff_t>(abs_e.size() / 2);
+  std::nth_element(abs_e.begin(), mid, abs_e.end());
+  const double s = 1.4826 * *mid;  // robust σ of the normalized residuals (1 if the stated σ holds)
+  return std::max(1.0, s * s);
+}
+
 bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p_out, double& yaw_out,
                                         Eigen::Matrix4d& cov_out, double& rms_out, int& n_used) {
   waiting_for_.clear();
@@ -179,41 +234,8 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
   centroid /= static_cast<double>(anchors.size());
 
   std::vector<bool> use(ranges_.size(), true);
-  // Gauss–Newton on [p, yaw]; returns the weighted cost.
   auto solve = [&](Eigen::Vector3d& p, double& yaw, Eigen::Matrix4d* cov) {
-    double cost = 0.0;
-    for (int it = 0; it < 30; ++it) {
-      Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
-      Eigen::Vector4d g = Eigen::Vector4d::Zero();
-      cost = 0.0;
-      const Eigen::Matrix3d R = rotZ(yaw) * R_rp;
-      for (size_t i = 0; i < ranges_.size(); ++i) {
-        if (!use[i]) continue;
-        const InitRange& r = ranges_[i];
-        const Eigen::Vector3d lever = R * setup_.rel_tag_positions.at(r.tag);
-        const Eigen::Vector3d delta = setup_.abs_anchor_positions.at(r.anchor) - p - lever;
-        const double d = std::max(delta.norm(), 1e-6);
-        const Eigen::Vector3d u = delta / d;
-        const double res = r.d_m - d;
-        Eigen::Vector4d J;  // ∂res/∂[p, yaw]
-        J.head<3>() = u;
-        J(3) = u.dot(Eigen::Vector3d::UnitZ().cross(lever));
-        // Huber (k = 2σ): NLOS outliers must not pick the minimum (a 109° yaw error in hover).
-        const double e = res / r.sigma_m;
-        const double w = huber::weight(e) / (r.sigma_m * r.sigma_m);
-        A += w * J * J.transpose();
-        g += w * J * res;
-        cost += huber::cost(e);
-      }
-      A.diagonal().array() += 1e-9;
-      A(3, 3) += 1.0 / (M_PI * M_PI);  // weak yaw prior: one tag leaves yaw (nearly) unobservable
-      const Eigen::Vector4d step = -A.ldlt().solve(g);
-      p += step.head<3>();
-      yaw = std::remainder(yaw + step(3), 2.0 * M_PI);
-      if (cov) *cov = A.inverse();
-      if (step.norm() < 1e-9) break;
-    }
-    return cost;
+    return solveFit(R_rp, use, p, yaw, cov);
   };
 
   double best_cost = std::numeric_limits<double>::infinity();
@@ -271,6 +293,7 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
   }
   if (n_used < 4) return false;
   solve(best_p, best_yaw, &cov_out);
+  cov_out *= robustVarianceFactor(R_rp, use, best_p, best_yaw);  // ranges noisier than their σ
   double sq = 0.0;
   const Eigen::Matrix3d R2 = rotZ(best_yaw) * R_rp;
   for (size_t i = 0; i < ranges_.size(); ++i) {
