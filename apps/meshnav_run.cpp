@@ -137,8 +137,8 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
   Diagnostics diag;
   spdlog::info("reading dataset {}", o.dataset);
   const Dataset ds = readDataset(o.dataset, diag, false);
-  spdlog::info("dataset: {} imu, {} baro, {} ranges, {} flight states{}", ds.imu.size(), ds.baro.size(),
-               ds.ranges.size(), ds.flight_states.size(), diag.total() ? "; dropped/flagged: " + diag.summary() : "");
+  spdlog::info("dataset: {} imu, {} baro, {} ranges, {} flight states, {} heights{}", ds.imu.size(), ds.baro.size(),
+               ds.ranges.size(), ds.flight_states.size(), ds.heights.size(), diag.total() ? "; dropped/flagged: " + diag.summary() : "");
 
   const std::filesystem::path out_dir = o.out;
   std::filesystem::create_directories(out_dir);

@@ -33,6 +33,7 @@ struct NoiseFigures {
 struct SystemSetup {
   SensorId imu_id = 1;
   SensorId baro_id = 2;
+  SensorId height_id = 3;  ///< downward laser rangefinder (height.csv), its bias instance
   std::map<SensorId, Eigen::Vector3d> rel_tag_positions;    ///< p_TinI: tag in IMU frame [m]
   std::map<SensorId, Eigen::Vector3d> abs_anchor_positions; ///< p_AinG: known anchors [m]
   /// Extension: position σ of known-but-uncertain anchors [m] (missing: exactly known).
@@ -40,6 +41,7 @@ struct SystemSetup {
   std::vector<PairBias> pair_biases;  ///< a-priori calibrated pairs (missing pair: γ = 0, β = 1)
   Eigen::Vector3d baro_p_IP = Eigen::Vector3d::Zero();  ///< baro in IMU frame [m]
   std::optional<double> baro_reference_pressure_pa;      ///< null: taken on the ground at start
+  Eigen::Vector3d height_p_IH = Eigen::Vector3d::Zero(); ///< rangefinder in IMU frame [m] (unknown: 0)
   std::optional<InitialPose> initial_pose;
   NoiseFigures noise;
 

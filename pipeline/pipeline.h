@@ -54,7 +54,7 @@ class Pipeline {
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
 
-  /// One sensor sample (IMU, baro, range, flight state) or command, then every message it causes.
+  /// One sensor sample (IMU, baro, range, flight state, height) or command, then every message it causes.
   void onInput(const estimator::EstimatorInput& in);
 
   estimator::EstimatorNode& estimator() { return *estimator_; }

@@ -9,6 +9,7 @@ inline constexpr const char* kImu = "IMU";                          ///< imu_t, 
 inline constexpr const char* kBaro = "BARO";                        ///< baro_t
 inline constexpr const char* kRange = "RANGE";                      ///< range_t, uwb_bridge → estimator, calibrator
 inline constexpr const char* kFlightState = "FLIGHT_STATE";         ///< flight_state_t
+inline constexpr const char* kHeight = "HEIGHT";                    ///< height_t, imu_bridge → estimator
 inline constexpr const char* kGroundTruth = "GROUND_TRUTH";         ///< ground_truth_t (simulator, logs)
 inline constexpr const char* kAnchorInit = "ANCHOR_INIT";           ///< anchor_init_t, calibrator → estimator
 inline constexpr const char* kPose = "POSE";                        ///< pose_t, estimator →
@@ -23,6 +24,6 @@ inline constexpr const char* kMissionStatus = "MISSION_STATUS";     ///< mission
 inline constexpr const char* kAll[] = {kImu,         kBaro,           kRange,           kFlightState,
                                        kGroundTruth, kAnchorInit,     kPose,            kAnchors,
                                        kEstimatorStatus, kEstimatorCmd, kCalibCmd,     kCalibStatus,
-                                       kMissionStatus};
+                                       kMissionStatus, kHeight};
 
 }  // namespace meshnav::channels

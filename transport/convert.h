@@ -20,6 +20,7 @@
 #include "meshnav/anchor_init_t.hpp"
 #include "meshnav/anchors_t.hpp"
 #include "meshnav/baro_t.hpp"
+#include "meshnav/height_t.hpp"
 #include "meshnav/calib_cmd_t.hpp"
 #include "meshnav/calib_status_t.hpp"
 #include "meshnav/estimator_cmd_t.hpp"
@@ -42,6 +43,7 @@ class InvalidMessage : public std::runtime_error {
 
 imu_t toLcm(const ImuSample& s);
 baro_t toLcm(const BaroSample& s);
+height_t toLcm(const HeightSample& s);
 range_t toLcm(const RangeSample& s);
 flight_state_t toLcm(const FlightStateSample& s);
 ground_truth_t toLcm(const PoseSample& s);
@@ -61,6 +63,7 @@ anchors_t toLcm(const std::vector<AnchorEstimate>& anchors);
 
 ImuSample fromLcm(const imu_t& m);
 BaroSample fromLcm(const baro_t& m);
+HeightSample fromLcm(const height_t& m);
 RangeSample fromLcm(const range_t& m);
 FlightStateSample fromLcm(const flight_state_t& m);
 PoseSample fromLcm(const ground_truth_t& m);
@@ -80,6 +83,7 @@ template <class Plain>
 struct LcmTypeOf;
 template <> struct LcmTypeOf<ImuSample> { using type = imu_t; };
 template <> struct LcmTypeOf<BaroSample> { using type = baro_t; };
+template <> struct LcmTypeOf<HeightSample> { using type = height_t; };
 template <> struct LcmTypeOf<RangeSample> { using type = range_t; };
 template <> struct LcmTypeOf<FlightStateSample> { using type = flight_state_t; };
 template <> struct LcmTypeOf<PoseSample> { using type = ground_truth_t; };

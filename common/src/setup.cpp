@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -148,10 +150,11 @@ void writeText(const std::string& path, const std::string& header, const char* b
   out << header << body << "\n";
 }
 
-/// Every id names one device: a collision is an error naming both roles. imu_id and baro_id left
-/// out of the file default to 1 and 2; when a tag or anchor of the file uses that id, the smallest
-/// free id is taken instead (the published toolbox's config.yaml numbers anchors 1, 2, 3).
-void checkIds(SystemSetup& s, const std::string& path, bool imu_given, bool baro_given) {
+/// Every id names one device: a collision is an error naming both roles. imu_id, baro_id and
+/// height_id left out of the file default to 1, 2 and 3; when a tag or anchor of the file uses that
+/// id, the smallest free id is taken instead (the published toolbox's config.yaml numbers anchors
+/// 1, 2, 3).
+void checkIds(SystemSetup& s, const std::string& path, bool imu_given, bool baro_given, bool height_given) {
   auto role = [&](SensorId id) -> std::string {
     if (s.rel_tag_positions.count(id)) return "a tag (rel_tag_positions." + std::to_string(id) + ")";
     if (s.abs_anchor_positions.count(id)) return "an anchor (abs_anchor_positions." + std::to_string(id) + ")";
@@ -159,22 +162,33 @@ void checkIds(SystemSetup& s, const std::string& path, bool imu_given, bool baro
   };
   for (const auto& [id, p] : s.rel_tag_positions)
     if (s.abs_anchor_positions.count(id)) fail(path, "id " + std::to_string(id) + " is both a tag and an anchor");
-  auto freeId = [&](SensorId avoid) {
+  const std::array<std::tuple<const char*, bool, SensorId*>, 3> ids{
+      {{"imu_id", imu_given, &s.imu_id}, {"baro_id", baro_given, &s.baro_id}, {"height_id", height_given, &s.height_id}}};
+  auto freeId = [&](std::initializer_list<SensorId> avoid) {
     SensorId id = 1;
-    while (!role(id).empty() || id == avoid) ++id;
+    while (!role(id).empty() || std::find(avoid.begin(), avoid.end(), id) != avoid.end()) ++id;
     return id;
   };
-  for (auto [key, given, id] : {std::tuple{"imu_id", imu_given, &s.imu_id}, {"baro_id", baro_given, &s.baro_id}}) {
+  for (auto [key, given, id] : ids) {
     if (*id < 0) fail(path, std::string("key '") + key + "' must be an id >= 0, got " + std::to_string(*id));
     const std::string other = role(*id);
-    if (other.empty()) continue;
+    const bool height = id == &s.height_id;
+    // A default height id also makes way for the IMU and the baro (their ids came first).
+    const bool height_clash = height && !given && (*id == s.imu_id || *id == s.baro_id);
+    if (other.empty() && !height_clash) continue;
     if (given) fail(path, std::string("key '") + key + "' = " + std::to_string(*id) + " is also " + other);
-    const SensorId moved = freeId(id == &s.imu_id ? s.baro_id : s.imu_id);
-    spdlog::info("{}: {} not given and its default {} is {}: using {}", path, key, *id, other, moved);
+    const SensorId moved = height                ? freeId({s.imu_id, s.baro_id})
+                           : id == &s.imu_id     ? freeId({s.baro_id})
+                                                 : freeId({s.imu_id});
+    spdlog::info("{}: {} not given and its default {} is {}: using {}", path, key, *id,
+                 other.empty() ? std::string("the IMU's or the baro's") : other, moved);
     *id = moved;
   }
-  if (s.imu_id == s.baro_id)
-    fail(path, "key 'imu_id' and key 'baro_id' are the same id " + std::to_string(s.imu_id));
+  for (size_t i = 0; i < ids.size(); ++i)
+    for (size_t j = i + 1; j < ids.size(); ++j)
+      if (*std::get<2>(ids[i]) == *std::get<2>(ids[j]))
+        fail(path, std::string("key '") + std::get<0>(ids[i]) + "' and key '" + std::get<0>(ids[j]) +
+                       "' are the same id " + std::to_string(*std::get<2>(ids[i])));
 }
 
 }  // namespace
@@ -192,12 +206,13 @@ SystemSetup loadSetup(const std::string& path) {
   // The one rule of common/yaml_options.h: unknown keys and bad values name the file and the key,
   // a missing key keeps its default (docs/configuration.md).
   YamlOptions y(root, path);
-  for (const char* section : {"baro", "initial_pose", "noise"})
+  for (const char* section : {"baro", "height", "initial_pose", "noise"})
     if (root[section] && root[section].IsNull()) y.take(section);  // `key:` with nothing: defaults
   for (const char* ignored : {"tag_topics", "anchor_topics", "pose_topics"}) y.take(ignored);  // toolbox config.yaml
   SystemSetup s;
   y.read("imu_id", s.imu_id);
   y.read("baro_id", s.baro_id);
+  y.read("height_id", s.height_id);
   s.rel_tag_positions = idVecMap(y.take("rel_tag_positions"), path, "rel_tag_positions");
   s.abs_anchor_positions = idVecMap(y.take("abs_anchor_positions"), path, "abs_anchor_positions");
   if (const auto sig = y.take("abs_anchor_sigmas"); sig && !sig.IsNull()) {
@@ -218,6 +233,7 @@ SystemSetup loadSetup(const std::string& path) {
   if (s.baro_reference_pressure_pa &&
       !(*s.baro_reference_pressure_pa >= plausible::kMinPressure_pa && *s.baro_reference_pressure_pa <= plausible::kMaxPressure_pa))
     y.fail("baro.reference_pressure", "must be a plausible pressure in Pa (or null: taken on the ground)");
+  y.read("height.p_IH", s.height_p_IH);
   if (y.has("initial_pose")) {
     InitialPose p;  // p_IinG and yaw_deg have no sensible default: required
     y.require("initial_pose.p_IinG", p.p_IinG);
@@ -243,7 +259,7 @@ SystemSetup loadSetup(const std::string& path) {
                                {"noise.imu_gyro_bias_rw", s.noise.imu_gyro_bias_rw}})
     if (v && !(*v >= 0.0)) y.fail(key, "must be >= 0");
   y.rejectUnknown();
-  checkIds(s, path, y.has("imu_id"), y.has("baro_id"));
+  checkIds(s, path, y.has("imu_id"), y.has("baro_id"), y.has("height_id"));
   return s;
 }
 
@@ -282,6 +298,13 @@ void saveSetup(const SystemSetup& s, const std::string& path) {
   if (s.baro_reference_pressure_pa) e << *s.baro_reference_pressure_pa;
   else e << YAML::Null;
   e << YAML::EndMap;
+  if (s.height_id != SystemSetup{}.height_id || !s.height_p_IH.isZero()) {  // only when not the defaults
+    e << YAML::Key << "height_id" << YAML::Value << s.height_id;
+    e << YAML::Key << "height" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "p_IH" << YAML::Comment("downward rangefinder in the IMU frame [m]") << YAML::Value;
+    emitVec(e, s.height_p_IH);
+    e << YAML::EndMap;
+  }
   if (s.initial_pose) {
     const auto& p = *s.initial_pose;
     e << YAML::Key << "initial_pose" << YAML::Value << YAML::BeginMap;

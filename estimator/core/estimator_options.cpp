@@ -43,6 +43,8 @@ void forEachField(Opt& o, Visitor&& v) {
   v("init.static_max_sigma_yaw_deg", o.init.static_max_sigma_yaw_deg, "static range fit refused above [deg]");
   v("init.ambiguity_chi2", o.init.ambiguity_chi2, "second fit minimum within this cost: ambiguous, refused [-]");
   v("init.motion_window_s", o.init.motion_window_s, "in-motion alignment window [s]");
+  v("init.motion_max_window_s", o.init.motion_max_window_s,
+    "in-motion alignment: longest window when ranges are sparse (count-based) [s]");
   v("init.motion_min_span_s", o.init.motion_min_span_s, "in-motion alignment shortest window [s]");
   v("init.motion_min_ranges", o.init.motion_min_ranges, "in-motion alignment ranges needed [-]");
   v("init.motion_max_sigma_yaw_deg", o.init.motion_max_sigma_yaw_deg, "in-motion alignment refused above [deg]");
@@ -56,6 +58,15 @@ void forEachField(Opt& o, Visitor&& v) {
   v("baro.bias_rw_m_per_sqrt_s", o.baro.bias_rw_m_per_sqrt_s, "height bias random walk [m/sqrt(s)]");
   v("baro.init_bias_sigma_m", o.baro.init_bias_sigma_m, "bias sigma with a given reference pressure [m]");
   v("baro.gate_probability", o.baro.gate_probability, "chi^2 gate, 0 = off [-]");
+  v("height.enabled", o.height.enabled, "downward rangefinder (height.csv)");
+  v("height.sigma_m", o.height.sigma_m, "range noise sigma [m]");
+  v("height.bias_rw_m_per_sqrt_s", o.height.bias_rw_m_per_sqrt_s, "bias random walk [m/sqrt(s)]");
+  v("height.init_bias_sigma_m", o.height.init_bias_sigma_m, "prior sigma of the bias around 0 [m]");
+  v("height.gate_probability", o.height.gate_probability, "chi^2 gate, 0 = off [-]");
+  v("height.min_range_m", o.height.min_range_m, "shorter readings are not used (clamped at the sensor's minimum) [m]");
+  v("height.tilt_correction", o.height.tilt_correction, "h = p_z / cos(tilt) (false: h = p_z)");
+  v("height.max_tilt_deg", o.height.max_tilt_deg, "not used while tilted more [deg]");
+  v("height.align_rate_hz", o.height.align_rate_hz, "rate fed to the in-motion alignment, 0 = not used there [Hz]");
   v("uwb.enabled", o.uwb.enabled, "");
   v("uwb.sigma_range_m", o.uwb.sigma_range_m, "fallback range sigma [m]");
   v("uwb.gate_probability", o.uwb.gate_probability, "chi^2 gate, 0 = off [-]");
@@ -170,6 +181,11 @@ void EstimatorOptions::validate() const {
        "init sigmas > 0");
   need(baro.pressure_sigma_pa > 0 && baro.bias_rw_m_per_sqrt_s >= 0 && baro.init_bias_sigma_m > 0, "baro sigmas");
   need(baro.gate_probability >= 0 && baro.gate_probability < 1, "baro.gate_probability in [0, 1)");
+  need(height.sigma_m > 0 && height.bias_rw_m_per_sqrt_s >= 0 && height.init_bias_sigma_m > 0 &&
+           height.min_range_m >= 0 && height.max_tilt_deg > 0 && height.max_tilt_deg < 90 && height.align_rate_hz >= 0,
+       "height: sigma_m > 0, bias_rw >= 0, init_bias_sigma_m > 0, min_range_m >= 0, max_tilt_deg in (0, 90), align_rate_hz >= 0");
+  need(height.gate_probability >= 0 && height.gate_probability < 1, "height.gate_probability in [0, 1)");
+  need(init.motion_max_window_s >= init.motion_window_s, "init.motion_max_window_s >= init.motion_window_s");
   need(uwb.sigma_range_m > 0 && uwb.max_range_m > 0, "uwb.sigma_range_m > 0, uwb.max_range_m > 0");
   need(uwb.gate_probability >= 0 && uwb.gate_probability < 1, "uwb.gate_probability in [0, 1)");
   need(process_noise.batch >= 5 && process_noise.upper_ratio > 1.0 && process_noise.lower_ratio > 0.0 &&

@@ -51,6 +51,9 @@ struct InitOptions {
   /// the best makes the pose ambiguous (refused) [-]
   double ambiguity_chi2 = 16.0;
   double motion_window_s = 12.0;            ///< in-motion alignment: data window [s]
+  /// In-motion alignment: with fewer than `motion_min_ranges` ranges in `motion_window_s` (sparse
+  /// ranging), the window reaches back until it holds them, at most this far [s]
+  double motion_max_window_s = 40.0;
   double motion_min_span_s = 3.0;          ///< in-motion alignment: shortest window [s]
   int motion_min_ranges = 20;              ///< in-motion alignment: tag–anchor ranges needed [-]
   /// In-motion alignment: refuse above [deg]. 15° rather than 25°: hover windows aligned at
@@ -69,6 +72,25 @@ struct BaroOptions {
   double bias_rw_m_per_sqrt_s = 0.02;    ///< height bias random walk [m/√s]
   double init_bias_sigma_m = 1.0;        ///< bias σ when the reference pressure is given [m]
   double gate_probability = 0.999;       ///< χ² gate (0: no gating) [-]
+};
+
+/// Downward laser rangefinder (height.csv, estimator/height/): range to a flat floor at z = 0 in
+/// G along the body's −z axis, plus a bias state (the sensor's offset from the IMU along z when
+/// setup.yaml gives no `height.p_IH`, and floor unevenness).
+struct HeightOptions {
+  bool enabled = true;
+  double sigma_m = 0.05;                 ///< range noise σ [m]
+  double bias_rw_m_per_sqrt_s = 0.01;    ///< bias random walk [m/√s]
+  double init_bias_sigma_m = 0.3;        ///< prior σ of the bias around 0 [m]
+  double gate_probability = 0.999;       ///< χ² gate (0: no gating) [-]
+  /// Readings below are not used: laser rangefinders clamp at the bottom of their range (MILUV's
+  /// reads 0.29 m while the drone stands on the floor) [m]
+  double min_range_m = 0.3;
+  bool tilt_correction = true;           ///< h = p_z / cos(tilt) (else h = p_z)
+  double max_tilt_deg = 30.0;            ///< not used while the body is tilted more [deg]
+  /// Fed to the in-motion alignment (MotionAligner) as a vertical constraint (removes the mirror
+  /// image across nearly coplanar anchors), thinned to this rate [Hz]; 0: not used there.
+  double align_rate_hz = 5.0;
 };
 
 struct UwbOptions {
@@ -122,6 +144,7 @@ struct EstimatorOptions {
   ImuNoiseOptions imu;
   InitOptions init;
   BaroOptions baro;
+  HeightOptions height;
   UwbOptions uwb;
   ZuptOptions zupt;
   HealthOptions health;

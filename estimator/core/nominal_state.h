@@ -31,6 +31,7 @@ struct NominalState {
   SensorId imu_id = 1;
   ImuState imu;
   std::map<SensorId, double> baro_bias_m;            ///< barometer height bias b_P [m]
+  std::map<SensorId, double> height_bias_m;          ///< downward rangefinder bias b_H [m]
   std::map<SensorId, Eigen::Vector3d> anchor_p_AinG; ///< estimated anchors' positions [m]
   std::map<SensorId, TagBiasState> tag_biases;        ///< estimated tag–anchor biases γ [m]
 
@@ -40,13 +41,15 @@ struct NominalState {
     switch (b.kind) {
       case InstanceKind::Imu: imu.boxplus(dx.template head<ImuErr::kDim>()); break;
       case InstanceKind::Baro: baro_bias_m.at(b.id) += dx(0); break;
+      case InstanceKind::Height: height_bias_m.at(b.id) += dx(0); break;
       case InstanceKind::Anchor: anchor_p_AinG.at(b.id) += dx.template head<3>(); break;
       case InstanceKind::Tag: tag_biases.at(b.id).gamma_m += dx.head(b.dim); break;
     }
   }
-  /// Forgets the nominal values of instance `id` (baro bias, anchor position or tag biases).
+  /// Forgets the nominal values of instance `id` (baro or height bias, anchor position or tag biases).
   void erase(SensorId id) {
     baro_bias_m.erase(id);
+    height_bias_m.erase(id);
     anchor_p_AinG.erase(id);
     tag_biases.erase(id);
   }

@@ -8,8 +8,12 @@
 
 namespace meshnav::estimator {
 
-CentralizedEkf::CentralizedEkf(const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s, bool joseph_form)
-    : propagator_(propagator), baro_bias_rw_(baro_bias_rw_m_per_sqrt_s), joseph_form_(joseph_form) {}
+CentralizedEkf::CentralizedEkf(const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s, bool joseph_form,
+                               double height_bias_rw_m_per_sqrt_s)
+    : propagator_(propagator),
+      baro_bias_rw_(baro_bias_rw_m_per_sqrt_s),
+      height_bias_rw_(height_bias_rw_m_per_sqrt_s),
+      joseph_form_(joseph_form) {}
 
 void CentralizedEkf::reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) {
   x_ = NominalState{};
@@ -34,6 +38,12 @@ void CentralizedEkf::addBaro(SensorId id, double bias_m, double var_m2) {
   if (layout_.find(id)) removeInstance(id);
   x_.baro_bias_m[id] = bias_m;
   appendBlock(id, InstanceKind::Baro, Eigen::MatrixXd::Constant(1, 1, var_m2));
+}
+
+void CentralizedEkf::addHeight(SensorId id, double bias_m, double var_m2) {
+  if (layout_.find(id)) removeInstance(id);
+  x_.height_bias_m[id] = bias_m;
+  appendBlock(id, InstanceKind::Height, Eigen::MatrixXd::Constant(1, 1, var_m2));
 }
 
 void CentralizedEkf::addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) {
@@ -81,7 +91,10 @@ void CentralizedEkf::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vec
   P_.topLeftCorner<kI, kI>() = 0.5 * (Pii + Pii.transpose());
   if (n > kI) P_.bottomLeftCorner(n - kI, kI) = P_.topRightCorner(kI, n - kI).transpose();
   for (const StateBlock& b : layout_.blocks())
-    if (b.kind == InstanceKind::Baro) P_(b.offset, b.offset) += baro_bias_rw_ * baro_bias_rw_ * dt;
+    if (b.kind == InstanceKind::Baro)
+      P_(b.offset, b.offset) += baro_bias_rw_ * baro_bias_rw_ * dt;
+    else if (b.kind == InstanceKind::Height)
+      P_(b.offset, b.offset) += height_bias_rw_ * height_bias_rw_ * dt;
   checkInvariants("propagate");
 }
 

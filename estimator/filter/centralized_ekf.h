@@ -15,13 +15,16 @@ namespace meshnav::estimator {
 
 class CentralizedEkf final : public FusionStrategy {
  public:
-  CentralizedEkf(const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s, bool joseph_form);
+  /// `height_bias_rw_m_per_sqrt_s`: random walk of every height bias instance.
+  CentralizedEkf(const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s, bool joseph_form,
+                 double height_bias_rw_m_per_sqrt_s = 0.0);
 
   std::string name() const override { return "centralized"; }
   std::unique_ptr<FusionStrategy> clone() const override { return std::make_unique<CentralizedEkf>(*this); }
 
   void reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) override;
   void addBaro(SensorId id, double bias_m, double var_m2) override;
+  void addHeight(SensorId id, double bias_m, double var_m2) override;
   void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) override;
   void addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
                     const Eigen::VectorXd& var_m2) override;
@@ -44,6 +47,7 @@ class CentralizedEkf final : public FusionStrategy {
 
   ImuPropagator propagator_;
   double baro_bias_rw_;
+  double height_bias_rw_ = 0.0;
   bool joseph_form_;
   NominalState x_;
   StateLayout layout_;

@@ -31,6 +31,9 @@ class FusionStrategy {
   virtual void reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) = 0;
   /// Adds a barometer bias instance (uncorrelated with the rest).
   virtual void addBaro(SensorId id, double bias_m, double var_m2) = 0;
+  /// Adds a downward rangefinder's bias instance (uncorrelated with the rest; random walk
+  /// `height.bias_rw_m_per_sqrt_s`). Replaces it if present.
+  virtual void addHeight(SensorId id, double bias_m, double var_m2) = 0;
   /// Adds an anchor position instance (uncorrelated with the rest). Replaces it if present.
   virtual void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) = 0;
   /// Adds a tag instance whose constant biases γ(tag, peer) towards exactly known anchors are

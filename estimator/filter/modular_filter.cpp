@@ -5,8 +5,11 @@
 namespace meshnav::estimator {
 
 ModularFilter::ModularFilter(Mode mode, const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s,
-                             bool joseph_form)
-    : propagator_(propagator), baro_bias_rw_(baro_bias_rw_m_per_sqrt_s), cov_(mode, joseph_form) {}
+                             bool joseph_form, double height_bias_rw_m_per_sqrt_s)
+    : propagator_(propagator),
+      baro_bias_rw_(baro_bias_rw_m_per_sqrt_s),
+      height_bias_rw_(height_bias_rw_m_per_sqrt_s),
+      cov_(mode, joseph_form) {}
 
 void ModularFilter::checkAfter(const char* where) const {
 #ifdef MESHNAV_CHECK_INVARIANTS
@@ -29,6 +32,12 @@ void ModularFilter::addBaro(SensorId id, double bias_m, double var_m2) {
   if (cov_.has(id)) removeInstance(id);
   x_.baro_bias_m[id] = bias_m;
   cov_.add(id, InstanceKind::Baro, Eigen::MatrixXd::Constant(1, 1, var_m2), x_.t);
+}
+
+void ModularFilter::addHeight(SensorId id, double bias_m, double var_m2) {
+  if (cov_.has(id)) removeInstance(id);
+  x_.height_bias_m[id] = bias_m;
+  cov_.add(id, InstanceKind::Height, Eigen::MatrixXd::Constant(1, 1, var_m2), x_.t);
 }
 
 void ModularFilter::addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) {
@@ -61,6 +70,9 @@ void ModularFilter::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vect
   if (baro_bias_rw_ > 0.0)
     for (const auto& [id, b] : x_.baro_bias_m)
       cov_.addNoise(id, Eigen::MatrixXd::Constant(1, 1, baro_bias_rw_ * baro_bias_rw_ * dt), t_to);
+  if (height_bias_rw_ > 0.0)
+    for (const auto& [id, b] : x_.height_bias_m)
+      cov_.addNoise(id, Eigen::MatrixXd::Constant(1, 1, height_bias_rw_ * height_bias_rw_ * dt), t_to);
   checkAfter("propagate");
 }
 

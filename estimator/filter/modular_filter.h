@@ -23,13 +23,16 @@ namespace meshnav::estimator {
 class ModularFilter final : public FusionStrategy {
  public:
   using Mode = FactorizedCovariance::Mode;
-  ModularFilter(Mode mode, const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s, bool joseph_form);
+  /// `height_bias_rw_m_per_sqrt_s`: random walk of every height bias instance.
+  ModularFilter(Mode mode, const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s, bool joseph_form,
+                double height_bias_rw_m_per_sqrt_s = 0.0);
 
   std::string name() const override { return cov_.mode() == Mode::DP ? "dp" : "dah"; }
   std::unique_ptr<FusionStrategy> clone() const override { return std::make_unique<ModularFilter>(*this); }
 
   void reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) override;
   void addBaro(SensorId id, double bias_m, double var_m2) override;
+  void addHeight(SensorId id, double bias_m, double var_m2) override;
   void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) override;
   void addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
                     const Eigen::VectorXd& var_m2) override;
@@ -55,6 +58,7 @@ class ModularFilter final : public FusionStrategy {
 
   ImuPropagator propagator_;
   double baro_bias_rw_;
+  double height_bias_rw_ = 0.0;
   NominalState x_;
   FactorizedCovariance cov_;
 };

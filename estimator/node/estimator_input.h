@@ -1,8 +1,8 @@
 #pragma once
 /// @file estimator_input.h
 /// @brief Everything the estimator node consumes, as one variant, and the canonical processing
-/// order: by time, then by kind (flight state, IMU, baro, range, anchor init, command), then by
-/// ids. Out-of-sequence handling re-processes in exactly this order, so the result does not depend
+/// order: by time, then by kind (flight state, IMU, baro, range, anchor init, command, height),
+/// then by ids (height last so that the order among the older kinds stays as it was). Out-of-sequence handling re-processes in exactly this order, so the result does not depend
 /// on arrival order.
 
 #include <cstdint>
@@ -17,7 +17,7 @@
 namespace meshnav::estimator {
 
 using EstimatorInput =
-    std::variant<FlightStateSample, ImuSample, BaroSample, RangeSample, AnchorInit, EstimatorCommand>;
+    std::variant<FlightStateSample, ImuSample, BaroSample, RangeSample, AnchorInit, EstimatorCommand, HeightSample>;
 
 /// Sort key of an input (time, kind = variant index, ids).
 struct InputOrder {

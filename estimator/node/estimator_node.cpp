@@ -24,11 +24,12 @@ std::string where(const char* channel, Timestamp t) { return std::string(channel
 
 std::vector<EstimatorInput> mergeInTimeOrder(const Dataset& ds) {
   std::vector<EstimatorInput> all;
-  all.reserve(ds.imu.size() + ds.baro.size() + ds.ranges.size() + ds.flight_states.size());
+  all.reserve(ds.imu.size() + ds.baro.size() + ds.ranges.size() + ds.flight_states.size() + ds.heights.size());
   for (const auto& s : ds.flight_states) all.emplace_back(s);
   for (const auto& s : ds.imu) all.emplace_back(s);
   for (const auto& s : ds.baro) all.emplace_back(s);
   for (const auto& s : ds.ranges) all.emplace_back(s);
+  for (const auto& s : ds.heights) all.emplace_back(s);
   std::stable_sort(all.begin(), all.end(),
                    [](const EstimatorInput& a, const EstimatorInput& b) { return inputOrder(a) < inputOrder(b); });
   return all;
@@ -61,8 +62,9 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       setup_(setup),
       sinks_(std::move(sinks)),
       baro_model_(setup.baro_p_IP),
+      height_model_(setup.height_p_IH, options_.height.tilt_correction, options_.height.max_tilt_deg * M_PI / 180.0),
       zupt_model_(Eigen::Vector3d(0.0, 0.0, -options.gravity_m_s2)),
-      aligner_(alignerOptions(options_), setup.rel_tag_positions),
+      aligner_(alignerOptions(options_, setup.height_p_IH), setup.rel_tag_positions),
       still_detector_(StillnessOptions{}, options_.imu.acc_noise_density, options_.imu.gyro_noise_density,
                       options_.gravity_m_s2),
       health_(options_.health),
@@ -73,6 +75,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
   skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
   if (options_.baro.gate_probability > 0) baro_gate_ = chi2Quantile(1, options_.baro.gate_probability);
+  if (options_.height.gate_probability > 0) height_gate_ = chi2Quantile(1, options_.height.gate_probability);
   resetAll();
 }
 
@@ -87,6 +90,8 @@ void EstimatorNode::resetAll() {
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);
   cur_.network = std::make_shared<const UwbNetwork>(setup_, options_.uwb.sigma_range_m);
   history_.clear();
+  pending_height_bias_.reset();
+  last_align_height_.reset();
   baro_reference_pa_.reset();
   instance_stats_.clear();
   last_pose_pub_.reset();
@@ -111,6 +116,9 @@ bool EstimatorNode::validate(const EstimatorInput& in) {
     if (!std::isfinite(s->pressure_pa) || s->pressure_pa < plausible::kMinPressure_pa ||
         s->pressure_pa > plausible::kMaxPressure_pa)
       bad = where("BARO", t) + ": non-finite or absurd pressure " + std::to_string(s->pressure_pa);
+  } else if (const auto* s = std::get_if<HeightSample>(&in)) {
+    if (!std::isfinite(s->range_m) || s->range_m < 0.0 || s->range_m > plausible::kMaxHeight_m)
+      bad = where("HEIGHT", t) + ": non-finite or absurd range to the floor " + std::to_string(s->range_m);
   } else if (const auto* s = std::get_if<RangeSample>(&in)) {
     const double z = options_.uwb.use_corrected_range ? s->range_corr_m : s->range_m;
     if (!std::isfinite(z) || z < -0.5 || z > options_.uwb.max_range_m || !std::isfinite(s->R_m2) || s->R_m2 < 0)
@@ -205,6 +213,7 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
         if constexpr (std::is_same_v<T, ImuSample>) processImu(m, first);
         if constexpr (std::is_same_v<T, BaroSample>) processBaro(m, first);
         if constexpr (std::is_same_v<T, RangeSample>) processRange(m, first);
+        if constexpr (std::is_same_v<T, HeightSample>) processHeight(m, first);
         if constexpr (std::is_same_v<T, FlightStateSample>) cur_.landed = m.landed;
         if constexpr (std::is_same_v<T, AnchorInit>) applyAnchorInit(m, first);
         if constexpr (std::is_same_v<T, EstimatorCommand>) applyCommand(m, first);
@@ -280,15 +289,44 @@ void EstimatorNode::processBaro(const BaroSample& s, bool first) {
   z.height_m = atmosphere::heightFromPressure(s.pressure_pa, *baro_reference_pa_);
   z.sigma_m = std::abs(atmosphere::dHeightDPressure(s.pressure_pa, *baro_reference_pa_)) * options_.baro.pressure_sigma_pa;
   const UpdateResult r = cur_.filter->update(baro_model_.linearize(z, cur_.filter->state()), baro_gate_);
-  if (!first) return;
-  InstanceStatus& st = instance_stats_[setup_.baro_id];
-  health_.onUpdate(s.t, "baro", 0, r.accepted, r.nis);
+  if (first) countScalarUpdate(s.t, setup_.baro_id, "baro", r);
+}
+
+void EstimatorNode::countScalarUpdate(Timestamp t, SensorId id, const std::string& type, const UpdateResult& r) {
+  InstanceStatus& st = instance_stats_[id];
+  health_.onUpdate(t, type, 0, r.accepted, r.nis);
   if (r.accepted) {
     ++st.n_updates;
   } else {
     ++st.n_rejected;
-    diag_.count("gated_baro");
+    diag_.count("gated_" + type);
   }
+}
+
+void EstimatorNode::processHeight(const HeightSample& s, bool first) {
+  if (!options_.height.enabled) return;
+  if (s.range_m < options_.height.min_range_m) {
+    event(first, "height_below_min_range");  // clamped at the bottom of the sensor's range
+    return;
+  }
+  if (!height_model_.valid(cur_.filter->state())) {
+    event(first, "height_tilted");
+    return;
+  }
+  if (!cur_.filter->state().height_bias_m.count(setup_.height_id)) {
+    // The floor is at z = 0 of G: the bias is near zero unless the sensor sits far from the IMU.
+    const double b = pending_height_bias_ ? pending_height_bias_->first : 0.0;
+    const double var = pending_height_bias_ ? pending_height_bias_->second : std::pow(options_.height.init_bias_sigma_m, 2);
+    cur_.filter->addHeight(setup_.height_id, b, var);
+    if (first)
+      spdlog::info("estimator: height sensor {} added at t={} with bias {:.3f} m (σ {:.3f} m)", setup_.height_id,
+                   formatSeconds(s.t), b, std::sqrt(var));
+  }
+  propagateTo(s.t);
+  ScopedStepTimer timer(timings_, "height_update");
+  const HeightMeasurement z{s.t, setup_.height_id, s.range_m, options_.height.sigma_m};
+  const UpdateResult r = cur_.filter->update(height_model_.linearize(z, cur_.filter->state()), height_gate_);
+  if (first) countScalarUpdate(s.t, setup_.height_id, "height", r);
 }
 
 void EstimatorNode::processRange(const RangeSample& s, bool first) {

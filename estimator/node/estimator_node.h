@@ -1,7 +1,7 @@
 #pragma once
 /// @file estimator_node.h
 /// @brief The estimator node (instance handler, docs/modular_estimator.md), free of LCM: consumes IMU, baro,
-/// range, flight state, ANCHOR_INIT and ESTIMATOR_CMD inputs, publishes POSE, ANCHORS and
+/// range, flight state, ANCHOR_INIT, ESTIMATOR_CMD and HEIGHT (downward rangefinder) inputs, publishes POSE, ANCHORS and
 /// ESTIMATOR_STATUS through callbacks.
 ///
 /// - Before initialization, inputs feed the `StaticInitializer` (no propagation).
@@ -47,6 +47,7 @@
 #include "common/time_guard.h"
 #include "common/types.h"
 #include "estimator/baro/baro_model.h"
+#include "estimator/height/height_model.h"
 #include "estimator/core/estimator_options.h"
 #include "estimator/filter/fusion_strategy.h"
 #include "estimator/node/checkpoint.h"
@@ -79,6 +80,7 @@ class EstimatorNode {
   void onImu(const ImuSample& s) { onInput(s); }
   void onBaro(const BaroSample& s) { onInput(s); }
   void onRange(const RangeSample& s) { onInput(s); }
+  void onHeight(const HeightSample& s) { onInput(s); }
   void onFlightState(const FlightStateSample& s) { onInput(s); }
   void onAnchorInit(const AnchorInit& a) { onInput(a); }
   void onCommand(const EstimatorCommand& c) { onInput(c); }
@@ -142,6 +144,9 @@ class EstimatorNode {
   void processImu(const ImuSample& s, bool first);
   void processBaro(const BaroSample& s, bool first);
   void processRange(const RangeSample& s, bool first);
+  void processHeight(const HeightSample& s, bool first);
+  /// Instance statistics, health and the "gated_<type>" counter of a scalar update (baro, height).
+  void countScalarUpdate(Timestamp t, SensorId id, const std::string& type, const UpdateResult& r);
   void applyAnchorInit(const AnchorInit& a, bool first);
   void applyCommand(const EstimatorCommand& c, bool first);
   void propagateTo(Timestamp t);
@@ -177,8 +182,12 @@ class EstimatorNode {
   /// Initializes from resume_ at IMU sample `s` when it is fresh enough; true if it did.
   bool tryResume(const ImuSample& s);
   BaroModel baro_model_;
+  HeightModel height_model_;
+  /// The height bias the in-motion alignment estimated (mean, variance), for the height instance.
+  std::optional<std::pair<double, double>> pending_height_bias_;
+  std::optional<Timestamp> last_align_height_;  ///< thinning of heights fed to the aligner
   ZuptModel zupt_model_;
-  double range_gate_ = 0.0, baro_gate_ = 0.0;
+  double range_gate_ = 0.0, baro_gate_ = 0.0, height_gate_ = 0.0;
   /// dah without uwb.dah_fuse_estimated_anchor_pairs: ranges between two estimated anchors are left out.
   bool skip_estimated_anchor_pairs_ = false;
 

@@ -51,6 +51,7 @@ void EstimatorNode::initialize(const InitialBelief& b) {
     filter->addBaro(setup_.baro_id, resume_baro_->baro_bias_m, resume_baro_->baro_bias_var_m2);
   }
   resume_baro_.reset();
+  pending_height_bias_ = b.height_bias;  // the height instance is added at the first usable height
   for (const auto& [id, p] : setup_.abs_anchor_positions) {
     auto sig = setup_.abs_anchor_sigmas_m.find(id);
     if (sig != setup_.abs_anchor_sigmas_m.end())
@@ -91,6 +92,9 @@ void EstimatorNode::initialize(const InitialBelief& b) {
       b.imu.p_IinG.z(), yaw_deg, weakestPositionAxis(b.cov.block<3, 3>(ImuErr::kP, ImuErr::kP)).first,
       sigma_yaw_deg,
       b.from_ranges ? fmt::format(", {} ranges, rms {:.3f} m", b.n_ranges_used, b.range_fit_rms_m) : "");
+  if (b.height_bias)
+    spdlog::info("estimator: the alignment used {} heights: rangefinder bias {:.3f} m (σ {:.3f} m)", b.n_heights_used,
+                 b.height_bias->first, std::sqrt(b.height_bias->second));
   if (!baro_reference_pa_ && options_.baro.enabled)
     spdlog::warn("estimator: no baro reference pressure (none in setup, no landed baro data): baro unused");
   const auto pending = std::move(pending_anchor_inits_);
@@ -122,6 +126,15 @@ void EstimatorNode::feedAligner(const EstimatorInput& in) {
     have_flight_state_ = true;
   } else if (const auto* b = std::get_if<BaroSample>(&in)) {
     last_pressure_pa_ = b->pressure_pa;
+  } else if (const auto* h = std::get_if<HeightSample>(&in)) {
+    // Usable readings only, thinned to height.align_rate_hz (a vertical constraint, not a trajectory).
+    if (!options_.height.enabled || options_.height.align_rate_hz <= 0.0 || h->range_m < options_.height.min_range_m)
+      return;
+    if (last_align_height_ && (h->t - *last_align_height_).sec() < 1.0 / options_.height.align_rate_hz - 1e-6 &&
+        h->t >= *last_align_height_)
+      return;
+    last_align_height_ = h->t;
+    aligner_.addHeight({h->t, h->range_m, options_.height.sigma_m});
   } else if (const auto* r = std::get_if<RangeSample>(&in)) {
     SensorId tag = r->id_initiator, anchor = r->id_responder;
     if (!cur_.network->isTag(tag)) std::swap(tag, anchor);
@@ -171,6 +184,10 @@ InitialBelief EstimatorNode::beliefFromAlignment(const AlignmentResult& r) const
   b.range_fit_rms_m = r.rms_m;
   b.last_imu = r.last_imu;
   b.landed = landedAt(r.t);
+  if (r.n_heights > 0) {
+    b.height_bias = std::make_pair(r.height_bias_m, r.height_bias_var_m2);
+    b.n_heights_used = r.n_heights;
+  }
   const double baro_z = (r.imu.p_IinG + r.imu.q_ItoG * setup_.baro_p_IP).z();
   if (setup_.baro_reference_pressure_pa) {
     b.baro_reference_pa = *setup_.baro_reference_pressure_pa;
@@ -273,6 +290,7 @@ void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp 
   // The baro bias may have absorbed the runaway: keep its mean, widen it to the init σ.
   for (const auto& [id, b] : s.baro_bias_m)
     f->addBaro(id, b, std::max(old.covariance(id, id)(0, 0), std::pow(options_.baro.init_bias_sigma_m, 2)));
+  for (const auto& [id, b] : s.height_bias_m) f->addHeight(id, b, old.covariance(id, id)(0, 0));
   for (const auto& [id, p] : s.anchor_p_AinG) f->addAnchor(id, p, old.covariance(id, id));
   for (const auto& [id, tb] : s.tag_biases)
     f->addTagBiases(id, tb.peers, tb.gamma_m, old.covariance(id, id).diagonal());

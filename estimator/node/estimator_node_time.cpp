@@ -12,7 +12,7 @@ namespace {
 
 /// Input kind as its channel name (counter prefix).
 const char* kindName(const EstimatorInput& in) {
-  static const char* const kNames[] = {"FLIGHT_STATE", "IMU", "BARO", "RANGE", "ANCHOR_INIT", "ESTIMATOR_CMD"};
+  static const char* const kNames[] = {"FLIGHT_STATE", "IMU", "BARO", "RANGE", "ANCHOR_INIT", "ESTIMATOR_CMD", "HEIGHT"};
   static_assert(std::variant_size_v<EstimatorInput> == std::size(kNames));
   return kNames[in.index()];
 }

@@ -14,9 +14,11 @@ namespace meshnav::estimator {
 namespace {
 constexpr double kDeg = M_PI / 180.0;
 constexpr size_t kMaxObservations = 400;
-constexpr int kDim = 15;
-using Vec15 = Eigen::Matrix<double, kDim, 1>;
-using Mat15 = Eigen::Matrix<double, kDim, kDim>;
+constexpr size_t kMaxHeights = 200;
+constexpr int kDim = 16;  ///< [δp₀, δv₀, δθ, δb_a, δb_ω, δb_H]
+constexpr int kBh = 15;   ///< index of δb_H
+using VecU = Eigen::Matrix<double, kDim, 1>;
+using MatU = Eigen::Matrix<double, kDim, kDim>;
 
 Eigen::Matrix3d rotZ(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
 
@@ -43,13 +45,14 @@ MotionAligner::Increments advance(const MotionAligner::Increments& a, const Eige
 
 }  // namespace
 
-MotionAligner::Unknowns MotionAligner::Unknowns::plus(const Vec15& d) const {
+MotionAligner::Unknowns MotionAligner::Unknowns::plus(const VecU& d) const {
   Unknowns x = *this;
   x.p0 += d.segment<3>(0);
   x.v0 += d.segment<3>(3);
   x.R0 = R0 * so3::expMap(d.segment<3>(6));
   x.ba += d.segment<3>(9);
   x.dbg += d.segment<3>(12);
+  x.bh += d(kBh);
   return x;
 }
 
@@ -65,9 +68,34 @@ void MotionAligner::addImu(const ImuSample& s) {
   if (!imu_.empty() && s.t <= imu_.back().t) return;
   if (!imu_.empty() && (s.t - imu_.back().t).sec() > options_.max_imu_gap_s) clear();
   imu_.push_back(s);
-  const Timestamp oldest = s.t - Duration::fromSec(options_.window_s);
+  const Timestamp oldest = s.t - Duration::fromSec(options_.max_window_s);
   while (!imu_.empty() && imu_.front().t < oldest) imu_.pop_front();
   while (!ranges_.empty() && ranges_.front().t < oldest) ranges_.pop_front();
+  while (!heights_.empty() && heights_.front().t < oldest) heights_.pop_front();
+}
+
+void MotionAligner::addHeight(const AlignHeight& h) {
+  auto pos = std::upper_bound(heights_.begin(), heights_.end(), h.t,
+                              [](Timestamp t, const AlignHeight& x) { return t < x.t; });
+  heights_.insert(pos, h);
+}
+
+Timestamp MotionAligner::windowStart() const {
+  if (imu_.empty()) return Timestamp{};
+  const Timestamp end = imu_.back().t;
+  Timestamp start = end - Duration::fromSec(options_.window_s);
+  // Ranges up to the newest IMU sample, newest first: the window must hold `min_ranges` of them.
+  std::vector<Timestamp> times;
+  for (auto r = ranges_.rbegin(); r != ranges_.rend(); ++r)
+    if (r->t <= end) times.push_back(r->t);
+  const size_t need = static_cast<size_t>(std::max(options_.min_ranges, 1));
+  if (times.size() >= need && times[need - 1] >= start) return std::max(start, imu_.front().t);
+  // Sparse: back to the IMU sample at or before the `min_ranges`-th newest range (or all held).
+  const Timestamp oldest = end - Duration::fromSec(options_.max_window_s);
+  const Timestamp want = times.size() >= need ? times[need - 1] : oldest;
+  auto it = std::upper_bound(imu_.begin(), imu_.end(), want, [](Timestamp t, const ImuSample& s) { return t < s.t; });
+  if (it != imu_.begin()) --it;
+  return std::max(it->t, imu_.front().t);
 }
 
 void MotionAligner::addRange(const AlignRange& r) {
@@ -80,24 +108,38 @@ void MotionAligner::addRange(const AlignRange& r) {
 void MotionAligner::clear() {
   imu_.clear();
   ranges_.clear();
+  heights_.clear();
 }
 
-double MotionAligner::spanSeconds() const { return imu_.size() < 2 ? 0.0 : (imu_.back().t - imu_.front().t).sec(); }
+double MotionAligner::spanSeconds() const { return imu_.size() < 2 ? 0.0 : (imu_.back().t - windowStart()).sec(); }
 
-std::vector<MotionAligner::Obs> MotionAligner::buildObservations(const Eigen::Vector3d& bias_gyro,
-                                                                 Increments* end) const {
+std::vector<MotionAligner::Obs> MotionAligner::buildObservations(const Eigen::Vector3d& bias_gyro, Increments* end,
+                                                                 std::vector<HeightObs>* heights) const {
   std::vector<Obs> obs;
+  heights->clear();
   Increments inc;
+  const Timestamp t0 = windowStart();
+  size_t k = 0;
+  while (k + 1 < imu_.size() && imu_[k].t < t0) ++k;
   auto r = ranges_.begin();
-  while (r != ranges_.end() && r->t < imu_.front().t) ++r;
-  for (size_t k = 0; k + 1 < imu_.size(); ++k) {
+  while (r != ranges_.end() && r->t < imu_[k].t) ++r;
+  auto h = heights_.begin();
+  while (h != heights_.end() && h->t < imu_[k].t) ++h;
+  for (; k + 1 < imu_.size(); ++k) {
     const ImuSample &a = imu_[k], &b = imu_[k + 1];
     const Eigen::Vector3d f = 0.5 * (a.acc_m_s2 + b.acc_m_s2);
     const Eigen::Vector3d w = 0.5 * (a.gyro_rad_s + b.gyro_rad_s) - bias_gyro;
     for (; r != ranges_.end() && r->t < b.t; ++r) obs.push_back({*r, advance(inc, f, w, (r->t - a.t).sec()), true});
+    for (; h != heights_.end() && h->t < b.t; ++h) heights->push_back({*h, advance(inc, f, w, (h->t - a.t).sec()), true});
     inc = advance(inc, f, w, (b.t - a.t).sec());
   }
   *end = inc;
+  if (heights->size() > kMaxHeights) {
+    std::vector<HeightObs> thin;
+    const double step = static_cast<double>(heights->size()) / kMaxHeights;
+    for (size_t i = 0; i < kMaxHeights; ++i) thin.push_back((*heights)[static_cast<size_t>(i * step)]);
+    heights->swap(thin);
+  }
   if (obs.size() > kMaxObservations) {  // evenly thinned: the cost of a fit stays bounded
     std::vector<Obs> thin;
     const double step = static_cast<double>(obs.size()) / kMaxObservations;
@@ -115,7 +157,7 @@ double MotionAligner::residual(const Obs& o, const Unknowns& x) const {
   return o.r.d_m - (o.r.p_AinG - p_TinG).norm();
 }
 
-Eigen::Matrix<double, 1, 15> MotionAligner::jacobian(const Obs& o, const Unknowns& x) const {
+Eigen::Matrix<double, 1, 16> MotionAligner::jacobian(const Obs& o, const Unknowns& x) const {
   // r = d − ‖p_A − p_T‖: ∂r/∂p_T = uᵀ with u the unit vector from the tag to the anchor;
   // ∂p_T/∂[p₀, v₀, δθ, b_a, δb_ω] = [I, τ I, −R₀[w]×, −R₀ M, R₀ (J_S − C[p_TinI]× J_C)],
   // w = S − M b_a + C p_TinI (the J_C term to first order around the current δb_ω).
@@ -126,7 +168,8 @@ Eigen::Matrix<double, 1, 15> MotionAligner::jacobian(const Obs& o, const Unknown
   const Eigen::Vector3d p_TinG = x.p0 + x.v0 * tau + 0.5 * g * tau * tau + x.R0 * w;
   const Eigen::Vector3d u = (o.r.p_AinG - p_TinG).normalized();
   const Eigen::Matrix3d C = o.inc.C * so3::expMap(o.inc.JC * x.dbg);
-  Eigen::Matrix<double, 1, 15> J;
+  Eigen::Matrix<double, 1, 16> J;
+  J(kBh) = 0.0;
   J.segment<3>(0) = u.transpose();
   J.segment<3>(3) = tau * u.transpose();
   J.segment<3>(6) = -u.transpose() * x.R0 * so3::skew(w);
@@ -135,38 +178,91 @@ Eigen::Matrix<double, 1, 15> MotionAligner::jacobian(const Obs& o, const Unknown
   return J;
 }
 
-double MotionAligner::fit(const std::vector<Obs>& obs, Unknowns& x, Mat15* info) const {
+double MotionAligner::residual(const HeightObs& o, const Unknowns& x) const {
+  const Eigen::Vector3d g(0.0, 0.0, -options_.gravity_m_s2);
+  const double tau = o.inc.tau_s;
+  const Eigen::Vector3d s = x.p0 + x.v0 * tau + 0.5 * g * tau * tau + x.R0 * bodyTerm(o.inc, x, options_.p_IH);
+  const double c = options_.height_tilt_correction ? (x.R0 * o.inc.C * so3::expMap(o.inc.JC * x.dbg))(2, 2) : 1.0;
+  return o.h.range_m - (s.z() / c + x.bh);
+}
+
+Eigen::Matrix<double, 1, 16> MotionAligner::jacobian(const HeightObs& o, const Unknowns& x) const {
+  // ĥ = s_z / c + b_H with s = p₀ + v₀τ + ½gτ² + R₀ w (w as for a tag, lever p_IH), c = e_zᵀ R₀ C e_z:
+  // ∂s_z = e_zᵀ [I, τ I, −R₀[w]×, −R₀ M, R₀ (J_S − C[p_IH]× J_C)],
+  // ∂c/∂δθ = −e_zᵀ R₀ [C e_z]×, ∂c/∂δb_ω = −e_zᵀ R₀ C [e_z]× J_C; r = h − ĥ, so J = −∂ĥ.
+  const Eigen::Vector3d g(0.0, 0.0, -options_.gravity_m_s2);
+  const double tau = o.inc.tau_s;
+  const Eigen::Vector3d& lever = options_.p_IH;
+  const Eigen::Vector3d w = bodyTerm(o.inc, x, lever);
+  const Eigen::Vector3d s = x.p0 + x.v0 * tau + 0.5 * g * tau * tau + x.R0 * w;
+  const Eigen::Matrix3d C = o.inc.C * so3::expMap(o.inc.JC * x.dbg);
+  const Eigen::RowVector3d ez = Eigen::RowVector3d::UnitZ();
+  Eigen::Matrix<double, 1, 15> ds;
+  ds.segment<3>(0) = ez;
+  ds.segment<3>(3) = tau * ez;
+  ds.segment<3>(6) = -ez * x.R0 * so3::skew(w);
+  ds.segment<3>(9) = -ez * x.R0 * o.inc.M;
+  ds.segment<3>(12) = ez * x.R0 * (o.inc.JS - C * so3::skew(lever) * o.inc.JC);
+  Eigen::Matrix<double, 1, 15> dh = ds;
+  if (options_.height_tilt_correction) {
+    const double c = (x.R0 * C)(2, 2);
+    Eigen::Matrix<double, 1, 15> dc = Eigen::Matrix<double, 1, 15>::Zero();
+    dc.segment<3>(6) = -ez * x.R0 * so3::skew(C * Eigen::Vector3d::UnitZ());
+    dc.segment<3>(12) = -ez * x.R0 * C * so3::skew(Eigen::Vector3d::UnitZ()) * o.inc.JC;
+    dh = ds / c - s.z() / (c * c) * dc;
+  }
+  Eigen::Matrix<double, 1, 16> J;
+  J.head<15>() = -dh;
+  J(kBh) = -1.0;
+  return J;
+}
+
+double MotionAligner::fit(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights, Unknowns& x,
+                          MatU* info) const {
   const double prior_ba = 1.0 / (options_.sigma_bias_acc_m_s2 * options_.sigma_bias_acc_m_s2);
   const double prior_bg = 1.0 / (options_.sigma_bias_gyro_rad_s * options_.sigma_bias_gyro_rad_s);
+  const double prior_bh = 1.0 / (options_.sigma_bias_height_m * options_.sigma_bias_height_m);
   auto cost = [&](const Unknowns& u) {
-    double c = prior_ba * u.ba.squaredNorm() + prior_bg * u.dbg.squaredNorm();
+    double c = prior_ba * u.ba.squaredNorm() + prior_bg * u.dbg.squaredNorm() + prior_bh * u.bh * u.bh;
     for (const Obs& o : obs)
       if (o.use) c += huber::cost(residual(o, u) / o.r.sigma_m);
+    for (const HeightObs& o : heights)
+      if (o.use) c += huber::cost(residual(o, u) / o.h.sigma_m);
     return c;
   };
   double c = cost(x), lambda = 1e-3;
-  Mat15 H;
+  MatU H;
   for (int it = 0; it < 25; ++it) {
     H.setZero();
-    Vec15 g = Vec15::Zero();
+    VecU g = VecU::Zero();
     for (const Obs& o : obs) {
       if (!o.use) continue;
       const double r = residual(o, x);
       const double e = std::abs(r) / o.r.sigma_m;
       const double w = huber::weight(e) / (o.r.sigma_m * o.r.sigma_m);
-      const Eigen::Matrix<double, 1, 15> J = jacobian(o, x);
+      const Eigen::Matrix<double, 1, 16> J = jacobian(o, x);
       H += w * J.transpose() * J;
       g += w * J.transpose() * r;
     }
+    for (const HeightObs& o : heights) {
+      if (!o.use) continue;
+      const double r = residual(o, x);
+      const double w = huber::weight(std::abs(r) / o.h.sigma_m) / (o.h.sigma_m * o.h.sigma_m);
+      const Eigen::Matrix<double, 1, 16> J = jacobian(o, x);
+      H += w * J.transpose() * J;
+      g += w * J.transpose() * r;
+    }
+    H(kBh, kBh) += prior_bh;
+    g(kBh) += prior_bh * x.bh;
     H.block<3, 3>(9, 9).diagonal().array() += prior_ba;
     g.segment<3>(9) += prior_ba * x.ba;
     H.block<3, 3>(12, 12).diagonal().array() += prior_bg;
     g.segment<3>(12) += prior_bg * x.dbg;
     bool improved = false;
     for (int tries = 0; tries < 6 && !improved; ++tries) {
-      Mat15 A = H;
+      MatU A = H;
       A.diagonal() += lambda * H.diagonal().cwiseMax(1e-9);
-      const Vec15 step = -A.ldlt().solve(g);
+      const VecU step = -A.ldlt().solve(g);
       const Unknowns xn = x.plus(step);
       const double cn = cost(xn);
       if (std::isfinite(cn) && cn < c) {
@@ -246,7 +342,9 @@ std::vector<MotionAligner::Unknowns> MotionAligner::starts(const std::vector<Obs
   }
   // Roll and pitch from the mean specific force (gravity dominates over a few seconds).
   Eigen::Vector3d f = Eigen::Vector3d::Zero();
-  for (const ImuSample& s : imu_) f += s.acc_m_s2;
+  const Timestamp t0 = windowStart();
+  for (const ImuSample& s : imu_)
+    if (s.t >= t0) f += s.acc_m_s2;
   const double roll = std::atan2(f.y(), f.z()), pitch = std::atan2(-f.x(), std::hypot(f.y(), f.z()));
   const Eigen::Matrix3d R_rp =
       (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
@@ -269,7 +367,8 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
     return std::nullopt;
   }
   Increments end;
-  std::vector<Obs> obs = buildObservations(bias_gyro_rad_s, &end);
+  std::vector<HeightObs> heights;
+  std::vector<Obs> obs = buildObservations(bias_gyro_rad_s, &end, &heights);
   std::set<SensorId> anchor_ids;
   for (const Obs& o : obs) anchor_ids.insert(o.r.anchor);
   if (static_cast<int>(obs.size()) < options_.min_ranges || static_cast<int>(anchor_ids.size()) < options_.min_anchors) {
@@ -286,7 +385,7 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
   };
   std::vector<Candidate> cands;
   for (Unknowns x : starts(obs)) {
-    const double c = fit(obs, x, nullptr);
+    const double c = fit(obs, heights, x, nullptr);
     if (std::isfinite(c)) cands.push_back({x, c, endState(x, end, bias_gyro_rad_s)});
   }
   if (cands.empty()) {
@@ -305,8 +404,9 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
     o.use = std::abs(residual(o, best)) <= std::max(options_.outlier_m, 4.0 * o.r.sigma_m);
     n_used += o.use;
   }
-  Mat15 info;
-  const double best_cost = fit(obs, best, &info);
+  for (HeightObs& o : heights) o.use = std::abs(residual(o, best)) <= std::max(0.3, 4.0 * o.h.sigma_m);
+  MatU info;
+  const double best_cost = fit(obs, heights, best, &info);
   const ImuState best_end = endState(best, end, bias_gyro_rad_s);
   // Distinct rivals are refitted on the same inliers: first the best of those elsewhere (> 0.5 m
   // away: a mirror image across nearly coplanar anchors), then by first-pass cost, up to 6 in all.
@@ -332,7 +432,7 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
       continue;
     checked.push_back(cands[k].end);
     Unknowns rival = cands[k].x;
-    const double c = fit(obs, rival, nullptr);
+    const double c = fit(obs, heights, rival, nullptr);
     const ImuState rival_end = endState(rival, end, bias_gyro_rad_s);
     if (c - best_cost < margin && distinct(rival_end, best_end)) {
       reason_ = "motion alignment: ambiguous (two poses " + std::to_string((rival_end.p_IinG - best_end.p_IinG).norm()) +
@@ -342,7 +442,7 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
     }
   }
   (void)n_used;
-  return finish(obs, best, info, end, bias_gyro_rad_s);
+  return finish(obs, heights, best, info, end, bias_gyro_rad_s);
 }
 
 double MotionAligner::robustVarianceFactor(const std::vector<Obs>& obs, const Unknowns& x) const {
@@ -356,14 +456,14 @@ double MotionAligner::robustVarianceFactor(const std::vector<Obs>& obs, const Un
   return std::max(1.0, s * s);
 }
 
-std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs, const Unknowns& x,
-                                                     const Mat15& info, const Increments& end,
+std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights,
+                                                     const Unknowns& x, const MatU& info, const Increments& end,
                                                      const Eigen::Vector3d& bias_gyro) {
-  const Mat15 Sigma = options_.cov_inflation * info.ldlt().solve(Mat15::Identity());
+  const MatU Sigma = options_.cov_inflation * info.ldlt().solve(MatU::Identity());
   const ImuState e0 = endState(x, end, bias_gyro);
   Eigen::Matrix<double, 15, kDim> J;
   for (int j = 0; j < kDim; ++j) {
-    Vec15 d = Vec15::Zero();
+    VecU d = VecU::Zero();
     d(j) = 1e-6;
     J.col(j) = (endState(x.plus(d), end, bias_gyro).boxminus(e0) - endState(x.plus(-d), end, bias_gyro).boxminus(e0)) / 2e-6;
   }
@@ -378,6 +478,10 @@ std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs
   }
   res.t = imu_.back().t;
   res.last_imu = imu_.back();
+  res.window_s = spanSeconds();
+  res.height_bias_m = x.bh;
+  res.height_bias_var_m2 = Sigma(kBh, kBh);
+  for (const HeightObs& o : heights) res.n_heights += o.use;
   std::set<SensorId> used_anchors;
   double sq = 0.0;
   for (const Obs& o : obs) {

@@ -19,6 +19,13 @@
 /// (1.4826 median|e|)²) the robust variance factor of the normalized residuals. The covariance is (Jᵀ W J + prior)⁻¹ inflated by `cov_inflation`, carried to the window's end by the numeric
 /// Jacobian of the end state. Refused (with a reason) while the geometry or the motion cannot
 /// fix the pose: too few ranges or anchors, σ_yaw or σ_p above their limits, ambiguity.
+///
+/// Sparse ranging: while `window_s` holds fewer than `min_ranges` ranges, the window reaches back
+/// until it holds them (at most `max_window_s`), so the count, not only the time, decides.
+/// Heights of a downward rangefinder (optional) add the vertical constraint
+///   h = (p_I(τ) + R₀C(τ) p_IH)_z / c(τ) + b_H,  c = e_zᵀ R₀ C(τ) e_z  (c ≡ 1 without tilt correction)
+/// with one more unknown, the sensor's bias b_H ~ N(0, σ_bH²): the floor is at z = 0 of G, so the
+/// mirror image of the trajectory across nearly coplanar anchors no longer fits.
 
 #include <deque>
 #include <map>
@@ -41,8 +48,16 @@ struct AlignRange {
   double sigma_m = 0.1;                              ///< range noise σ [m]
 };
 
+/// One downward rangefinder reading for the alignment.
+struct AlignHeight {
+  Timestamp t;
+  double range_m = 0.0;   ///< distance to the floor along the beam [m]
+  double sigma_m = 0.05;  ///< noise σ [m]
+};
+
 struct MotionAlignerOptions {
-  double window_s = 12.0;             ///< data kept and fitted [s]
+  double window_s = 12.0;             ///< data fitted while it holds `min_ranges` ranges [s]
+  double max_window_s = 40.0;         ///< sparse ranges: the window reaches back at most this far [s]
   double min_span_s = 3.0;           ///< shortest window worth a fit [s]
   int min_ranges = 20;               ///< ranges needed in the window
   int min_anchors = 3;               ///< distinct anchors needed in the window
@@ -59,6 +74,9 @@ struct MotionAlignerOptions {
   int yaw_starts = 12;               ///< yaw grid of the multi-start [-]
   double sigma_bias_gyro_rad_s = 0.005;  ///< σ of the gyro bias in the result [rad/s]
   double max_imu_gap_s = 0.1;        ///< increments cannot span a longer IMU gap: the window restarts [s]
+  Eigen::Vector3d p_IH = Eigen::Vector3d::Zero();  ///< rangefinder in the IMU frame [m]
+  bool height_tilt_correction = true;  ///< h = s_z / cos(tilt) (else s_z)
+  double sigma_bias_height_m = 0.3;   ///< prior σ of the rangefinder's bias around 0 [m]
 };
 
 /// The aligned state at the window's end.
@@ -72,6 +90,10 @@ struct AlignmentResult {
   double sigma_p_m = 0.0;    ///< largest position σ at the end [m]
   double sigma_yaw_deg = 0.0;
   ImuSample last_imu;        ///< the IMU reading at `t`
+  int n_heights = 0;         ///< rangefinder readings used (inliers)
+  double height_bias_m = 0.0;       ///< rangefinder bias b_H (prior mean 0 without heights) [m]
+  double height_bias_var_m2 = 0.0;  ///< its variance [m²]
+  double window_s = 0.0;     ///< span of the data fitted [s]
 };
 
 class MotionAligner {
@@ -80,6 +102,7 @@ class MotionAligner {
 
   void addImu(const ImuSample& s);
   void addRange(const AlignRange& r);
+  void addHeight(const AlignHeight& h);
   void clear();
   /// Fits the current window; nullopt (see `reason()`) while the pose is not determined.
   std::optional<AlignmentResult> solve(const Eigen::Vector3d& bias_gyro_rad_s);
@@ -87,6 +110,9 @@ class MotionAligner {
   const std::string& reason() const { return reason_; }
   /// Data span currently held [s].
   double spanSeconds() const;
+  /// Start of the window the next `solve` fits: `window_s` back from the newest IMU sample, or
+  /// further (at most `max_window_s`) until it holds `min_ranges` ranges.
+  Timestamp windowStart() const;
   const MotionAlignerOptions& options() const { return options_; }
 
   /// Strapdown increments at one instant relative to the window start (see the file comment).
@@ -104,8 +130,9 @@ class MotionAligner {
     Eigen::Matrix3d R0 = Eigen::Matrix3d::Identity();
     Eigen::Vector3d ba = Eigen::Vector3d::Zero();
     Eigen::Vector3d dbg = Eigen::Vector3d::Zero();  ///< gyro bias correction to b̂_ω [rad/s]
-    /// x ⊞ δ with δ = [δp₀, δv₀, δθ, δb_a, δb_ω].
-    Unknowns plus(const Eigen::Matrix<double, 15, 1>& d) const;
+    double bh = 0.0;                                ///< rangefinder bias b_H [m]
+    /// x ⊞ δ with δ = [δp₀, δv₀, δθ, δb_a, δb_ω, δb_H].
+    Unknowns plus(const Eigen::Matrix<double, 16, 1>& d) const;
   };
 
  private:
@@ -114,28 +141,39 @@ class MotionAligner {
     Increments inc;
     bool use = true;
   };
-  std::vector<Obs> buildObservations(const Eigen::Vector3d& bias_gyro, Increments* end) const;
+  struct HeightObs {
+    AlignHeight h;
+    Increments inc;
+    bool use = true;
+  };
+  using Info = Eigen::Matrix<double, 16, 16>;
+  std::vector<Obs> buildObservations(const Eigen::Vector3d& bias_gyro, Increments* end,
+                                     std::vector<HeightObs>* heights) const;
   /// Levenberg–Marquardt with Huber weights; returns the cost (Huber terms and bias priors).
-  double fit(const std::vector<Obs>& obs, Unknowns& x, Eigen::Matrix<double, 15, 15>* info) const;
-  /// max(1, (1.4826 · median|e_i|)²) over the inliers: how much noisier than their σ the ranges fit.
+  double fit(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights, Unknowns& x, Info* info) const;
+  /// max(1, (1.4826 · median|e_i|)²) over the inlier ranges: how much noisier than their σ they fit.
   double robustVarianceFactor(const std::vector<Obs>& obs, const Unknowns& x) const;
   double residual(const Obs& o, const Unknowns& x) const;
-  /// ∂residual/∂[δp₀, δv₀, δθ, δb_a, δb_ω] (analytic; the noise-free unit test converges with it).
-  Eigen::Matrix<double, 1, 15> jacobian(const Obs& o, const Unknowns& x) const;
+  /// ∂residual/∂[δp₀, δv₀, δθ, δb_a, δb_ω, δb_H] (analytic; the noise-free unit test converges with it).
+  Eigen::Matrix<double, 1, 16> jacobian(const Obs& o, const Unknowns& x) const;
+  /// Height residual h − ĥ and its Jacobian (same unknowns).
+  double residual(const HeightObs& o, const Unknowns& x) const;
+  Eigen::Matrix<double, 1, 16> jacobian(const HeightObs& o, const Unknowns& x) const;
   /// Tag position (τ of `inc`) and the body-frame vector w it is R₀ w away from the
   /// gravity/velocity terms.
   Eigen::Vector3d bodyTerm(const Increments& inc, const Unknowns& x, const Eigen::Vector3d& p_TinI) const;
   ImuState endState(const Unknowns& x, const Increments& end, const Eigen::Vector3d& bias_gyro) const;
   std::vector<Unknowns> starts(const std::vector<Obs>& obs) const;
   /// Covariance, end state and the acceptance checks of the best fit.
-  std::optional<AlignmentResult> finish(const std::vector<Obs>& obs, const Unknowns& x,
-                                        const Eigen::Matrix<double, 15, 15>& info, const Increments& end,
+  std::optional<AlignmentResult> finish(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights,
+                                        const Unknowns& x, const Info& info, const Increments& end,
                                         const Eigen::Vector3d& bias_gyro);
 
   MotionAlignerOptions options_;
   std::map<SensorId, Eigen::Vector3d> tags_p_TinI_;
   std::deque<ImuSample> imu_;
   std::deque<AlignRange> ranges_;
+  std::deque<AlignHeight> heights_;
   std::string reason_ = "no data";
 };
 

@@ -16,8 +16,9 @@
 
 namespace meshnav::estimator::node_internal {
 
-inline MotionAlignerOptions alignerOptions(const EstimatorOptions& o) {
+inline MotionAlignerOptions alignerOptions(const EstimatorOptions& o, const Eigen::Vector3d& p_IH) {
   MotionAlignerOptions a;
+  a.p_IH = p_IH;
   a.window_s = o.init.motion_window_s;
   a.min_span_s = o.init.motion_min_span_s;
   a.min_ranges = o.init.motion_min_ranges;
@@ -29,6 +30,9 @@ inline MotionAlignerOptions alignerOptions(const EstimatorOptions& o) {
   a.ambiguity_chi2 = o.init.ambiguity_chi2;
   a.gravity_m_s2 = o.gravity_m_s2;
   a.max_imu_gap_s = o.imu.max_dt_s;
+  a.max_window_s = o.init.motion_max_window_s;
+  a.height_tilt_correction = o.height.tilt_correction;
+  a.sigma_bias_height_m = o.height.init_bias_sigma_m;
   return a;
 }
 

@@ -42,6 +42,10 @@ struct InitialBelief {
   double baro_bias_var_m2 = 1.0;
   ImuSample last_imu;                ///< the IMU reading the belief is valid at
   bool landed = true;                ///< flight state at initialization
+  /// The downward rangefinder's bias when the initialization estimated it (in-motion alignment
+  /// with heights): mean [m] and variance [m²]. None: the node's prior (0, height.init_bias_sigma_m²).
+  std::optional<std::pair<double, double>> height_bias;
+  int n_heights_used = 0;
 };
 
 class StaticInitializer {

@@ -84,6 +84,7 @@ int main(int argc, char** argv) {
 
     lcm.subscribe<ImuSample>(channels::kImu, [&](const ImuSample& s) { node.onImu(s); });
     lcm.subscribe<BaroSample>(channels::kBaro, [&](const BaroSample& s) { node.onBaro(s); });
+    lcm.subscribe<HeightSample>(channels::kHeight, [&](const HeightSample& s) { node.onHeight(s); });
     lcm.subscribe<RangeSample>(channels::kRange, [&](const RangeSample& s) { node.onRange(s); });
     lcm.subscribe<FlightStateSample>(channels::kFlightState, [&](const FlightStateSample& s) { node.onFlightState(s); });
     lcm.subscribe<AnchorInit>(channels::kAnchorInit, [&](const AnchorInit& a) { node.onAnchorInit(a); });

@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   const Timestamp t = Timestamp::fromUtime(1'700'000'000'000'000);
   save(toLcm(ImuSample{t, {0.1, -0.2, 9.81}, {0.01, 0.0, -0.02}}));
   save(toLcm(BaroSample{t, 101325.0}));
+  save(toLcm(HeightSample{t, 1.27}));
   RangeSample r;
   r.t = t; r.id_initiator = 100; r.id_responder = 106; r.range_m = 4.46; r.range_corr_m = 4.45; r.R_m2 = 0.01;
   save(toLcm(r));

@@ -55,6 +55,7 @@ void fuzzType(const uint8_t* data, size_t size) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fuzzType<imu_t>(data, size);
   fuzzType<baro_t>(data, size);
+  fuzzType<height_t>(data, size);
   fuzzType<range_t>(data, size);
   fuzzType<flight_state_t>(data, size);
   fuzzType<ground_truth_t>(data, size);

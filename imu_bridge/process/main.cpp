@@ -10,16 +10,17 @@ int main(int argc, char** argv) {
   transport::ProcessMain process(
       "imu_bridge",
       "Publishes the inertial inputs of a dataset folder: imu.csv -> IMU, baro.csv -> BARO, flight_state.csv -> "
-      "FLIGHT_STATE (each file optional), time-sorted, message utime = data time. Exits when the data is played "
+      "FLIGHT_STATE, height.csv -> HEIGHT (each file optional), time-sorted, message utime = data time. Exits when the data is played "
       "(0), on SIGINT/SIGTERM (0), on bad input (1) or when --wait-for timed out (3).");
   std::string dataset;
-  bool no_imu = false, no_baro = false, no_flight_state = false;
+  bool no_imu = false, no_baro = false, no_flight_state = false, no_height = false;
   transport::ReplayCliValues replay_values;
   Cli& cli = process.cli();
   cli.optional("dataset", dataset, "dataset folder; required")->type_name("DIR");
   cli.flag("no-imu", no_imu, "leave imu.csv out");
   cli.flag("no-baro", no_baro, "leave baro.csv out");
   cli.flag("no-flight-state", no_flight_state, "leave flight_state.csv out");
+  cli.flag("no-height", no_height, "leave height.csv out");
   transport::declareReplayOptions(cli, replay_values);
   cli.optionsFile("these options as a YAML map (`rate: 10`, `wait_for: ESTIMATOR_STATUS`); the command line wins");
 
@@ -34,6 +35,7 @@ int main(int argc, char** argv) {
     if (no_imu) streams.imu.clear();
     if (no_baro) streams.baro.clear();
     if (no_flight_state) streams.flight_states.clear();
+    if (no_height) streams.heights.clear();
     if (diag.total() > 0) spdlog::warn("input problems (rows dropped): {}", diag.summary());
     const auto events = streams.timeline();
 
@@ -43,17 +45,18 @@ int main(int argc, char** argv) {
     if (!transport::waitForStart(node, replay_options)) return node.stopRequested() ? 0 : 3;
 
     using imu::InertialStreams;
-    int64_t n[3] = {0, 0, 0};
+    int64_t n[4] = {0, 0, 0, 0};
     transport::runReplay(replay_options, events, [&](const replay::ReplayEvent& ev) {
       switch (ev.stream) {
         case InertialStreams::kImuStream: node.publish(channels::kImu, streams.imu[ev.index]); break;
         case InertialStreams::kBaroStream: node.publish(channels::kBaro, streams.baro[ev.index]); break;
         case InertialStreams::kFlightStateStream: node.publish(channels::kFlightState, streams.flight_states[ev.index]); break;
+        case InertialStreams::kHeightStream: node.publish(channels::kHeight, streams.heights[ev.index]); break;
       }
       ++n[ev.stream];
     });
-    spdlog::info("published IMU {}, BARO {}, FLIGHT_STATE {}{}", n[InertialStreams::kImuStream],
-                 n[InertialStreams::kBaroStream], n[InertialStreams::kFlightStateStream],
+    spdlog::info("published IMU {}, BARO {}, FLIGHT_STATE {}, HEIGHT {}{}", n[InertialStreams::kImuStream],
+                 n[InertialStreams::kBaroStream], n[InertialStreams::kFlightStateStream], n[InertialStreams::kHeightStream],
                  node.diagnostics().total() ? ", errors: " + node.diagnostics().summary() : "");
     return node.diagnostics().get("lcm:publish_error") > 0 ? 1 : 0;
   });

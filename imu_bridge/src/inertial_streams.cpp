@@ -10,7 +10,8 @@
 namespace meshnav::imu {
 
 std::vector<replay::ReplayEvent> InertialStreams::timeline() const {
-  return replay::mergeTimeline({replay::timesOf(flight_states), replay::timesOf(imu), replay::timesOf(baro)});
+  return replay::mergeTimeline(
+      {replay::timesOf(flight_states), replay::timesOf(imu), replay::timesOf(baro), replay::timesOf(heights)});
 }
 
 InertialStreams loadInertialStreams(const std::string& dataset_dir, Diagnostics& diag) {
@@ -31,10 +32,14 @@ InertialStreams loadInertialStreams(const std::string& dataset_dir, Diagnostics&
     s.flight_states = readFlightStateCsv((dir / "flight_state.csv").string(), diag);
     any = true;
   }
+  if (fs::exists(dir / "height.csv")) {
+    s.heights = readHeightCsv((dir / "height.csv").string(), diag);
+    any = true;
+  }
   if (!any)
-    throw std::runtime_error(dataset_dir + ": none of imu.csv, baro.csv, flight_state.csv found");
-  spdlog::info("{}: {} IMU, {} baro, {} flight-state samples", dataset_dir, s.imu.size(), s.baro.size(),
-               s.flight_states.size());
+    throw std::runtime_error(dataset_dir + ": none of imu.csv, baro.csv, flight_state.csv, height.csv found");
+  spdlog::info("{}: {} IMU, {} baro, {} flight-state, {} height samples", dataset_dir, s.imu.size(), s.baro.size(),
+               s.flight_states.size(), s.heights.size());
   return s;
 }
 

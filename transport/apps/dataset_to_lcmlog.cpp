@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
     // IMU, baro, range), so a replay of the log causes no rewinds; inputs before the truth.
     const std::vector<std::vector<Timestamp>> times = {
         replay::timesOf(ds.flight_states), replay::timesOf(ds.imu), replay::timesOf(ds.baro),
-        replay::timesOf(ds.ranges), with_gt ? replay::timesOf(ds.ground_truth) : std::vector<Timestamp>{}};
+        replay::timesOf(ds.ranges), with_gt ? replay::timesOf(ds.ground_truth) : std::vector<Timestamp>{},
+        replay::timesOf(ds.heights)};
     const auto events = replay::mergeTimeline(times);
 
     const std::filesystem::path outp(out);
@@ -74,6 +75,7 @@ int main(int argc, char** argv) {
         case 2: ok = writeEvent(log, channels::kBaro, ev.t.us, transport::toLcm(ds.baro[ev.index]), buf); break;
         case 3: ok = writeEvent(log, channels::kRange, ev.t.us, transport::toLcm(ds.ranges[ev.index]), buf); break;
         case 4: ok = writeEvent(log, channels::kGroundTruth, ev.t.us, transport::toLcm(ds.ground_truth[ev.index]), buf); break;
+        case 5: ok = writeEvent(log, channels::kHeight, ev.t.us, transport::toLcm(ds.heights[ev.index]), buf); break;
         default: break;
       }
       if (!ok) {
@@ -82,9 +84,9 @@ int main(int argc, char** argv) {
       }
       ++written;
     }
-    spdlog::info("{}: {} events (IMU {}, BARO {}, FLIGHT_STATE {}, RANGE {}, GROUND_TRUTH {}), {:.3f}..{:.3f} s",
+    spdlog::info("{}: {} events (IMU {}, BARO {}, FLIGHT_STATE {}, RANGE {}, GROUND_TRUTH {}, HEIGHT {}), {:.3f}..{:.3f} s",
                  out, written, ds.imu.size(), ds.baro.size(), ds.flight_states.size(), ds.ranges.size(),
-                 with_gt ? ds.ground_truth.size() : 0, events.empty() ? 0.0 : events.front().t.sec(),
+                 with_gt ? ds.ground_truth.size() : 0, ds.heights.size(), events.empty() ? 0.0 : events.front().t.sec(),
                  events.empty() ? 0.0 : events.back().t.sec());
     if (diag.total() > 0) spdlog::warn("dataset input problems: {}", diag.summary());
     return 0;

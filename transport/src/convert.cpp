@@ -119,6 +119,20 @@ baro_t toLcm(const BaroSample& s) {
   m.pressure = s.pressure_pa;
   return m;
 }
+height_t toLcm(const HeightSample& s) {
+  height_t m;
+  m.utime = s.t.us;
+  m.range = s.range_m;
+  return m;
+}
+HeightSample fromLcm(const height_t& m) {
+  requireFinite(m.range, "range");
+  requireWithin(m.range, 0.0, plausible::kMaxHeight_m, "range [m]");
+  HeightSample s;
+  s.t = Timestamp::fromUtime(m.utime);
+  s.range_m = m.range;
+  return s;
+}
 BaroSample fromLcm(const baro_t& m) {
   requireFinite(m.pressure, "pressure");
   requireWithin(m.pressure, plausible::kMinPressure_pa, plausible::kMaxPressure_pa, "pressure [Pa]");

@@ -46,6 +46,16 @@ TEST(Setup, RoundTrip) {
   EXPECT_DOUBLE_EQ(r.initial_pose->yaw_deg, 30);
   EXPECT_DOUBLE_EQ(*r.noise.sigma_range_m, 0.15);
   EXPECT_FALSE(r.noise.imu_acc_bias_rw);
+  EXPECT_EQ(r.height_id, 3);
+  EXPECT_TRUE(r.height_p_IH.isZero());
+  // The rangefinder's id and lever arm, written only when not the defaults.
+  auto h = s;
+  h.height_id = 7;
+  h.height_p_IH = Eigen::Vector3d(0.02, 0.0, -0.11);
+  saveSetup(h, (d / "height.yaml").string());
+  const auto rh = loadSetup((d / "height.yaml").string());
+  EXPECT_EQ(rh.height_id, 7);
+  EXPECT_TRUE(rh.height_p_IH.isApprox(h.height_p_IH));
 }
 
 TEST(Setup, ReadsThePublishedToolboxConfig) {
@@ -114,6 +124,10 @@ TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
   EXPECT_NE(error(base + "imu_id: 101\n").find("key 'imu_id' = 101 is also an anchor (abs_anchor_positions.101)"),
             std::string::npos);
   EXPECT_NE(error(base + "imu_id: 7\nbaro_id: 7\n").find("same id 7"), std::string::npos);
+  EXPECT_NE(error(base + "height_id: 105\n").find("key 'height_id' = 105 is also a tag"), std::string::npos);
+  EXPECT_NE(error(base + "imu_id: 3\nheight_id: 3\n").find("key 'imu_id' and key 'height_id' are the same id 3"),
+            std::string::npos);
+  EXPECT_NE(error(base + "height: {p_IH: [0, 0]}\n").find("height.p_IH"), std::string::npos);
   EXPECT_NE(error(base + "noise: {sigma_range: -0.1}\n").find("key 'noise.sigma_range' must be > 0"), std::string::npos);
   EXPECT_NE(error(base + "noise: {sigma_rnage: 0.1}\n").find("unknown key 'noise.sigma_rnage'"), std::string::npos);
   EXPECT_NE(error(base + "baro: {reference_pressure: 1e9}\n").find("key 'baro.reference_pressure'"), std::string::npos);
@@ -128,6 +142,7 @@ TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
   const SystemSetup s = loadSetup(f);
   EXPECT_EQ(s.imu_id, 3);
   EXPECT_EQ(s.baro_id, 4);
+  EXPECT_EQ(s.height_id, 5);  // its default 3 made way for the IMU
   ASSERT_TRUE(s.initial_pose);
   EXPECT_DOUBLE_EQ(s.initial_pose->sigma_p_m, InitialPose{}.sigma_p_m);
 }

@@ -233,3 +233,48 @@ TEST(EstimatorNode, UnknownStrategyIsRefusedAndModularOnesAreBuilt) {
     EXPECT_NO_THROW(EstimatorNode(o, synthetic::syntheticSetup({}))) << s;
   }
 }
+
+TEST(EstimatorNode, HeightsAddABiasInstanceThatConvergesAndBadHeightsAreCounted) {
+  synthetic::SyntheticOptions o;
+  o.duration_s = 20.0;
+  Dataset ds = synthetic::makeSyntheticDataset(o);
+  // A rangefinder 0.1 m below the IMU, level flight: reads z − 0.1 (+ 0.08 floor offset as bias).
+  const double bias = 0.08;
+  ds.setup.height_p_IH = Eigen::Vector3d(0.0, 0.0, -0.1);
+  for (size_t i = 0; i < ds.ground_truth.size(); i += 7) {
+    const PoseSample& g = ds.ground_truth[i];
+    const Eigen::Matrix3d R = g.q_ItoG.toRotationMatrix();
+    const double s_z = (g.p_IinG + R * ds.setup.height_p_IH).z();
+    ds.heights.push_back({g.t, s_z / R(2, 2) + bias});
+  }
+  EstimatorNode node(test::testOptions(), ds.setup);
+  int n_bad = 0, n_low = 0;
+  for (const auto& in : mergeInTimeOrder(ds)) {
+    node.onInput(in);
+    if (!node.initialized() || !std::holds_alternative<HeightSample>(in)) continue;
+    const Timestamp t = inputTime(in);
+    if (n_bad < 5) {
+      node.onHeight({t, std::nan("")});
+      node.onHeight({t, -1.0});
+      n_bad += 2;
+    } else if (n_low < 3) {
+      node.onHeight({t, 0.1});  // below height.min_range_m: the sensor's clamped bottom reading
+      ++n_low;
+    }
+  }
+  ASSERT_TRUE(node.initialized());
+  const NominalState& x = node.filter()->state();
+  ASSERT_EQ(x.height_bias_m.count(ds.setup.height_id), 1u);
+  EXPECT_NEAR(x.height_bias_m.at(ds.setup.height_id), bias, 0.03);
+  EXPECT_EQ(node.diagnostics().get("bad_input"), n_bad);
+  // Also the real readings while landed (z = 0.1 m: 0.08 m) after initialization.
+  int n_low_data = 0;
+  for (const auto& h : ds.heights) n_low_data += h.range_m < node.options().height.min_range_m;
+  EXPECT_GT(n_low_data, 0);
+  EXPECT_GE(node.diagnostics().get("height_below_min_range"), n_low);
+  EXPECT_LE(node.diagnostics().get("height_below_min_range"), n_low + n_low_data);
+  EXPECT_EQ(node.diagnostics().get("gated_height"), 0);
+  bool listed = false;
+  for (const auto& is : node.status().instances) listed |= is.id == ds.setup.height_id && is.type == "height";
+  EXPECT_TRUE(listed);
+}

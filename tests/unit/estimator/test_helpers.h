@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <functional>
 
+#include "estimator/core/linearization.h"
 #include "estimator/core/nominal_state.h"
 
 namespace meshnav::estimator::test {
@@ -49,6 +50,16 @@ inline Eigen::MatrixXd numericalJacobian(const NominalState& x, const StateLayou
     J.col(i) = (h(xp) - h(xm)) / (2.0 * eps);
   }
   return J;
+}
+
+/// Stacks the named blocks of `lin` into a full H over `layout` (zeros elsewhere).
+inline Eigen::MatrixXd stack(const Linearization& lin, const StateLayout& layout) {
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(lin.dim(), layout.dim());
+  for (const auto& b : lin.blocks) {
+    const StateBlock& sb = layout.at(b.id);
+    H.block(0, sb.offset, lin.dim(), sb.dim) = b.H;
+  }
+  return H;
 }
 
 }  // namespace meshnav::estimator::test

@@ -12,16 +12,6 @@ using namespace meshnav::estimator::test;
 
 namespace {
 
-/// Stacks the named blocks of `lin` into a full H over `layout` (zeros elsewhere).
-Eigen::MatrixXd stack(const Linearization& lin, const StateLayout& layout) {
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(lin.dim(), layout.dim());
-  for (const auto& b : lin.blocks) {
-    const StateBlock& sb = layout.at(b.id);
-    H.block(0, sb.offset, lin.dim(), sb.dim) = b.H;
-  }
-  return H;
-}
-
 UwbNetwork network() {
   SystemSetup s;
   s.rel_tag_positions = {{100, {-0.19, 0.105, -0.07}}, {105, {0.05, -0.105, -0.07}}};

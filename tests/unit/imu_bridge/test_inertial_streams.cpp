@@ -49,6 +49,24 @@ TEST(InertialStreams, LoadsAndMergesWithBadRowsDropped) {
   fs::remove_all(d);
 }
 
+TEST(InertialStreams, HeightsAreTheFourthStreamLastAtEqualTimes) {
+  const auto d = freshDir("height");
+  std::ofstream(d / "imu.csv") << "t,lin_acc_x,lin_acc_y,lin_acc_z,ang_vel_x,ang_vel_y,ang_vel_z\n"
+                                  "0.000,0,0,9.81,0,0,0\n0.010,0,0,9.81,0,0,0\n";
+  std::ofstream(d / "height.csv") << "t,range_m\n0.0,1.20\n0.005,-3\n0.010,1.21\n";
+  Diagnostics diag;
+  const auto s = loadInertialStreams(d.string(), diag);
+  EXPECT_EQ(s.heights.size(), 2u);
+  EXPECT_EQ(diag.get("height.csv:bad_value"), 1);
+  const auto tl = s.timeline();
+  ASSERT_EQ(tl.size(), 4u);
+  const std::vector<int> streams = {InertialStreams::kImuStream, InertialStreams::kHeightStream,
+                                    InertialStreams::kImuStream, InertialStreams::kHeightStream};
+  for (size_t i = 0; i < tl.size(); ++i) EXPECT_EQ(tl[i].stream, streams[i]) << i;
+  EXPECT_DOUBLE_EQ(s.heights[tl[3].index].range_m, 1.21);
+  fs::remove_all(d);
+}
+
 TEST(InertialStreams, OnlyBaroIsEnough) {
   const auto d = freshDir("baro");
   std::ofstream(d / "baro.csv") << "t,pressure\n0.0,101325.0\n";

@@ -8,6 +8,7 @@
 #include "meshnav/anchor_init_t.hpp"
 #include "meshnav/anchors_t.hpp"
 #include "meshnav/baro_t.hpp"
+#include "meshnav/height_t.hpp"
 #include "meshnav/calib_anchor_status_t.hpp"
 #include "meshnav/calib_cmd_t.hpp"
 #include "meshnav/calib_status_t.hpp"
@@ -140,7 +141,7 @@ TEST(LcmTypes, ForeignBytesAreRefused) {
 
 TEST(LcmTypes, FingerprintsAreDistinct) {
   const std::vector<int64_t> hashes = {
-      meshnav::imu_t::getHash(),          meshnav::baro_t::getHash(),
+      meshnav::imu_t::getHash(),          meshnav::baro_t::getHash(),          meshnav::height_t::getHash(),
       meshnav::range_t::getHash(),        meshnav::flight_state_t::getHash(),
       meshnav::ground_truth_t::getHash(), meshnav::pose_t::getHash(),
       meshnav::anchors_t::getHash(),      meshnav::anchor_init_t::getHash(),
@@ -150,7 +151,7 @@ TEST(LcmTypes, FingerprintsAreDistinct) {
       meshnav::calib_anchor_status_t::getHash(), meshnav::counter_t::getHash(),
       meshnav::instance_status_t::getHash(), meshnav::pair_bias_t::getHash(),
       meshnav::timing_t::getHash()};
-  ASSERT_EQ(hashes.size(), 19u);  // every type in lcmtypes/types
+  ASSERT_EQ(hashes.size(), 20u);  // every type in lcmtypes/types
   for (size_t i = 0; i < hashes.size(); ++i)
     for (size_t j = i + 1; j < hashes.size(); ++j) EXPECT_NE(hashes[i], hashes[j]) << i << " vs " << j;
 }

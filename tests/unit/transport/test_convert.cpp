@@ -85,6 +85,18 @@ TEST(Convert, Baro) {
   EXPECT_EQ(r.pressure_pa, s.pressure_pa);
 }
 
+TEST(Convert, Height) {
+  HeightSample s{Timestamp{1'700'000'000'123'456}, 1.274};
+  const HeightSample r = fromLcm(wire(toLcm(s)));
+  EXPECT_EQ(r.t, s.t);
+  EXPECT_EQ(r.range_m, s.range_m);
+  auto m = toLcm(s);
+  for (double bad : {std::nan(""), -0.1, 1e6}) {  // not finite, below the floor, beyond plausibility
+    m.range = bad;
+    EXPECT_THROW(fromLcm(m), InvalidMessage) << bad;
+  }
+}
+
 TEST(Convert, RangeBothTypeCombinations) {
   for (auto [ti, tr] : {std::pair{UwbType::Tag, UwbType::Anchor}, std::pair{UwbType::Anchor, UwbType::Tag},
                         std::pair{UwbType::Anchor, UwbType::Anchor}}) {
