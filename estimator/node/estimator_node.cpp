@@ -87,6 +87,7 @@ void EstimatorNode::resetAll() {
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);
   cur_.network = std::make_shared<const UwbNetwork>(setup_, options_.uwb.sigma_range_m);
   history_.clear();
+  seen_.clear();
   baro_reference_pa_.reset();
   instance_stats_.clear();
   last_pose_pub_.reset();
@@ -138,6 +139,7 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   if (!validate(in_raw)) return;
   EstimatorInput in = in_raw;
   if (!admitTime(in)) return;
+  if (!admitOnce(in_raw)) return;
   // Commands are not measurements: they apply now (at the newest time) unless they are newer.
   if (newest_ && (std::holds_alternative<AnchorInit>(in) || std::holds_alternative<EstimatorCommand>(in))) {
     if (auto* a = std::get_if<AnchorInit>(&in)) a->t = std::max(a->t, *newest_);
