@@ -2,11 +2,17 @@
 """Pose outage and error around an instant (the kill -9 of the estimator in multihost_test.sh).
 
 Usage: pose_gap.py ESTIMATE_CSV GROUNDTRUTH_CSV T_EVENT [--settle S] [--until T]
+       pose_gap.py --anchors ANCHORS_CSV T_EVENT ID,ID,...
 
 Prints, in data seconds: the longest gap between two consecutive poses in [T_EVENT - 1, T_EVENT + 10]
 (`gap`), the time of the first pose after that gap (`back`), and the largest position error from
 T_EVENT + settle (default 10 s) to the end or --until (`max_error_after`), against the ground
 truth interpolated linearly. One line "key value" each.
+
+With --anchors: for each anchor the last row of anchors.csv before T_EVENT and the first after,
+"anchor ID moved M var_ratio R" (position change [m], trace of the covariance after / before):
+an anchor resumed from a checkpoint barely moves and keeps its covariance; one that came back
+from the setup prior (or a recalibration) would not. Exit 1 when an anchor has no row after.
 """
 import sys
 
@@ -25,7 +31,27 @@ def load(path, cols):
     return np.array(rows)
 
 
+def anchors(argv):
+    rows = load(argv[2], [0, 1, 2, 3, 4, 5, 8, 10])
+    t_event = float(argv[3])
+    ok = True
+    for i in [int(x) for x in argv[4].split(',')]:
+        r = rows[rows[:, 1] == i]
+        before, after = r[r[:, 0] < t_event], r[r[:, 0] > t_event]
+        if not len(before) or not len(after):
+            print('anchor %d rows_before %d rows_after %d' % (i, len(before), len(after)))
+            ok = False
+            continue
+        b, a = before[-1], after[0]
+        moved = float(np.linalg.norm(a[2:5] - b[2:5]))
+        ratio = float(a[5:8].sum() / b[5:8].sum()) if b[5:8].sum() > 0 else float('inf')
+        print('anchor %d moved %.4f var_ratio %.3f' % (i, moved, ratio))
+    return 0 if ok else 1
+
+
 def main(argv):
+    if len(argv) >= 2 and argv[1] == '--anchors':
+        return anchors(argv)
     if len(argv) < 4:
         print(__doc__)
         return 2
