@@ -478,9 +478,9 @@ void CalibratorNode::runPeriodic() {
     if (next_prune_) pruneOldTagRanges();
     next_prune_ = now + Duration::fromSec(kPruneSlackS);
   }
-  if (node_options_.auto_mode) {
-    for (auto& [x, tr] : tracks_)
-      if (tr.state == State::Collecting || tr.state == State::Refused) checkAuto(x, tr);
+  for (auto& [x, tr] : tracks_) {
+    if (node_options_.auto_mode && (tr.state == State::Collecting || tr.state == State::Refused)) checkAuto(x, tr);
+    else if (node_options_.retry_refused && tr.state == State::Refused) checkAuto(x, tr);
   }
   const Duration period = Duration::fromSec(node_options_.status_period_s);
   if (!next_status_) next_status_ = now;

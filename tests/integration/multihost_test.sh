@@ -16,6 +16,9 @@
 #   Checks: the supervisor restarts it, POSE again within 2 s, position error <= 0.3 m from 10 s
 #   after the kill, the calibrated anchors back from the checkpoint (5 anchors) without a new
 #   ANCHOR_INIT.
+# MODE kill_calibrator: clean links, 4x, the paper's mission (calibrations at 80 and 100 s); kill -9
+#   of the calibrator at t = 60 s while it collects. Checks: it is restarted and replays its input
+#   journal (--state-dir), every host exits 0, the mission finishes, anchors 106-110 within 0.3 m.
 #
 # Skips (exit 77, "SKIP: reason") when network namespaces cannot be created (not root). Waits are
 # on conditions (log lines, process exits, wall time of the data), bounded.
@@ -55,7 +58,10 @@ case "$MODE" in
   kill)
     RATE=1
     VARS+=(RATE=$RATE MISSION="$SRC/tests/integration/data/mission_calibrate_50s.yaml") ;;
-  *) fail "MODE must be faults or kill" ;;
+  kill_calibrator)
+    RATE=4
+    VARS+=(RATE=$RATE MISSION="$SRC/config/missions/paper_s2.yaml") ;;
+  *) fail "MODE must be faults, kill or kill_calibrator" ;;
 esac
 
 echo "== config/launch/multihost.yaml across namespaces, ${RATE}x, netem: ${NETEM:-none}"
@@ -77,23 +83,26 @@ T0=$(grep -o "T0_UTIME [0-9]*" "$WORK/multihost.log" | awk '{print $2}')
 [[ -n "$T0" ]] || fail "multihost_netns.sh did not start: $(tail -n 5 "$WORK/multihost.log")"
 grep "^multihost:" "$WORK/multihost.log" | head -n 1
 
-if [[ "$MODE" == kill ]]; then
+if [[ "$MODE" == kill* ]]; then
+  victim=$([[ "$MODE" == kill ]] && echo estimator || echo calibrator)
   # Data time t (the dataset starts at 0) is played at wall time T0 + t / RATE.
   kill_at=$(( T0 + 60000000 / RATE ))
   while (( $(now_us) < kill_at )); do
     kill -0 "$MH" 2> /dev/null || fail "the run ended before t = 60 s"
     sleep 0.02
   done
-  pid=$(grep -o "started estimator (pid [0-9]*)" "$WORK/logs/uav.log" | tail -n 1 | grep -o "[0-9]*")
-  [[ -n "$pid" ]] || fail "no estimator pid in uav.log"
-  kill -9 "$pid" || fail "cannot kill the estimator (pid $pid)"
+  pid=$(grep -o "started $victim (pid [0-9]*)" "$WORK/logs/uav.log" | tail -n 1 | grep -o "[0-9]*")
+  [[ -n "$pid" ]] || fail "no $victim pid in uav.log"
+  kill -9 "$pid" || fail "cannot kill the $victim (pid $pid)"
   killed=$(now_us)
-  echo "killed the estimator (pid $pid) at t = $(( (killed - T0) / 1000 )) ms of data time"
-  until grep -q "respawning estimator" "$WORK/logs/uav.log"; do
-    (( $(now_us) - killed < 5000000 )) || fail "the supervisor did not restart the estimator within 5 s"
+  echo "killed the $victim (pid $pid) at t = $(( (killed - T0) * RATE / 1000 )) ms of data time"
+  until grep -q "respawning $victim" "$WORK/logs/uav.log"; do
+    (( $(now_us) - killed < 5000000 )) || fail "the supervisor did not restart the $victim within 5 s"
     sleep 0.01
   done
   echo "restarted after $(( ($(now_us) - killed) / 1000 )) ms (supervisor respawn)"
+fi
+if [[ "$MODE" == kill ]]; then
   stop_at=$(( T0 + 75000000 / RATE ))
   while (( $(now_us) < stop_at )); do
     kill -0 "$MH" 2> /dev/null || fail "the run ended before t = 75 s"
@@ -116,7 +125,17 @@ for f in summary.yaml estimate.csv anchors.csv calibration.yaml; do
   [[ -s "$OUT/$f" ]] || fail "no $OUT/$f"
 done
 
-if [[ "$MODE" == faults ]]; then
+if [[ "$MODE" == kill_calibrator ]]; then
+  (( rc == 0 )) || fail "a host failed (exit $rc)"
+  grep -q "\[mission\].*mission finished" "$LOGS/ground.log" || fail "the mission did not finish"
+  grep -q "\[calibrator\].*restart: [0-9]* inputs replayed" "$LOGS/uav.log" \
+    || fail "the restarted calibrator did not replay its journal"
+  grep "\[calibrator\].*restart:" "$LOGS/uav.log" | cut -c1-220 | sed 's/^/  /'
+  "$BIN/meshnav_check_flyby" --truth "$WORK/data/truth.yaml" --anchor-ids $ANCHORS \
+    --anchor-init "$OUT/calibration.yaml" --estimate "$OUT/estimate.csv" \
+    --groundtruth "$WORK/data/groundtruth.csv" --max-anchor-error 0.3 --max-rmse 0.15 \
+    || fail "fly-by results off (see above)"
+elif [[ "$MODE" == faults ]]; then
   (( rc == 0 )) || fail "a host failed (exit $rc)"
   grep -q "\[mission\].*mission finished" "$LOGS/ground.log" || fail "the mission did not finish"
   # The switch lost and duplicated datagrams of the channels that cross the links.
