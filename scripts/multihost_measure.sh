@@ -7,7 +7,10 @@
 # then meshnav_eval on each (pose RMSE, anchor errors) and meshnav_check_flyby on the calibrator's
 # results. Needs root. About 3 minutes per run.
 #   scripts/multihost_measure.sh OUT_DIR [SEED] [RATE] [NETEM ...]
-# Default NETEM: "loss 5% delay 20ms 10ms" and "loss 20% delay 20ms 10ms".
+# Default NETEM: "loss 5% delay 20ms 10ms" and "loss 20% delay 20ms 10ms". A spec may end in
+# "|VAR=value ..." (e.g. "loss 20% delay 20ms 10ms|TIME_SYNC=0": without the clock correction).
+# Environment: SKIP_LOOPBACK=1 keeps an earlier loopback run in OUT_DIR; PREFIX names the runs
+# (default multihost: multihost1, multihost2, ...).
 set -u
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${BIN:-$ROOT/build/bin}"
@@ -30,18 +33,23 @@ evaluate() {  # NAME
   grep -iE "position RMSE|rmse|anchor" "$OUT/$1.eval.txt" | head -n 12
   cat "$OUT/$1.calib.txt"
 }
-echo "== loopback (one namespace)"
-"$ROOT/scripts/lcm_netns.sh" /usr/bin/python3 "$ROOT/scripts/supervisor.py" "$ROOT/config/launch/multihost.yaml" \
-  "${VARS[@]}" OUT="$OUT/loopback" > "$OUT/loopback.log" 2>&1 || echo "loopback run: exit $?"
-evaluate loopback
+if [[ "${SKIP_LOOPBACK:-0}" != 1 ]]; then
+  echo "== loopback (one namespace)"
+  "$ROOT/scripts/lcm_netns.sh" /usr/bin/python3 "$ROOT/scripts/supervisor.py" "$ROOT/config/launch/multihost.yaml" \
+    "${VARS[@]}" OUT="$OUT/loopback" > "$OUT/loopback.log" 2>&1 || echo "loopback run: exit $?"
+  evaluate loopback
+fi
 k=0
 for spec in "${SPECS[@]}"; do
   k=$((k + 1))
-  name="multihost$k"
-  echo "== across hosts, netem: $spec"
+  name="${PREFIX:-multihost}$k"
+  netem=${spec%%|*}
+  extra=()
+  [[ "$spec" == *"|"* ]] && read -r -a extra <<< "${spec#*|}"
+  echo "== across hosts, netem: $netem ${extra[*]}"
   echo "$spec" > "$OUT/$name.netem"
-  "$ROOT/scripts/multihost_netns.sh" --netem "$spec" --logs "$OUT/$name.logs" "$ROOT/config/launch/multihost.yaml" \
-    "${VARS[@]}" OUT="$OUT/$name" CLOCK_OFFSET_107=0.040 CLOCK_OFFSET_109=-0.025 > "$OUT/$name.log" 2>&1 \
+  "$ROOT/scripts/multihost_netns.sh" --netem "$netem" --logs "$OUT/$name.logs" "$ROOT/config/launch/multihost.yaml" \
+    "${VARS[@]}" OUT="$OUT/$name" CLOCK_OFFSET_107=0.040 CLOCK_OFFSET_109=-0.025 "${extra[@]}" > "$OUT/$name.log" 2>&1 \
     || echo "$name: exit $?"
   evaluate "$name"
   grep -h "time sync: offset" "$OUT/$name.logs/anchor107.log" "$OUT/$name.logs/anchor109.log" | tail -n 2

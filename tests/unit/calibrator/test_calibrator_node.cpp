@@ -569,6 +569,39 @@ TEST(CalibratorNode, FarStampedInputsAreRefusedAndChangeNothing) {
   EXPECT_EQ(out.statuses.size(), clean_out.statuses.size());
 }
 
+TEST(CalibratorNode, DuplicatedRangesAreCollectedOnce) {
+  // Issue 12: a network that duplicates datagrams must not weigh those ranges twice.
+  const auto cmds = std::vector<TimedCommand>{{80.0, command(CalibCommand::Action::Calibrate, {106, 107})}};
+  Outputs clean_out, out;
+  CalibratorNode clean(CalibratorOptions{}, setup(), sinksInto(clean_out));
+  replay(clean, seed1().dataset, cmds, 80.0);
+  Dataset dup = seed1().dataset;
+  dup.ranges.clear();
+  int64_t n_dup = 0;
+  const auto& ranges = seed1().dataset.ranges;
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    dup.ranges.push_back(ranges[i]);
+    if (i % 20 == 7 && ranges[i].t.sec() <= 80.0) {  // 5 %: at once, or again 3 ranges later
+      if (i % 40 == 7) {
+        dup.ranges.push_back(ranges[i]);
+      } else if (i >= 3) {
+        dup.ranges.push_back(ranges[i - 3]);
+      }
+      ++n_dup;
+    }
+  }
+  CalibratorNode node(CalibratorOptions{}, setup(), sinksInto(out));
+  replay(node, dup, cmds, 80.0);
+  EXPECT_EQ(node.diagnostics().get("RANGE:duplicate"), n_dup);
+  EXPECT_GT(n_dup, 300);
+  ASSERT_EQ(clean_out.inits.size(), 2u);
+  ASSERT_EQ(out.inits.size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(out.inits[k].p_AinG, clean_out.inits[k].p_AinG);
+    EXPECT_EQ(out.inits[k].n_inliers, clean_out.inits[k].n_inliers);
+  }
+}
+
 TEST(CalibratorNodeOptions, YamlRejectsUnknownKeysAndBadValues) {
   const auto ok = CalibratorNodeOptions::fromYaml(YAML::Load("{auto_mode: true, auto_min_ranges: 500}"), "x.yaml");
   EXPECT_TRUE(ok.auto_mode);
