@@ -18,7 +18,8 @@ namespace meshnav {
 /// Streaming writer of estimate.csv (header written on open).
 class EstimateCsvWriter {
  public:
-  explicit EstimateCsvWriter(const std::string& path);
+  /// `append`: continue an existing non-empty file (a restarted logger) instead of starting anew.
+  explicit EstimateCsvWriter(const std::string& path, bool append = false);
   void write(const PoseEstimate& e);
   void flush();
 
@@ -29,7 +30,8 @@ class EstimateCsvWriter {
 /// Streaming writer of anchors.csv (header written on open).
 class AnchorsCsvWriter {
  public:
-  explicit AnchorsCsvWriter(const std::string& path);
+  /// `append`: as EstimateCsvWriter.
+  explicit AnchorsCsvWriter(const std::string& path, bool append = false);
   void write(const AnchorEstimate& a);
   void flush();
 

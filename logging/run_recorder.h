@@ -6,7 +6,8 @@
 /// Files in the output folder:
 ///  - estimate.csv    every POSE (common/estimate_io.h)
 ///  - anchors.csv     every anchor of every ANCHORS message
-///  - anchor_init.yaml  every ANCHOR_INIT, in the calibration YAML format (`anchors:` list)
+///  - anchor_init.yaml  every ANCHOR_INIT, in the calibration YAML format (`anchors:` list),
+///                    rewritten at each one (so a kill -9 loses none)
 ///  - groundtruth.csv GROUND_TRUTH when present (TUM)
 ///  - summary.yaml    written by finish(): messages and bytes per channel, the last
 ///                    ESTIMATOR_STATUS / CALIB_STATUS / MISSION_STATUS, and the recorder's counters
@@ -36,8 +37,10 @@ struct ChannelStats {
 class RunRecorder {
  public:
   /// Creates `out_dir` and opens estimate.csv and anchors.csv there (header written at once).
-  /// Throws std::runtime_error when the folder or files cannot be written.
-  explicit RunRecorder(const std::string& out_dir);
+  /// `append` (a logger restarted within the same run): the files are continued, and the
+  /// ANCHOR_INITs of anchor_init.yaml are taken back. Throws std::runtime_error when the folder
+  /// or files cannot be written.
+  explicit RunRecorder(const std::string& out_dir, bool append = false);
   ~RunRecorder();
 
   /// Any message on any channel (for the summary), received at `wall_utime`.

@@ -15,6 +15,12 @@
 ///   by one jump all run, in order). Commands carry the data time at which they are issued.
 ///   collect/calibrate/abort → one CALIB_CMD; remove → one ESTIMATOR_CMD RemoveInstance per id.
 ///   Data time going backwards never re-runs a step (counted as "time_backwards").
+/// - **Resends** (a lossy link, docs/deployment.md): a CALIB_CMD counts as answered once a
+///   CALIB_STATUS shows its effect — Collect: its anchors (all: every listed one) no longer `idle`;
+///   Calibrate: its anchors `calibrated` or `refused` (all: none `collecting`); Abort: none of its
+///   anchors `collecting`. Until then it is sent again (with the current data time) every
+///   `resend_period_s` of data time, at most `max_resends` times ("calib_cmd_resent"); the
+///   calibrator takes a repeated command as a no-op (already calibrated, already collecting).
 /// - **Status** (MISSION_STATUS, the heartbeat) every `status_period_s` of data time and right
 ///   after a step ran: index of the last executed step, step count and a text with the next step
 ///   and the calibrator's per-anchor states from CALIB_STATUS (refusals are also logged).
@@ -24,6 +30,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "common/diagnostics.h"
 #include "common/messages.h"
@@ -40,6 +47,9 @@ struct MissionSinks {
 
 struct MissionNodeOptions {
   double status_period_s = 1.0;  ///< MISSION_STATUS period in data time [s] (> 0)
+  double resend_period_s = 0.0;  ///< unanswered CALIB_CMD sent again after this data time [s] (0 = never; the
+                                 ///< mission process: --resend-period, 1 s)
+  int max_resends = 30;          ///< ... at most this many times each [-]
 };
 
 class MissionNode {
@@ -67,6 +77,10 @@ class MissionNode {
 
  private:
   void runStep(const MissionStep& step);
+  void sendCalib(const CalibCommand& c);
+  /// Whether the last CALIB_STATUS shows the effect of `c`.
+  bool answered(const CalibCommand& c) const;
+  void resendUnanswered();
   void publishStatus();
   std::string text() const;
 
@@ -81,6 +95,12 @@ class MissionNode {
   std::optional<Timestamp> next_status_;
   std::map<SensorId, CalibAnchorStatus> calib_;  ///< last CALIB_STATUS per anchor
   bool estimator_initialized_ = false;
+  struct Sent {
+    CalibCommand cmd;
+    Timestamp last;
+    int resends = 0;
+  };
+  std::vector<Sent> unanswered_;  ///< CALIB_CMDs whose effect no CALIB_STATUS has shown yet
 };
 
 }  // namespace meshnav::mission

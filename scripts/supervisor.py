@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """meshnav supervisor: runs the processes of a launch file (python3 and PyYAML).
 
-Usage: supervisor.py LAUNCH.yaml [VAR=value ...] [--dry-run] [--stop-timeout S]
+Usage: supervisor.py LAUNCH.yaml [VAR=value ...] [--host NAME] [--list-hosts] [--dry-run] [--stop-timeout S]
 
 Launch file (YAML, read with yaml.safe_load; a key given twice is an error):
 
@@ -24,6 +24,13 @@ Launch file (YAML, read with yaml.safe_load; a key given twice is an error):
         delay: 0.0           # s after the launch start before this process starts
         env: {MESHNAV_LOG_LEVEL: info}
         cwd: .
+        host: uav            # the machine it runs on (multi-host launch files, docs/deployment.md)
+
+--host NAME starts only the processes whose host: is NAME (run it on each machine, or in each
+network namespace of scripts/multihost_netns.sh); shutdown_after then counts only that host's
+processes. Without --host every process starts here. --list-hosts prints the host names, one a
+line, each followed by "stops" (it has shutdown_after processes: it stops by itself) or "runs" (it
+runs until stopped, like a ground station).
 
 ${VAR} and ${VAR:-default} in any string are replaced by VAR=value arguments, else the
 environment; an unknown variable without default is an error naming it. Built in: ${T0_UTIME},
@@ -116,7 +123,7 @@ def _arg_text(a):
 
 class ProcSpec:
     KEYS = {'name', 'command', 'args', 'required', 'respawn', 'respawn_delay', 'respawn_delay_max',
-            'max_respawns', 'delay', 'env', 'cwd'}
+            'max_respawns', 'delay', 'env', 'cwd', 'host'}
     RESPAWN = {False: 'never', True: 'always', 'never': 'never', 'always': 'always',
                'on-failure': 'on-failure'}
 
@@ -154,6 +161,10 @@ class ProcSpec:
             raise LaunchError('%s: env must be a map NAME: value' % where)
         self.env = {str(k): '' if v is None else str(v) for k, v in env.items()}
         self.cwd = d.get('cwd')
+        host = d.get('host')
+        if host is not None and (not isinstance(host, str) or not re.fullmatch(r'[A-Za-z0-9_.-]+', host)):
+            raise LaunchError('%s: host must be a name (letters, digits, _ . -), got %r' % (where, host))
+        self.host = host
 
     def restarts_after(self, code):
         """Whether an exit with `code` (negative: killed by that signal) calls for a restart."""
@@ -218,6 +229,25 @@ class Launch:
         for n in self.shutdown_after:
             if n not in names:
                 raise LaunchError('%s: shutdown_after names unknown process %r' % (path, n))
+        self.path = path
+
+    def hosts(self):
+        """Host names in the order of their first process."""
+        out = []
+        for p in self.procs:
+            if p.host is not None and p.host not in out:
+                out.append(p.host)
+        return out
+
+    def select_host(self, host):
+        """Keeps only the processes of `host` (shutdown_after likewise)."""
+        if host not in self.hosts():
+            raise LaunchError('%s: no process has host %r (hosts: %s)' % (self.path, host,
+                                                                          ', '.join(self.hosts()) or 'none'))
+        self.procs = [p for p in self.procs if p.host == host]
+        names = {p.name for p in self.procs}
+        self.shutdown_after = [n for n in self.shutdown_after if n in names]
+        self.name = '%s@%s' % (self.name, host)
 
 
 # ------------------------------------------------------------------------------------ supervisor
@@ -374,7 +404,19 @@ def main(argv):
         print(__doc__)
         return 0 if args else 2
     dry_run = '--dry-run' in args
-    args = [a for a in args if a != '--dry-run']
+    list_hosts = '--list-hosts' in args
+    args = [a for a in args if a not in ('--dry-run', '--list-hosts')]
+    host = None
+    if '--host' in args:
+        i = args.index('--host')
+        if i + 1 >= len(args) or args[i + 1].startswith('-') or '=' in args[i + 1]:
+            print('supervisor: --host needs a host name', file=sys.stderr)
+            return 2
+        host = args[i + 1]
+        del args[i:i + 2]
+    if not args:
+        print('supervisor: no launch file given', file=sys.stderr)
+        return 2
     stop_timeout = None
     if '--stop-timeout' in args:
         i = args.index('--stop-timeout')
@@ -394,6 +436,13 @@ def main(argv):
         variables[k] = v
     try:
         launch = Launch(launch_path, variables)
+        if list_hosts:
+            for h in launch.hosts():
+                stops = any(p.host == h and p.name in launch.shutdown_after for p in launch.procs)
+                print('%s %s' % (h, 'stops' if stops else 'runs'))
+            return 0
+        if host is not None:
+            launch.select_host(host)
     except LaunchError as e:
         print('supervisor: %s' % e, file=sys.stderr)
         return 2
@@ -402,7 +451,7 @@ def main(argv):
     if dry_run:
         for p in launch.procs:
             flags = (['required'] if p.required else []) + (['respawn ' + p.respawn] if p.respawn != 'never' else [])
-            print('%s%s: %s' % (p.name, ' [' + ', '.join(flags) + ']' if flags else '',
+            print('%s%s%s: %s' % (p.name, '@' + p.host if p.host else '', ' [' + ', '.join(flags) + ']' if flags else '',
                                 ' '.join(shlex.quote(a) for a in p.argv)))
         return 0
     sup = Supervisor(launch)

@@ -19,11 +19,13 @@ inline constexpr const char* kEstimatorCmd = "ESTIMATOR_CMD";       ///< estimat
 inline constexpr const char* kCalibCmd = "CALIB_CMD";               ///< calib_cmd_t, mission → calibrator
 inline constexpr const char* kCalibStatus = "CALIB_STATUS";         ///< calib_status_t (heartbeat)
 inline constexpr const char* kMissionStatus = "MISSION_STATUS";     ///< mission_status_t (heartbeat)
+inline constexpr const char* kTimeSyncRequest = "TIME_SYNC_REQUEST"; ///< time_sync_t, bridges → estimator (clock reference)
+inline constexpr const char* kTimeSync = "TIME_SYNC";                ///< time_sync_t, estimator → bridges (replies)
 
 /// Every channel above, for tools that list or record them.
 inline constexpr const char* kAll[] = {kImu,         kBaro,           kRange,           kFlightState,
                                        kGroundTruth, kAnchorInit,     kPose,            kAnchors,
                                        kEstimatorStatus, kEstimatorCmd, kCalibCmd,     kCalibStatus,
-                                       kMissionStatus, kHeight};
+                                       kMissionStatus, kHeight, kTimeSyncRequest, kTimeSync};
 
 }  // namespace meshnav::channels

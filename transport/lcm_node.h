@@ -65,6 +65,18 @@ class LcmNode {
     });
   }
 
+  /// As subscribeLcm, with the wall time [µs] at which LCM received the message (taken by LCM's
+  /// receive thread, so it does not include the time the message waited in the queue).
+  template <class Msg>
+  void subscribeLcmStamped(const std::string& channel,
+                           std::function<void(const Msg&, int64_t recv_utime)> fn) {
+    subscribeRaw(channel, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+      Msg msg;
+      if (!decode(rbuf, ch, msg)) return;
+      guarded(ch, [&] { fn(msg, rbuf.recv_utime); });
+    });
+  }
+
   /// Subscription delivering the plain struct (common/types.h, common/messages.h): decoded and
   /// converted with fromLcm (which validates: NaN, unknown codes → "<CHANNEL>:invalid_message").
   template <class Plain>

@@ -5,6 +5,7 @@
 /// one file per device as in the real recording (a01_ranges.csv, ..., d01_ranges.csv) — merged
 /// into one time-sorted stream. Bad rows are reported with file:line and counted (common/dataset.h).
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,11 @@ namespace meshnav::uwb {
 /// Throws std::runtime_error when a file is missing or lacks a required column.
 std::vector<RangeSample> importRangeCsv(const std::vector<std::string>& paths, Diagnostics& diag,
                                         const RangeLimits& limits = {});
+
+/// Keeps the ranges whose initiator (UWB_ID1) is in `initiators` (all when it is empty), in their
+/// order: what the computer of one anchor publishes in a multi-host deployment, where each device
+/// reports the ranges it initiated. Returns the number of ranges removed.
+size_t keepInitiators(std::vector<RangeSample>& ranges, const std::set<SensorId>& initiators);
 
 /// Splits "a.csv,b.csv" (and trims blanks) into paths.
 std::vector<std::string> splitPathList(const std::string& list);

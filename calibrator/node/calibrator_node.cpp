@@ -113,6 +113,16 @@ void CalibratorNode::onRange(const RangeSample& r) {
       return;
     }
   }
+  // A range that comes a second time (a network that duplicates datagrams) is not collected
+  // twice: keys (time, ids) are kept over time_max_offset of data time.
+  if (newest_) {
+    const int64_t oldest = (*newest_ - Duration::fromSec(node_options_.time.max_offset_s)).us;
+    while (!seen_ranges_.empty() && std::get<0>(*seen_ranges_.begin()) < oldest) seen_ranges_.erase(seen_ranges_.begin());
+  }
+  if (!seen_ranges_.emplace(r.t.us, r.id_initiator, r.id_responder).second) {
+    diag_.report("RANGE:duplicate", describe(r) + " came a second time; dropped");
+    return;
+  }
   advance(r.t);
   bool kept = false, idle = false;
   for (const auto& [x, type] : {std::make_pair(r.id_initiator, r.type_initiator),
@@ -478,9 +488,9 @@ void CalibratorNode::runPeriodic() {
     if (next_prune_) pruneOldTagRanges();
     next_prune_ = now + Duration::fromSec(kPruneSlackS);
   }
-  if (node_options_.auto_mode) {
-    for (auto& [x, tr] : tracks_)
-      if (tr.state == State::Collecting || tr.state == State::Refused) checkAuto(x, tr);
+  for (auto& [x, tr] : tracks_) {
+    if (node_options_.auto_mode && (tr.state == State::Collecting || tr.state == State::Refused)) checkAuto(x, tr);
+    else if (node_options_.retry_refused && tr.state == State::Refused) checkAuto(x, tr);
   }
   const Duration period = Duration::fromSec(node_options_.status_period_s);
   if (!next_status_) next_status_ = now;

@@ -49,6 +49,9 @@
 /// bad_range, unknown_device, bad_pose, pose_too_old, poses_out_of_order, bad_anchor_estimate,
 /// bad_command, calibrations_ok, calibrations_refused.
 ///
+/// **Duplicates**: a range with the time and ids of one already received (within
+/// `time_max_offset` of data time) is dropped and counted ("RANGE:duplicate").
+///
 /// **Bad input** (non-finite or absurd range, self-range, ids ≤ 0, tag-typed ids not in the setup,
 /// the IMU/baro ids, non-finite poses or covariances, poses older than the history window) is
 /// logged, counted and dropped; it never throws. Not thread-safe: call from one thread.
@@ -57,7 +60,9 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "calibrator/anchor_calibrator.h"
@@ -163,6 +168,7 @@ class CalibratorNode {
   std::vector<PoseEstimate> poses_;  ///< sorted by time, within the history window
   std::map<SensorId, AnchorEstimate> beliefs_;
   std::map<SensorId, Track> tracks_;
+  std::set<std::tuple<int64_t, SensorId, SensorId>> seen_ranges_;  ///< (µs, ids) within time_max_offset
   bool collect_new_anchors_ = true;
   std::vector<CalibrationResult> results_;
   std::optional<Timestamp> newest_;

@@ -19,6 +19,7 @@ void visitOptions(Opts& o, F&& f) {
   f("auto_min_line_spread", o.auto_min_line_spread_m);
   f("auto_check_period", o.auto_check_period_s);
   f("auto_retry_period", o.auto_retry_period_s);
+  f("retry_refused", o.retry_refused);
   f("collect_from_start", o.collect_from_start);
   f("history_window", o.history_window_s);
   f("max_ranges_per_anchor", o.max_ranges_per_anchor);

@@ -13,6 +13,7 @@
 ///   auto_min_line_spread: 0.5     # RMS of tag positions off their best line [m]
 ///   auto_check_period: 1.0        # how often the criterion is evaluated (data time) [s]
 ///   auto_retry_period: 10.0       # wait after an automatic calibration was refused [s]
+///   retry_refused: true           # also without auto_mode: retry a refused anchor by the criterion
 ///   collect_from_start: true      # collect every unknown anchor from its first range
 ///   history_window: 300.0         # pose history and tag ranges kept [s]
 ///   max_ranges_per_anchor: 20000  # the oldest range is evicted beyond this [-]
@@ -30,6 +31,11 @@
 ///  3. the library's refusal checks (`checkReferenceGeometry`) pass with the stricter spreads
 ///     `auto_min_plane_spread` / `auto_min_line_spread`: the tag positions span a volume, not
 ///     just the plane of a hover or the line of a take-off.
+///
+/// **Retry of refused anchors** (`retry_refused`, also when a mission drives the calibrator): an
+/// anchor refused by a Calibrate command keeps collecting and is tried again by the same criterion
+/// once `auto_retry_period` has passed and new data makes it pass (a calibration refused for too
+/// few or too coplanar data is not final).
 
 #include <string>
 
@@ -48,6 +54,7 @@ struct CalibratorNodeOptions {
   double auto_min_line_spread_m = 0.5;
   double auto_check_period_s = 1.0;
   double auto_retry_period_s = 10.0;
+  bool retry_refused = true;  ///< retry refused anchors by the automatic criterion, also without auto_mode
 
   // --- collection and memory --------------------------------------------------------------
   bool collect_from_start = true;   ///< false: an anchor is collected only after a Collect naming it (or all)

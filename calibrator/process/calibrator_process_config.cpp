@@ -30,6 +30,11 @@ void declareCalibratorProcessOptions(Cli& cli, CalibratorProcessConfig& c) {
   cli.flag("auto", c.auto_requested,
            "calibrate automatically once an anchor's data suffices (when no mission drives the calibrator; sets "
            "calibrator_node.auto_mode)");
+  cli.optional("state-dir", c.state_dir,
+               "folder of the input journal (calibrator_inputs.lcmlog): every RANGE, decimated POSE, ANCHORS and "
+               "CALIB_CMD the node consumed, flushed at once; a restarted calibrator replays it first and so keeps "
+               "what it had collected and calibrated (docs/faults.md)")
+      ->type_name("DIR");
   cli.optional("out-yaml", c.out_yaml,
                "write the calibration results YAML (calibrator/calibration_io.h) after every calibration and on exit")
       ->type_name("FILE");
@@ -68,6 +73,7 @@ std::string CalibratorProcessConfig::toString() const {
   s << "  setup: " << (setup_path.empty() ? "(none)" : setup_path) << "\n";
   s << "  config: " << (config_path.empty() ? "(built-in defaults)" : config_path) << "\n";
   s << "  out_yaml: " << (out_yaml.empty() ? "(none)" : out_yaml) << "\n";
+  s << "  state_dir: " << (state_dir.empty() ? "(none)" : state_dir) << "\n";
   s << "  pose_rate: " << pose_rate_hz << "  # [Hz], 0 = every pose\n";
   s << "  heartbeat: " << heartbeat_s << "  # [s] wall time\n";
   return s.str();

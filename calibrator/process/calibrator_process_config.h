@@ -22,6 +22,7 @@ struct CalibratorProcessConfig {
   std::string setup_path;           ///< --setup (required to run)
   std::string config_path;          ///< --config ("" = built-in defaults)
   std::string out_yaml;             ///< --out-yaml ("" = none)
+  std::string state_dir;            ///< --state-dir: input journal of a restart ("" = none)
   double pose_rate_hz = 50.0;       ///< --pose-rate: POSE decimation towards the node (0 = every pose) [Hz]
   double heartbeat_s = 1.0;         ///< --heartbeat: wall time between CALIB_STATUS heartbeats [s]
   bool print_config = false;        ///< --print-config

@@ -3,6 +3,8 @@
 /// CALIB_STATUS goes out at the node's data-time rate, after every Calibrate command and, as the
 /// process heartbeat, every --heartbeat seconds of wall time (also while no data flows).
 #include <cmath>
+#include <filesystem>
+#include <memory>
 #include <iostream>
 #include <optional>
 
@@ -10,6 +12,7 @@
 #include "calibrator/process/calibrator_process_config.h"
 #include "common/setup.h"
 #include "transport/channels.h"
+#include "transport/input_journal.h"
 #include "transport/process_main.h"
 
 namespace {
@@ -51,12 +54,15 @@ int main(int argc, char** argv) {
       return 0;
     }
     transport::LcmNode& lcm = process.lcm();
+    bool replaying = false;  // while the journal is replayed: the results are known to the others
     calib::CalibratorSinks sinks;
     sinks.anchor_init = [&](const AnchorInit& a) {
       logAnchorInit(a);
-      lcm.publish(channels::kAnchorInit, a);
+      if (!replaying) lcm.publish(channels::kAnchorInit, a);
     };
-    sinks.status = [&](const CalibStatus& s) { lcm.publish(channels::kCalibStatus, process.stamped(s)); };
+    sinks.status = [&](const CalibStatus& s) {
+      if (!replaying) lcm.publish(channels::kCalibStatus, process.stamped(s));
+    };
     calib::CalibratorNode node(config.calibrator, setup, sinks, config.node);
     spdlog::info("calibrator options:\n{}", config.toString());
 
@@ -69,22 +75,58 @@ int main(int argc, char** argv) {
     };
     std::optional<Timestamp> last_pose;
     const Duration pose_period = Duration::fromSec(config.pose_rate_hz > 0 ? 1.0 / config.pose_rate_hz : 0.0);
-    lcm.subscribe<RangeSample>(channels::kRange, [&](const RangeSample& r) {
+    // What the node consumed goes to the journal first, so a kill -9 right after loses nothing.
+    std::unique_ptr<transport::InputJournal> journal;
+    auto journaled = [&](const std::string& channel, const auto& value, Timestamp t) {
+      if (journal && !replaying) journal->write(channel, value, t.us);
+    };
+    auto onRange = [&](const RangeSample& r) {
+      journaled(channels::kRange, r, r.t);
       node.onRange(r);
       writeResults(false);  // automatic mode calibrates on data
-    });
-    lcm.subscribe<PoseEstimate>(channels::kPose, [&](const PoseEstimate& p) {
+    };
+    auto onPose = [&](const PoseEstimate& p) {
       if (last_pose && p.t >= *last_pose && p.t - *last_pose < pose_period) return;  // decimation
       last_pose = p.t;
+      journaled(channels::kPose, p, p.t);
       node.onPose(p);
       writeResults(false);
-    });
-    lcm.subscribe<std::vector<AnchorEstimate>>(channels::kAnchors,
-                                               [&](const std::vector<AnchorEstimate>& a) { node.onAnchors(a); });
-    lcm.subscribe<CalibCommand>(channels::kCalibCmd, [&](const CalibCommand& c) {
+    };
+    auto onAnchors = [&](const std::vector<AnchorEstimate>& a) {
+      journaled(channels::kAnchors, a, a.empty() ? Timestamp{} : a.front().t);
+      node.onAnchors(a);
+    };
+    auto onCommand = [&](const CalibCommand& c) {
+      journaled(channels::kCalibCmd, c, c.t);
       node.onCommand(c);
       writeResults(false);
-    });
+    };
+    if (!config.state_dir.empty()) {
+      const std::string path = (std::filesystem::path(config.state_dir) / "calibrator_inputs.lcmlog").string();
+      replaying = true;
+      Diagnostics& diag = lcm.diagnostics();
+      const int64_t n = transport::InputJournal::read(path, [&](const std::string& ch, const lcm::ReceiveBuffer& rb) {
+        RangeSample r;
+        PoseEstimate p;
+        std::vector<AnchorEstimate> a;
+        CalibCommand c;
+        if (ch == channels::kRange && transport::InputJournal::decode(rb, ch, r, diag)) onRange(r);
+        if (ch == channels::kPose && transport::InputJournal::decode(rb, ch, p, diag)) onPose(p);
+        if (ch == channels::kAnchors && transport::InputJournal::decode(rb, ch, a, diag)) onAnchors(a);
+        if (ch == channels::kCalibCmd && transport::InputJournal::decode(rb, ch, c, diag)) onCommand(c);
+      });
+      replaying = false;
+      if (n > 0) {
+        const CalibStatus st = node.status();
+        spdlog::warn("restart: {} inputs replayed from {} (data time {} s); anchors: {}", n, path,
+                     node.dataTime() ? formatSeconds(*node.dataTime()) : std::string("none"), anchorStates(st));
+      }
+      journal = std::make_unique<transport::InputJournal>(path);
+    }
+    lcm.subscribe<RangeSample>(channels::kRange, onRange);
+    lcm.subscribe<PoseEstimate>(channels::kPose, onPose);
+    lcm.subscribe<std::vector<AnchorEstimate>>(channels::kAnchors, onAnchors);
+    lcm.subscribe<CalibCommand>(channels::kCalibCmd, onCommand);
     const int64_t progress_period_us = 10'000'000;  // a progress line every 10 s of wall time
     int64_t next_progress = replay::wallUtimeNow() + progress_period_us;
     process.heartbeat<CalibStatus>(channels::kCalibStatus, config.heartbeat_s, [&] { return node.status(); },

@@ -14,12 +14,14 @@ namespace meshnav {
 
 namespace {
 
-std::ofstream openOut(const std::string& path, const char* header) {
+std::ofstream openOut(const std::string& path, const char* header, bool append) {
   std::filesystem::path p(path);
   if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
-  std::ofstream out(path);
+  std::error_code ec;
+  const bool continues = append && std::filesystem::file_size(p, ec) > 0 && !ec;
+  std::ofstream out(path, continues ? std::ios::app : std::ios::trunc);
   if (!out) throw std::runtime_error(path + ": cannot write file");
-  out << header;
+  if (!continues) out << header;
   return out;
 }
 
@@ -41,7 +43,8 @@ std::optional<Eigen::Matrix3d> upper(const CsvRow& r, const char* const names[6]
 
 }  // namespace
 
-EstimateCsvWriter::EstimateCsvWriter(const std::string& path) : out_(openOut(path, kEstimateHeader)) {}
+EstimateCsvWriter::EstimateCsvWriter(const std::string& path, bool append)
+    : out_(openOut(path, kEstimateHeader, append)) {}
 
 void EstimateCsvWriter::write(const PoseEstimate& e) {
   const auto& P = e.cov_p_m2;
@@ -57,7 +60,8 @@ void EstimateCsvWriter::write(const PoseEstimate& e) {
 
 void EstimateCsvWriter::flush() { out_.flush(); }
 
-AnchorsCsvWriter::AnchorsCsvWriter(const std::string& path) : out_(openOut(path, kAnchorsHeader)) {}
+AnchorsCsvWriter::AnchorsCsvWriter(const std::string& path, bool append)
+    : out_(openOut(path, kAnchorsHeader, append)) {}
 
 void AnchorsCsvWriter::write(const AnchorEstimate& a) {
   const auto& P = a.cov_p_m2;

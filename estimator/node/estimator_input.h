@@ -6,6 +6,7 @@
 /// on arrival order.
 
 #include <cstdint>
+#include <iterator>
 #include <tuple>
 #include <variant>
 #include <vector>
@@ -30,6 +31,13 @@ struct InputOrder {
 
 inline Timestamp inputTime(const EstimatorInput& in) {
   return std::visit([](const auto& m) { return m.t; }, in);
+}
+
+/// Kind of an input as its channel name (counter prefix: "RANGE:duplicate", "IMU:time_ahead").
+inline const char* inputKindName(const EstimatorInput& in) {
+  static const char* const kNames[] = {"FLIGHT_STATE", "IMU", "BARO", "RANGE", "ANCHOR_INIT", "ESTIMATOR_CMD", "HEIGHT"};
+  static_assert(std::variant_size_v<EstimatorInput> == std::size(kNames));
+  return kNames[in.index()];
 }
 
 inline InputOrder inputOrder(const EstimatorInput& in) {

@@ -92,6 +92,7 @@ void EstimatorNode::resetAll() {
   history_.clear();
   pending_height_bias_.reset();
   last_align_height_.reset();
+  seen_.clear();
   baro_reference_pa_.reset();
   instance_stats_.clear();
   last_pose_pub_.reset();
@@ -146,6 +147,7 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   if (!validate(in_raw)) return;
   EstimatorInput in = in_raw;
   if (!admitTime(in)) return;
+  if (!admitOnce(in_raw)) return;
   // Commands are not measurements: they apply now (at the newest time) unless they are newer.
   if (newest_ && (std::holds_alternative<AnchorInit>(in) || std::holds_alternative<EstimatorCommand>(in))) {
     if (auto* a = std::get_if<AnchorInit>(&in)) a->t = std::max(a->t, *newest_);

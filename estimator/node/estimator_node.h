@@ -19,6 +19,9 @@
 ///   A snapshot is `FusionStrategy::clone()`: for dp/dah O(#instances) pointer copies
 ///   (copy-on-write instances), so the history is also each instance's belief/factor history.
 ///   Step timings include "rewind" (restore + re-processing of one late input).
+/// - An input that comes a second time (same kind, time and ids: a network that duplicates
+///   datagrams, a sender that retransmits) is dropped and counted ("RANGE:duplicate", ...), so a
+///   range is never fused twice; keys are kept over the out-of-sequence window.
 /// - IMU samples propagate (inputs interpolated to the middle of the step); baro and range
 ///   updates propagate to their own time with the latest reading held. While landed a
 ///   zero-velocity update runs at `zupt.rate_hz` with the latest IMU reading.
@@ -39,6 +42,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <vector>
 
 #include "common/diagnostics.h"
@@ -137,6 +141,8 @@ class EstimatorNode {
   bool validate(const EstimatorInput& in);
   /// The time guard on `in` (may restamp a command); false: refused and counted.
   bool admitTime(EstimatorInput& in);
+  /// False (counted "<KIND>:duplicate") when an input with the same key came before.
+  bool admitOnce(const EstimatorInput& in);
   void feedInitializer(const EstimatorInput& in);
   void initialize(const InitialBelief& b);
   /// Processes one input on `cur_`; `first` = first time (count events, publish).
@@ -201,6 +207,7 @@ class EstimatorNode {
 
   Snapshot cur_;
   std::deque<Entry> history_;
+  std::set<InputOrder> seen_;  ///< keys of the inputs admitted within the window (duplicates)
   std::optional<Timestamp> newest_;   ///< newest input time seen (also before init)
   TimeGuard time_guard_;
   Timestamp init_time_;

@@ -10,13 +10,6 @@ namespace meshnav::estimator {
 
 namespace {
 
-/// Input kind as its channel name (counter prefix).
-const char* kindName(const EstimatorInput& in) {
-  static const char* const kNames[] = {"FLIGHT_STATE", "IMU", "BARO", "RANGE", "ANCHOR_INIT", "ESTIMATOR_CMD", "HEIGHT"};
-  static_assert(std::variant_size_v<EstimatorInput> == std::size(kNames));
-  return kNames[in.index()];
-}
-
 Timestamp& stamp(EstimatorInput& in) {
   return std::visit([](auto& m) -> Timestamp& { return m.t; }, in);
 }
@@ -24,7 +17,7 @@ Timestamp& stamp(EstimatorInput& in) {
 }  // namespace
 
 bool EstimatorNode::admitTime(EstimatorInput& in) {
-  const std::string kind = kindName(in);
+  const std::string kind = inputKindName(in);
   Timestamp& t = stamp(in);
   const Duration max_offset = Duration::fromSec(options_.time.max_offset_s);
   // Commands are not measurements and do not drive the clock: far from it, they apply now.
@@ -52,6 +45,22 @@ bool EstimatorNode::admitTime(EstimatorInput& in) {
                                         options_.imu.gyro_noise_density, options_.gravity_m_s2);
     have_flight_state_ = false;
     last_pressure_pa_.reset();
+  }
+  return true;
+}
+
+bool EstimatorNode::admitOnce(const EstimatorInput& in) {
+  const InputOrder key = inputOrder(in);
+  if (newest_) {
+    // Keys older than the window are forgotten: such an input is refused as too old anyway.
+    const int64_t oldest = (*newest_ - Duration::fromSec(options_.window_s)).us;
+    while (!seen_.empty() && seen_.begin()->t_us < oldest) seen_.erase(seen_.begin());
+  }
+  if (!seen_.insert(key).second) {
+    const std::string kind = inputKindName(in);
+    diag_.report(kind + ":duplicate", kind + " at t=" + formatSeconds(inputTime(in)) +
+                                          " came a second time (same time and ids); dropped");
+    return false;
   }
   return true;
 }

@@ -13,6 +13,7 @@
 #include "estimator/node/estimator_node.h"
 #include "transport/channels.h"
 #include "transport/process_main.h"
+#include "transport/time_sync.h"
 
 int main(int argc, char** argv) {
   using namespace meshnav;
@@ -89,6 +90,9 @@ int main(int argc, char** argv) {
     lcm.subscribe<FlightStateSample>(channels::kFlightState, [&](const FlightStateSample& s) { node.onFlightState(s); });
     lcm.subscribe<AnchorInit>(channels::kAnchorInit, [&](const AnchorInit& a) { node.onAnchorInit(a); });
     lcm.subscribe<EstimatorCommand>(channels::kEstimatorCmd, [&](const EstimatorCommand& c) { node.onCommand(c); });
+    // This host's clock is the reference of every stamp the estimator fuses: bridges on other
+    // hosts estimate their offset to it (transport/time_sync.h, docs/deployment.md).
+    transport::serveTimeSync(lcm);
 
     bool was_initialized = false;
     process.heartbeat<EstimatorStatus>(channels::kEstimatorStatus, heartbeat_s, [&] { return node.status(); },

@@ -26,12 +26,14 @@ void writeYaml(const YAML::Emitter& e, const std::string& path) {
 
 }  // namespace
 
-RunRecorder::RunRecorder(const std::string& out_dir) : out_dir_(out_dir) {
+RunRecorder::RunRecorder(const std::string& out_dir, bool append) : out_dir_(out_dir) {
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec) throw std::runtime_error(out_dir + ": cannot create folder: " + ec.message());
-  estimate_ = std::make_unique<EstimateCsvWriter>((fs::path(out_dir) / "estimate.csv").string());
-  anchors_ = std::make_unique<AnchorsCsvWriter>((fs::path(out_dir) / "anchors.csv").string());
+  estimate_ = std::make_unique<EstimateCsvWriter>((fs::path(out_dir) / "estimate.csv").string(), append);
+  anchors_ = std::make_unique<AnchorsCsvWriter>((fs::path(out_dir) / "anchors.csv").string(), append);
+  const fs::path inits = fs::path(out_dir) / "anchor_init.yaml";
+  if (append && fs::exists(inits)) anchor_inits_ = readAnchorInitsYaml(inits.string());
 }
 
 RunRecorder::~RunRecorder() = default;
@@ -56,7 +58,10 @@ void RunRecorder::onAnchors(const std::vector<AnchorEstimate>& anchors) {
   }
 }
 
-void RunRecorder::onAnchorInit(const AnchorInit& a) { anchor_inits_.push_back(a); }
+void RunRecorder::onAnchorInit(const AnchorInit& a) {
+  anchor_inits_.push_back(a);
+  writeAnchorInitsYaml(anchor_inits_, (fs::path(out_dir_) / "anchor_init.yaml").string());
+}
 
 void RunRecorder::onGroundTruth(const PoseSample& p) { ground_truth_.push_back(p); }
 

@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
     sinks.calib_cmd = [&](const CalibCommand& c) { lcm.publish(channels::kCalibCmd, c); };
     sinks.estimator_cmd = [&](const EstimatorCommand& c) { lcm.publish(channels::kEstimatorCmd, c); };
     sinks.status = [&](const MissionStatus& s) { lcm.publish(channels::kMissionStatus, process.stamped(s)); };
-    mission::MissionNode node(script, sinks, mission::MissionNodeOptions{config.status_period_s});
+    mission::MissionNode node(script, sinks, mission::MissionNodeOptions{config.status_period_s, config.resend_period_s});
     if (config.t0_s) node.setT0(Timestamp::fromSec(*config.t0_s));
     mission::MissionCompletion completion(script, config.linger_s);
     spdlog::info("mission {}: {} steps; options:\n{}", config.mission_path, script.steps.size(), config.toString());

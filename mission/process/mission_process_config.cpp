@@ -32,6 +32,11 @@ void declareMissionProcessOptions(Cli& cli, MissionProcessConfig& c) {
   cli.option("status-period", c.status_period_s, "MISSION_STATUS period in data time [s]")
       ->type_name("S")
       ->check(cli::positive());
+  cli.option("resend-period", c.resend_period_s,
+             "data seconds after which a CALIB_CMD whose effect no CALIB_STATUS shows yet is sent again (a lossy "
+             "link; at most 30 times; 0 = never)")
+      ->type_name("S")
+      ->check(cli::nonNegative());
   cli.option("heartbeat", c.heartbeat_s, "wall seconds between heartbeat MISSION_STATUS")
       ->type_name("S")
       ->check(cli::positive());
@@ -80,6 +85,7 @@ std::string MissionProcessConfig::toString() const {
   s << "stay: " << (stay ? "true" : "false") << "\n";
   s << "linger: " << linger_s << "  # [s] wall time\n";
   s << "status_period: " << status_period_s << "  # [s] data time\n";
+  s << "resend_period: " << resend_period_s << "  # [s] data time\n";
   s << "heartbeat: " << heartbeat_s << "  # [s] wall time\n";
   return s.str();
 }

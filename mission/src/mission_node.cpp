@@ -11,6 +11,7 @@ namespace meshnav::mission {
 MissionNode::MissionNode(Mission mission, MissionSinks sinks, MissionNodeOptions options)
     : mission_(std::move(mission)), sinks_(std::move(sinks)), options_(options) {
   if (!(options_.status_period_s > 0.0)) throw std::invalid_argument("mission status_period_s must be > 0");
+  if (!(options_.resend_period_s >= 0.0)) throw std::invalid_argument("mission resend_period_s must be >= 0");
 }
 
 void MissionNode::setT0(Timestamp t0) {
@@ -32,7 +33,7 @@ void MissionNode::onTime(Timestamp t) {
       CalibCommand c;
       c.t = t;
       c.action = CalibCommand::Action::Collect;
-      sinks_.calib_cmd(c);
+      sendCalib(c);
     }
   } else if (t < now_) {
     diag_.count("time_backwards");
@@ -40,6 +41,7 @@ void MissionNode::onTime(Timestamp t) {
   } else {
     now_ = t;
   }
+  resendUnanswered();
   bool ran = false;
   while (next_step_ < mission_.steps.size() &&
          now_ >= *t0_ + Duration::fromSec(mission_.steps[next_step_].t_s)) {
@@ -71,7 +73,7 @@ void MissionNode::runStep(const MissionStep& step) {
                  : step.action == MissionAction::Calibrate ? CalibCommand::Action::Calibrate
                                                            : CalibCommand::Action::Abort;
       c.anchors = step.anchors;
-      if (sinks_.calib_cmd) sinks_.calib_cmd(c);
+      sendCalib(c);
       break;
     }
     case MissionAction::Remove:
@@ -83,6 +85,58 @@ void MissionNode::runStep(const MissionStep& step) {
         if (sinks_.estimator_cmd) sinks_.estimator_cmd(c);
       }
       break;
+  }
+}
+
+void MissionNode::sendCalib(const CalibCommand& c) {
+  if (!sinks_.calib_cmd) return;
+  sinks_.calib_cmd(c);
+  if (options_.resend_period_s > 0) unanswered_.push_back({c, c.t, 0});
+}
+
+bool MissionNode::answered(const CalibCommand& c) const {
+  auto state = [&](SensorId id) {
+    const auto it = calib_.find(id);
+    return it == calib_.end() ? std::string() : it->second.state;
+  };
+  std::vector<SensorId> ids = c.anchors;
+  if (ids.empty()) {
+    if (calib_.empty()) return false;  // no status with anchors yet
+    for (const auto& [id, a] : calib_) ids.push_back(id);
+  }
+  for (SensorId id : ids) {
+    const std::string s = state(id);
+    switch (c.action) {
+      case CalibCommand::Action::Collect:
+        if (s.empty() || s == "idle") return false;
+        break;
+      case CalibCommand::Action::Calibrate:
+        if (c.anchors.empty() ? s == "collecting" : (s != "calibrated" && s != "refused")) return false;
+        break;
+      case CalibCommand::Action::Abort:
+        if (s == "collecting") return false;
+        break;
+    }
+  }
+  return true;
+}
+
+void MissionNode::resendUnanswered() {
+  const Duration period = Duration::fromSec(options_.resend_period_s);
+  for (auto it = unanswered_.begin(); it != unanswered_.end();) {
+    if (answered(it->cmd) || it->resends >= options_.max_resends) {
+      it = unanswered_.erase(it);
+      continue;
+    }
+    if (now_ - it->last >= period) {
+      it->cmd.t = now_;
+      it->last = now_;
+      ++it->resends;
+      diag_.count("calib_cmd_resent");
+      spdlog::info("mission: no answer of the calibrator yet; CALIB_CMD sent again ({})", it->resends);
+      sinks_.calib_cmd(it->cmd);
+    }
+    ++it;
   }
 }
 

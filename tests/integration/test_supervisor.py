@@ -349,5 +349,78 @@ class ShippedLaunchFiles(unittest.TestCase):
                 if p.name in ('calibrator', 'mission'):
                     self.assertFalse(p.required, where)
 
+
+class Hosts(unittest.TestCase):
+    """host: per process, --host NAME, --list-hosts (multi-host launch files, docs/deployment.md)."""
+    TEXT = '''
+shutdown_after: [a_bridge, u_bridge]
+shutdown_delay: 0.1
+processes:
+  - {name: u_main, host: uav, command: sleep 60, required: true}
+  - {name: u_bridge, host: uav, command: "sh -c 'echo uav bridge done'"}
+  - {name: a_bridge, host: anchor1, command: "sh -c 'echo anchor bridge done'"}
+  - {name: g_log, host: ground, command: sleep 60}
+'''
+
+    def test_list_hosts_says_which_stop_by_themselves(self):
+        rc, out, err = run_launch(self.TEXT, '--list-hosts')
+        self.assertEqual(rc, 0, err)
+        self.assertEqual(out.split('\n')[:3], ['uav stops', 'anchor1 stops', 'ground runs'])
+
+    def test_host_starts_only_its_processes_and_stops_on_its_shutdown_after(self):
+        rc, out, _ = run_launch(self.TEXT, '--host', 'uav')
+        self.assertEqual(rc, 0, out)
+        self.assertIn('[u_bridge] uav bridge done', out)
+        self.assertNotIn('a_bridge', out)  # another host's shutdown_after process is not waited for
+        self.assertNotIn('g_log', out)
+        self.assertIn('stopping (every shutdown_after process has exited)', out)
+        rc, out, _ = run_launch(self.TEXT, '--host', 'anchor1', '--dry-run')
+        self.assertEqual(rc, 0, out)
+        self.assertEqual(out.strip().split('\n'), ["a_bridge@anchor1: sh -c 'echo anchor bridge done'"])
+
+    def test_a_host_without_shutdown_after_runs_until_stopped(self):
+        with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
+            f.write(self.TEXT)
+        try:
+            p = subprocess.Popen([sys.executable, SUPERVISOR, f.name, '--host', 'ground'], stdout=subprocess.PIPE,
+                                 text=True)
+            for line in p.stdout:
+                if 'started g_log' in line:
+                    break
+            self.assertIsNone(p.poll())
+            p.send_signal(signal.SIGTERM)
+            rest = p.stdout.read()
+            p.stdout.close()
+            self.assertEqual(p.wait(timeout=20), 0, rest)
+        finally:
+            os.unlink(f.name)
+
+    def test_unknown_host_and_bad_host_names_are_refused(self):
+        rc, _, err = run_launch(self.TEXT, '--host', 'nowhere')
+        self.assertEqual(rc, 2)
+        self.assertIn("no process has host 'nowhere' (hosts: uav, anchor1, ground)", err)
+        rc, _, err = run_launch('processes: [{name: x, command: "true", host: "a b"}]', '--dry-run')
+        self.assertEqual(rc, 2)
+        self.assertIn('host must be a name', err)
+        rc, _, err = run_launch(self.TEXT, '--host')
+        self.assertEqual(rc, 2)
+        self.assertIn('--host needs a host name', err)
+
+    def test_shipped_multihost_file_has_a_host_per_anchor_the_uav_and_the_ground(self):
+        launch = supervisor.Launch(os.path.join(SOURCE, 'config', 'launch', 'multihost.yaml'),
+                                   {'DATASET': '/d', 'OUT': '/o'})
+        hosts = launch.hosts()
+        self.assertGreaterEqual(len(hosts), 7)
+        self.assertEqual({p.host for p in launch.procs if p.name in ('estimator', 'calibrator', 'imu_bridge')},
+                         {'uav'})
+        self.assertEqual({p.host for p in launch.procs if p.name in ('mission', 'logging')}, {'ground'})
+        for h in [h for h in hosts if h.startswith('anchor')]:
+            procs = [p for p in launch.procs if p.host == h]
+            self.assertEqual(len(procs), 1, h)
+            self.assertIn('--initiators', procs[0].argv)
+            self.assertEqual(procs[0].argv[procs[0].argv.index('--initiators') + 1], h[len('anchor'):])
+        self.assertTrue(all(p.host for p in launch.procs))
+
+
 if __name__ == '__main__':
     unittest.main()

@@ -18,6 +18,13 @@ std::vector<RangeSample> importRangeCsv(const std::vector<std::string>& paths, D
   return all;
 }
 
+size_t keepInitiators(std::vector<RangeSample>& ranges, const std::set<SensorId>& initiators) {
+  if (initiators.empty()) return 0;
+  const size_t before = ranges.size();
+  std::erase_if(ranges, [&](const RangeSample& r) { return !initiators.count(r.id_initiator); });
+  return before - ranges.size();
+}
+
 std::vector<std::string> splitPathList(const std::string& list) {
   std::vector<std::string> out;
   size_t start = 0;

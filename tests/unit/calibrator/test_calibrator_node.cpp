@@ -226,7 +226,9 @@ TEST(CalibratorNode, EstimatorBeliefsReplaceTheCalibrationAsReferencePosition) {
 
 TEST(CalibratorNode, RefusesEarlyWithAReasonAndKeepsCollecting) {
   Outputs out;
-  CalibratorNode node(CalibratorOptions{}, setup(), sinksInto(out));
+  CalibratorNodeOptions o;
+  o.retry_refused = false;  // refused stays refused until the next command (the retry: next test)
+  CalibratorNode node(CalibratorOptions{}, setup(), sinksInto(out), o);
   replay(node, seed1().dataset, {{10.0, command(CalibCommand::Action::Calibrate, {106})}}, 10.01);
   EXPECT_TRUE(out.inits.empty());
   ASSERT_FALSE(out.statuses.empty());
@@ -567,6 +569,39 @@ TEST(CalibratorNode, FarStampedInputsAreRefusedAndChangeNothing) {
   EXPECT_EQ(out.statuses.size(), clean_out.statuses.size());
 }
 
+TEST(CalibratorNode, DuplicatedRangesAreCollectedOnce) {
+  // Issue 12: a network that duplicates datagrams must not weigh those ranges twice.
+  const auto cmds = std::vector<TimedCommand>{{80.0, command(CalibCommand::Action::Calibrate, {106, 107})}};
+  Outputs clean_out, out;
+  CalibratorNode clean(CalibratorOptions{}, setup(), sinksInto(clean_out));
+  replay(clean, seed1().dataset, cmds, 80.0);
+  Dataset dup = seed1().dataset;
+  dup.ranges.clear();
+  int64_t n_dup = 0;
+  const auto& ranges = seed1().dataset.ranges;
+  for (size_t i = 0; i < ranges.size(); ++i) {
+    dup.ranges.push_back(ranges[i]);
+    if (i % 20 == 7 && ranges[i].t.sec() <= 80.0) {  // 5 %: at once, or again 3 ranges later
+      if (i % 40 == 7) {
+        dup.ranges.push_back(ranges[i]);
+      } else if (i >= 3) {
+        dup.ranges.push_back(ranges[i - 3]);
+      }
+      ++n_dup;
+    }
+  }
+  CalibratorNode node(CalibratorOptions{}, setup(), sinksInto(out));
+  replay(node, dup, cmds, 80.0);
+  EXPECT_EQ(node.diagnostics().get("RANGE:duplicate"), n_dup);
+  EXPECT_GT(n_dup, 300);
+  ASSERT_EQ(clean_out.inits.size(), 2u);
+  ASSERT_EQ(out.inits.size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(out.inits[k].p_AinG, clean_out.inits[k].p_AinG);
+    EXPECT_EQ(out.inits[k].n_inliers, clean_out.inits[k].n_inliers);
+  }
+}
+
 TEST(CalibratorNodeOptions, YamlRejectsUnknownKeysAndBadValues) {
   const auto ok = CalibratorNodeOptions::fromYaml(YAML::Load("{auto_mode: true, auto_min_ranges: 500}"), "x.yaml");
   EXPECT_TRUE(ok.auto_mode);
@@ -584,4 +619,27 @@ TEST(CalibratorNodeOptions, YamlRejectsUnknownKeysAndBadValues) {
   CalibratorNodeOptions bad;
   bad.history_window_s = 0;
   EXPECT_THROW(CalibratorNode(CalibratorOptions{}, setup(), {}, bad), std::invalid_argument);
+}
+
+TEST(CalibratorNode, ARefusedAnchorIsRetriedWhenNewDataMakesItPass) {
+  // Issue 12: a refusal (too early, too coplanar, a restarted calibrator short of data) used to be
+  // final until the next Calibrate command. With retry_refused the anchor keeps collecting and is
+  // calibrated by the automatic criterion once the data suffices.
+  Outputs out;
+  CalibratorNode node(CalibratorOptions{}, setup(), sinksInto(out));  // retry_refused: the default
+  replay(node, seed1().dataset, {{10.0, command(CalibCommand::Action::Calibrate, {106})}}, 79.99);
+  ASSERT_EQ(node.results().size(), 2u);
+  EXPECT_EQ(node.results()[0].status, CalibrationStatus::DegenerateGeometry);  // at 10 s
+  EXPECT_EQ(node.results()[1].status, CalibrationStatus::Ok);                 // retried later
+  EXPECT_GE(node.results()[1].t.sec(), 20.0);  // not before auto_retry_period after the refusal
+  ASSERT_EQ(out.inits.size(), 1u);
+  EXPECT_LT(positionError(out.inits[0]), 0.3);
+  const CalibStatus st = node.status();
+  const auto* a = find(st, 106);
+  ASSERT_NE(a, nullptr);
+  EXPECT_EQ(a->state, "calibrated");
+  // Anchors that were never refused are not calibrated by it (no auto_mode): 107 still collects.
+  const auto* b = find(st, 107);
+  ASSERT_NE(b, nullptr);
+  EXPECT_EQ(b->state, "collecting");
 }

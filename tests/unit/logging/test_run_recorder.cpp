@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "common/dataset.h"
+#include "common/anchor_init_io.h"
 #include "common/estimate_io.h"
 #include "logging/run_recorder.h"
 
@@ -126,6 +127,52 @@ TEST(RunRecorder, FinishWritesSummaryAnchorInitsAndGroundTruth) {
   const auto gt = readTumCsv((d / "groundtruth.csv").string(), diag);
   ASSERT_EQ(gt.size(), 1u);
   EXPECT_DOUBLE_EQ(gt[0].p_IinG.z(), 3.0);
+  fs::remove_all(d);
+}
+
+TEST(RunRecorder, ARestartedLoggerContinuesItsFiles) {
+  // Issue 12: a logger killed (-9) and respawned within the same run keeps what it had written:
+  // the CSVs are continued (one header), the ANCHOR_INITs come back from anchor_init.yaml, which
+  // is rewritten at every ANCHOR_INIT.
+  const auto d = freshDir("restart");
+  AnchorInit ai;
+  ai.t = Timestamp::fromSec(80.0);
+  ai.id = 106;
+  ai.p_AinG = {-1.7, 0.9, 3.2};
+  ai.cov_p_m2 = Eigen::Matrix3d::Identity() * 0.05;
+  ai.biases = {PairBias{100, 106, 0.2, 1.0, 0.1, 0.03, 0.0}};
+  {
+    RunRecorder first(d.string());
+    first.onPose(pose(1.0));
+    first.onPose(pose(1.5));
+    first.onAnchorInit(ai);
+    first.flush();
+  }  // killed: no finish()
+  ASSERT_TRUE(fs::exists(d / "anchor_init.yaml"));
+  {
+    RunRecorder second(d.string(), true);
+    second.onPose(pose(2.0));
+    AnchorInit b = ai;
+    b.id = 107;
+    second.onAnchorInit(b);
+    second.finish(Diagnostics{});
+  }
+  Diagnostics diag;
+  const auto est = readEstimateCsv((d / "estimate.csv").string(), diag);
+  ASSERT_EQ(est.size(), 3u);
+  EXPECT_NEAR(est[2].t.sec(), 2.0, 1e-9);
+  EXPECT_EQ(diag.total(), 0);  // one header: no bad row
+  const auto inits = readAnchorInitsYaml((d / "anchor_init.yaml").string());
+  ASSERT_EQ(inits.size(), 2u);
+  EXPECT_EQ(inits[0].id, 106);
+  EXPECT_EQ(inits[1].id, 107);
+  // Without append (a new run into the same folder) the files start anew.
+  {
+    RunRecorder fresh(d.string());
+    fresh.onPose(pose(5.0));
+    fresh.flush();
+  }
+  EXPECT_EQ(readEstimateCsv((d / "estimate.csv").string(), diag).size(), 1u);
   fs::remove_all(d);
 }
 

@@ -157,3 +157,55 @@ TEST(MissionNode, StatusAtOneHertzOfDataTimeAndAfterEachStep) {
   EXPECT_NE(text.find("calibrator: 106 calibrated 107 refused 108 collecting (912 ranges)"), std::string::npos) << text;
   EXPECT_EQ(text.find("estimator not initialized"), std::string::npos);
 }
+
+TEST(MissionNode, CommandsWithoutAnAnswerAreSentAgainUntilTheStatusShowsTheirEffect) {
+  // Over a lossy link a CALIB_CMD may be lost: with resend_period_s it is sent again every second
+  // of data time until CALIB_STATUS shows its effect.
+  Recorder rec;
+  MissionNodeOptions o;
+  o.resend_period_s = 1.0;
+  MissionNode node(paperLike(), rec.sinks(), o);
+  auto status = [&](std::vector<std::pair<SensorId, std::string>> states) {
+    CalibStatus s;
+    for (const auto& [id, st] : states) {
+      CalibAnchorStatus a;
+      a.id = id;
+      a.state = st;
+      s.anchors.push_back(a);
+    }
+    node.onCalibStatus(s);
+  };
+  node.onTime(Timestamp::fromSec(0.0));
+  ASSERT_EQ(rec.calib.size(), 1u);  // collect-all
+  node.onTime(Timestamp::fromSec(0.5));
+  EXPECT_EQ(rec.calib.size(), 1u);  // not yet due
+  node.onTime(Timestamp::fromSec(1.0));
+  ASSERT_EQ(rec.calib.size(), 2u);  // lost? sent again, with the current data time
+  EXPECT_EQ(rec.calib[1].action, CalibCommand::Action::Collect);
+  EXPECT_DOUBLE_EQ(rec.calib[1].t.sec(), 1.0);
+  status({{106, "idle"}, {107, "idle"}});  // a status from before the command: not its effect
+  node.onTime(Timestamp::fromSec(2.0));
+  EXPECT_EQ(rec.calib.size(), 3u);
+  status({{106, "collecting"}, {107, "collecting"}});  // the effect
+  node.onTime(Timestamp::fromSec(10.0));
+  EXPECT_EQ(rec.calib.size(), 3u);
+
+  node.onTime(Timestamp::fromSec(80.0));  // calibrate 106, 107
+  ASSERT_EQ(rec.calib.size(), 4u);
+  status({{106, "calibrated"}, {107, "collecting"}});
+  node.onTime(Timestamp::fromSec(81.0));
+  ASSERT_EQ(rec.calib.size(), 5u);  // 107 not answered yet: the whole command again
+  EXPECT_EQ(rec.calib[4].anchors, (std::vector<SensorId>{106, 107}));
+  status({{106, "calibrated"}, {107, "refused"}});  // a refusal is an answer
+  node.onTime(Timestamp::fromSec(85.0));
+  EXPECT_EQ(rec.calib.size(), 5u);
+  EXPECT_EQ(node.diagnostics().get("calib_cmd_resent"), 3);
+
+  // Never answered: at most max_resends times.
+  Recorder rec2;
+  o.max_resends = 3;
+  MissionNode lonely(paperLike(), rec2.sinks(), o);
+  fly(lonely, 0.0, 20.0);
+  EXPECT_EQ(rec2.calib.size(), 4u);  // collect-all and 3 resends
+  EXPECT_EQ(lonely.diagnostics().get("calib_cmd_resent"), 3);
+}

@@ -109,3 +109,37 @@ TEST(RangeCsvImport, SplitPathList) {
   EXPECT_EQ(splitPathList("a.csv, b.csv,,c.csv "), (std::vector<std::string>{"a.csv", "b.csv", "c.csv"}));
   EXPECT_TRUE(splitPathList("").empty());
 }
+
+// A multi-host deployment runs one bridge per anchor computer, each publishing the ranges its
+// anchor initiated (--initiators): together the bridges publish every range exactly once.
+TEST(RangeCsvImport, KeepInitiatorsSplitsRangesPerInitiatingDevice) {
+  const auto p = writeFile("initiators.csv",
+                           "t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS\n"
+                           "1.0,3.0,3.0,0.01,101,100,A,T,1\n"
+                           "1.1,4.0,4.0,0.01,100,102,T,A,1\n"
+                           "1.2,5.0,5.0,0.01,102,101,A,A,1\n"
+                           "1.3,6.0,6.0,0.01,101,102,A,A,1\n");
+  Diagnostics diag;
+  const auto all = importRangeCsv({p.string()}, diag);
+  ASSERT_EQ(all.size(), 4u);
+
+  auto a101 = all;
+  EXPECT_EQ(keepInitiators(a101, {101}), 2u);
+  ASSERT_EQ(a101.size(), 2u);
+  EXPECT_DOUBLE_EQ(a101[0].range_m, 3.0);
+  EXPECT_DOUBLE_EQ(a101[1].range_m, 6.0);  // order kept
+
+  auto rest = all;
+  EXPECT_EQ(keepInitiators(rest, {100, 102}), 2u);
+  ASSERT_EQ(rest.size(), 2u);
+  EXPECT_EQ(rest[0].id_initiator, 100);
+  EXPECT_EQ(rest[1].id_initiator, 102);
+
+  auto none = all;
+  EXPECT_EQ(keepInitiators(none, {}), 0u);  // no filter: everything
+  EXPECT_EQ(none.size(), 4u);
+  auto unknown = all;
+  EXPECT_EQ(keepInitiators(unknown, {999}), 4u);
+  EXPECT_TRUE(unknown.empty());
+  fs::remove(p);
+}
