@@ -129,10 +129,21 @@ bool EstimatorNode::validate(const EstimatorInput& in) {
         bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) + " with invalid pair bias";
     if (const std::string e = a->jointCovarianceError(); !e.empty())
       bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) + ": " + e;
-    else if (a->hasJointCovariance() && bad.empty() &&
-             Eigen::LLT<Eigen::MatrixXd>(a->jointCovariance()).info() != Eigen::Success)
-      bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) +
-            ": joint covariance of position and gamma not positive definite";
+    else if (a->hasJointCovariance() && bad.empty()) {
+      // Positive definite where it is used: the position and the γ with σ_γ > 0 (the candidates
+      // for states; a pair with σ_γ = 0 is an exact dictionary value with a zero row).
+      std::vector<Eigen::Index> rows = {0, 1, 2};
+      for (size_t i = 0; i < a->biases.size(); ++i)
+        if (a->biases[i].sigma_gamma_m > 0.0) rows.push_back(3 + static_cast<Eigen::Index>(i));
+      const Eigen::MatrixXd J = a->jointCovariance();
+      Eigen::MatrixXd used(rows.size(), rows.size());
+      for (size_t r = 0; r < rows.size(); ++r)
+        for (size_t c = 0; c < rows.size(); ++c)
+          used(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = J(rows[r], rows[c]);
+      if (Eigen::LLT<Eigen::MatrixXd>(used).info() != Eigen::Success)
+        bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) +
+              ": joint covariance of position and gamma not positive definite";
+    }
   }
   if (!bad.empty()) {
     diag_.report("bad_input", bad);

@@ -234,6 +234,19 @@ TEST(AnchorBiasStates, AnchorInitBecomesStatesWithTheJointCovariance) {
         EXPECT_EQ(a.biases[k].gamma_m, node.filter()->state().anchor_biases.at(106).gamma_m(0));
       }
     }
+    // … and a restarted node takes it back (the exact pair 102 has a zero row there).
+    EstimatorNode again(opt, ds.setup);
+    again.resumeFrom(c);
+    for (const auto& in : mergeInTimeOrder(ds)) {
+      if (inputTime(in) >= c.t) again.onInput(in);
+      if (again.initialized()) break;
+    }
+    ASSERT_TRUE(again.initialized());
+    EXPECT_EQ(again.diagnostics().get("bad_input"), 0);
+    ASSERT_EQ(again.filter()->layout().at(106).dim, 5);
+    if (joint) {  // (without the option the resumed prior is block-diagonal again)
+      EXPECT_LT((again.filter()->covariance(106, 106) - node.filter()->covariance(106, 106)).norm(), 1e-12);
+    }
   }
   // A joint covariance that is not positive definite is refused as bad input.
   EstimatorNode node(test::testOptions(), ds.setup);
