@@ -72,6 +72,10 @@ struct CalibrationResult {
   Eigen::Matrix3d cov_p_m2 = Eigen::Matrix3d::Zero();        ///< its covariance [m²]
   Eigen::Vector3d p_AinG_linear = Eigen::Vector3d::Zero();   ///< linear (optimal double) solution [m]
   std::vector<ReferenceBiasEstimate> references;             ///< sorted by ref_id
+  /// Joint covariance of [p_AinG, γ of references[0..n-1]] ((3 + n)², the marginal of the stacked
+  /// covariance over [p, γ, β]; β marginalized out) [m²]. The γ are correlated with the position
+  /// (a range to a reference fixes only their combination), which the estimator keeps (issue 10).
+  Eigen::MatrixXd cov_p_gamma_m2;
   std::vector<bool> inliers;                                 ///< per input observation
   int n_observations = 0;
   int n_inliers = 0;

@@ -2,7 +2,10 @@
 /// @file anchor_init_io.h
 /// @brief Calibration results file, docs/formats.md (one entry per anchor: id, t, p_AinG, p_AinG_cov
 /// (3×3 row-major), ref_ids, const_biases, dist_biases, sigma_const_biases, sigma_dist_biases,
-/// sigma_ranges, n_inliers, n_outliers; refused anchors under `refused:`). Written by the
+/// sigma_ranges, n_inliers, n_outliers, and optionally cov_gamma_p (n × 3 row-major: cov(γ_i, p_AinG))
+/// with cov_gamma (n × n row-major): the joint covariance of position and γ, issue 10; files
+/// without them still read, as anchors whose γ are independent of the position; refused anchors
+/// under `refused:`). Written by the
 /// calibrator and by the logger (ANCHOR_INIT), read by the estimator's users and the evaluation.
 
 #include <string>

@@ -117,6 +117,41 @@ struct AnchorInit {
   std::vector<PairBias> biases;             ///< one per reference device (a = reference, b = id)
   int n_inliers = 0;
   int n_outliers = 0;
+  /// The calibration's joint covariance of p_AinG and the γ of `biases` (optional; both empty when
+  /// not given: the γ are then independent of the position with σ = sigma_gamma_m):
+  /// row i of `cov_gamma_p_m2` (n × 3) is cov(γ_i, p_AinG) [m²], `cov_gamma_m2` (n × n) the
+  /// covariance among the γ in `biases` order [m²] (its diagonal: sigma_gamma_m²).
+  Eigen::MatrixXd cov_gamma_p_m2;
+  Eigen::MatrixXd cov_gamma_m2;
+
+  bool hasJointCovariance() const { return cov_gamma_m2.size() > 0; }
+  /// [p_AinG, γ_1..γ_n] covariance ((3 + n)², symmetrized): the joint one when given, else
+  /// block-diagonal from cov_p_m2 and the sigma_gamma_m².
+  Eigen::MatrixXd jointCovariance() const {
+    const auto n = static_cast<Eigen::Index>(biases.size());
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3 + n, 3 + n);
+    J.topLeftCorner<3, 3>() = cov_p_m2;
+    if (hasJointCovariance()) {
+      J.bottomLeftCorner(n, 3) = cov_gamma_p_m2;
+      J.topRightCorner(3, n) = cov_gamma_p_m2.transpose();
+      J.bottomRightCorner(n, n) = cov_gamma_m2;
+    } else {
+      for (Eigen::Index i = 0; i < n; ++i)
+        J(3 + i, 3 + i) = biases[static_cast<size_t>(i)].sigma_gamma_m * biases[static_cast<size_t>(i)].sigma_gamma_m;
+    }
+    return 0.5 * (J + J.transpose());
+  }
+  /// Empty when no joint covariance is given or its sizes fit `biases`; else what is wrong.
+  std::string jointCovarianceError() const {
+    const auto n = static_cast<Eigen::Index>(biases.size());
+    if (cov_gamma_p_m2.size() == 0 && cov_gamma_m2.size() == 0) return "";
+    if (cov_gamma_m2.rows() != n || cov_gamma_m2.cols() != n || cov_gamma_p_m2.rows() != n || cov_gamma_p_m2.cols() != 3)
+      return "joint covariance sizes (" + std::to_string(cov_gamma_p_m2.rows()) + "x" +
+             std::to_string(cov_gamma_p_m2.cols()) + ", " + std::to_string(cov_gamma_m2.rows()) + "x" +
+             std::to_string(cov_gamma_m2.cols()) + ") do not fit " + std::to_string(n) + " biases";
+    if (!cov_gamma_p_m2.allFinite() || !cov_gamma_m2.allFinite()) return "joint covariance not finite";
+    return "";
+  }
 };
 
 }  // namespace meshnav

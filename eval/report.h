@@ -19,6 +19,8 @@ class TextTable {
   void addRow(std::vector<std::string> row) { rows_.push_back(std::move(row)); }
   /// Horizontal rule before the next row (plain text only).
   void addRule() { rules_.push_back(rows_.size()); }
+  /// No rows (only the header).
+  bool empty() const { return rows_.empty(); }
   std::string plain() const;
   std::string markdown() const;
 
@@ -55,6 +57,11 @@ struct BatchEntry {
 /// The paper-style table (Tab. III): per run pos RMSE, ori RMSE, ANEES pos/ori and per calibrated
 /// anchor the initial (★) and final error, their means; last row: mean over runs.
 TextTable makeBatchTable(const std::vector<BatchEntry>& entries);
+
+/// The anchors of a batch in one row (issue 10): estimated anchors with truth, mean initial (★)
+/// and final error [m], their ratio, how many initial and final beliefs have NEES ≤ the 99.7 %
+/// χ²(3) bound 13.93, and the median final NEES.
+TextTable makeBatchAnchorSummary(const std::vector<BatchEntry>& entries);
 
 /// Range statistics table; `reference` may be empty; `truth_pairs` (simulated γ, β, σ) may be empty.
 TextTable makeRangeStatsTable(const std::map<std::pair<SensorId, SensorId>, PairRangeStats>& stats,

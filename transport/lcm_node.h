@@ -6,7 +6,8 @@
 /// SIGTERM (StopSignal) or on request.
 ///
 /// Counter keys in diagnostics(): "<CHANNEL>:decode_error" (bytes that do not decode as the
-/// channel's type), "<CHANNEL>:invalid_message" (decoded, but NaN / unknown code),
+/// channel's type; the report names a foreign fingerprint, and a retired version of the type —
+/// an older log — by name), "<CHANNEL>:invalid_message" (decoded, but NaN / unknown code),
 /// "<CHANNEL>:handler_error" (the callback threw), "lcm:publish_error", "<CHANNEL>:oversized"
 /// (a received message above kMaxMessageBytes, dropped before decoding) and
 /// "<CHANNEL>:oversized_publish" (a message of ours above it, not sent).
@@ -31,6 +32,18 @@
 #include "transport/convert.h"
 
 namespace meshnav::transport {
+
+/// Fingerprints of message versions this code no longer reads, with what they were: a log
+/// recorded before a message changed is refused by name, never misread (lcmtypes/README.md).
+struct RetiredFingerprint {
+  int64_t hash;
+  const char* what;
+};
+const std::vector<RetiredFingerprint>& retiredFingerprints();
+/// Empty when the first 8 bytes of `rbuf` are `expected` (or there are fewer than 8); else why the
+/// message is not a `type_name`: "an older version of <type> (...)" for a retired fingerprint,
+/// else "fingerprint 0x… is not <type>'s 0x… (another type or version)".
+std::string fingerprintMismatch(const lcm::ReceiveBuffer& rbuf, int64_t expected, const char* type_name);
 
 class LcmNode {
  public:
@@ -141,6 +154,11 @@ class LcmNode {
       rc = -1;
     }
     if (rc < 0) {
+      if (const std::string fp = fingerprintMismatch(rbuf, Msg::getHash(), Msg::getTypeName()); !fp.empty()) {
+        diag_.report(ch + ":decode_error", "channel " + ch + ": dropped a message (" +
+                                               std::to_string(rbuf.data_size) + " bytes): " + fp);
+        return false;
+      }
       diag_.report(ch + ":decode_error", "channel " + ch + ": dropped a malformed message (" +
                                              std::to_string(rbuf.data_size) + " bytes, " + what + ")");
       return false;

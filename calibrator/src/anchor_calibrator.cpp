@@ -61,6 +61,11 @@ AnchorInit CalibrationResult::toAnchorInit() const {
   a.cov_p_m2 = cov_p_m2;
   a.n_inliers = n_inliers;
   a.n_outliers = n_outliers;
+  const auto n = static_cast<Eigen::Index>(references.size());
+  if (cov_p_gamma_m2.rows() == 3 + n && cov_p_gamma_m2.cols() == 3 + n) {
+    a.cov_gamma_p_m2 = cov_p_gamma_m2.bottomLeftCorner(n, 3);
+    a.cov_gamma_m2 = cov_p_gamma_m2.bottomRightCorner(n, n);
+  }
   for (const auto& r : references) {
     PairBias b;
     b.a = r.ref_id;
@@ -172,6 +177,15 @@ CalibrationResult AnchorCalibrator::calibrate(SensorId anchor_id, const std::vec
     res.n_outliers += r.n_outliers;
     res.references.push_back(r);
   }
+  // [p, γ_0..γ_n-1] block of the stacked covariance, in references order.
+  const auto ns = static_cast<Eigen::Index>(pb.slots().size());
+  std::vector<Eigen::Index> idx = {0, 1, 2};
+  for (int s = 0; s < static_cast<int>(ns); ++s) idx.push_back(pb.gammaIndex(s));
+  res.cov_p_gamma_m2.resize(3 + ns, 3 + ns);
+  for (Eigen::Index r = 0; r < 3 + ns; ++r)
+    for (Eigen::Index c = 0; c < 3 + ns; ++c)
+      res.cov_p_gamma_m2(r, c) = 0.5 * (cov.P(idx[static_cast<size_t>(r)], idx[static_cast<size_t>(c)]) +
+                                        cov.P(idx[static_cast<size_t>(c)], idx[static_cast<size_t>(r)]));
   return res;
 }
 

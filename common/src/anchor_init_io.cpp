@@ -83,6 +83,15 @@ void writeAnchorInitsYaml(const std::vector<AnchorInit>& inits, const std::strin
     seq(e, "sigma_const_biases", sg);
     seq(e, "sigma_dist_biases", sb);
     seq(e, "sigma_ranges", sr);
+    if (a.hasJointCovariance()) {
+      std::vector<double> gp, gg;
+      for (Eigen::Index i = 0; i < a.cov_gamma_p_m2.rows(); ++i)
+        for (int j = 0; j < 3; ++j) gp.push_back(a.cov_gamma_p_m2(i, j));
+      for (Eigen::Index i = 0; i < a.cov_gamma_m2.rows(); ++i)
+        for (Eigen::Index j = 0; j < a.cov_gamma_m2.cols(); ++j) gg.push_back(a.cov_gamma_m2(i, j));
+      seq(e, "cov_gamma_p", gp);
+      seq(e, "cov_gamma", gg);
+    }
     e << YAML::Key << "n_inliers" << YAML::Value << a.n_inliers;
     e << YAML::Key << "n_outliers" << YAML::Value << a.n_outliers;
     e << YAML::EndMap;
@@ -149,6 +158,18 @@ std::vector<AnchorInit> readAnchorInitsYaml(const std::string& path) {
       pbias.sigma_beta = sb[i];
       pbias.sigma_m = sr[i];
       a.biases.push_back(pbias);
+    }
+    // Optional (issue 10): the joint covariance of p_AinG and the γ; both keys or neither.
+    if (n["cov_gamma_p"] || n["cov_gamma"]) {
+      const auto gp = numbers(n["cov_gamma_p"], path, pre + "cov_gamma_p", 3 * m);
+      const auto gg = numbers(n["cov_gamma"], path, pre + "cov_gamma", m * m);
+      const auto mm = static_cast<Eigen::Index>(m);
+      a.cov_gamma_p_m2.resize(mm, 3);
+      a.cov_gamma_m2.resize(mm, mm);
+      for (Eigen::Index i = 0; i < mm; ++i) {
+        for (int j = 0; j < 3; ++j) a.cov_gamma_p_m2(i, j) = gp[static_cast<size_t>(3 * i + j)];
+        for (Eigen::Index j = 0; j < mm; ++j) a.cov_gamma_m2(i, j) = gg[static_cast<size_t>(mm * i + j)];
+      }
     }
     out.push_back(std::move(a));
   }

@@ -73,6 +73,14 @@ void forEachField(Opt& o, Visitor&& v) {
   v("uwb.use_corrected_range", o.uwb.use_corrected_range, "fuse range_corr instead of range_raw");
   v("uwb.max_range_m", o.uwb.max_range_m, "longer ranges are bad input [m]");
   v("uwb.estimate_tag_biases", o.uwb.estimate_tag_biases, "estimate tag-anchor gamma (setup anchors, sigma_gamma > 0) as states");
+  v("uwb.estimate_anchor_biases", o.uwb.estimate_anchor_biases,
+    "estimate a calibrated anchor's gamma (ANCHOR_INIT, sigma_gamma > 0) as states of its instance");
+  v("uwb.anchor_bias_joint_covariance", o.uwb.anchor_bias_joint_covariance,
+    "initialize them with the calibration's joint covariance of position and gamma");
+  v("uwb.estimate_setup_anchor_biases", o.uwb.estimate_setup_anchor_biases,
+    "the same for known-but-uncertain setup anchors (towards exact and smaller-id uncertain anchors)");
+  v("uwb.fuse_calibrated_anchor_pairs", o.uwb.fuse_calibrated_anchor_pairs,
+    "fuse ranges between two calibrated anchors (their correlated calibration errors are not known)");
   v("uwb.dah_fuse_estimated_anchor_pairs", o.uwb.dah_fuse_estimated_anchor_pairs,
     "dah only: fuse ranges between two estimated anchors (overconfident, see docs)");
   v("zupt.enabled", o.zupt.enabled, "");

@@ -100,9 +100,26 @@ struct UwbOptions {
   bool use_corrected_range = false;      ///< fuse range_corr instead of range_raw
   double max_range_m = 100.0;            ///< longer ranges are bad input [m]
   /// Estimate γ of tag–setup-anchor pairs whose a-priori bias has sigma_gamma > 0 as states of the
-  /// tag instances (else their σ_γ inflates the range noise). Anchors added at run time
-  /// (ANCHOR_INIT) keep their calibrated γ as dictionary values.
+  /// tag instances (else their σ_γ inflates the range noise).
   bool estimate_tag_biases = true;
+  /// Estimate the γ of an anchor added at run time (ANCHOR_INIT: its calibrated biases with
+  /// sigma_gamma > 0) as states of the anchor's instance (issue 10). Else they are fixed
+  /// dictionary values whose σ_γ inflates the range noise.
+  bool estimate_anchor_biases = true;
+  /// The same for a known-but-uncertain setup anchor: its a-priori γ towards exactly known anchors
+  /// and towards uncertain anchors of smaller id. Off by default: DP gains (docs/results.md) but
+  /// DAH loses its private anchor–exact-anchor updates as position information and becomes
+  /// overconfident on one sequence (seed 10: position ANEES 9.4).
+  bool estimate_setup_anchor_biases = false;
+  /// Fuse ranges between two anchors that both came from a calibration (ANCHOR_INIT), in every
+  /// strategy. Off by default: their calibrations share the estimated trajectory (and one may be
+  /// the other's reference), so their errors are correlated in a way ANCHOR_INIT does not carry;
+  /// fused as independent they made DP overconfident (S2: final anchor NEES ≤ 13.93 for 37 % of
+  /// the anchors, 93 % without them; docs/modular_estimator.md, "Anchor γ as states").
+  bool fuse_calibrated_anchor_pairs = false;
+  /// Initialize those states with the calibration's joint covariance of position and γ (when
+  /// ANCHOR_INIT carries it); false: block-diagonal (position, independent σ_γ²), for comparison.
+  bool anchor_bias_joint_covariance = true;
   /// Strategy `dah` only: fuse ranges between two estimated anchors. Off by default: DAH keeps no
   /// correlation between anchors that is built through a third instance (their common-mode error),
   /// so these updates shrink both anchors' covariance for information they share and make the

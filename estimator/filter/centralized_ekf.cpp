@@ -46,16 +46,19 @@ void CentralizedEkf::addHeight(SensorId id, double bias_m, double var_m2) {
   appendBlock(id, InstanceKind::Height, Eigen::MatrixXd::Constant(1, 1, var_m2));
 }
 
-void CentralizedEkf::addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) {
+void CentralizedEkf::addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::MatrixXd& cov,
+                               const BiasState& biases) {
+  checkAnchorBlock(id, cov, biases);
   if (layout_.find(id)) removeInstance(id);
   x_.anchor_p_AinG[id] = p_AinG;
+  if (!biases.peers.empty()) x_.anchor_biases[id] = biases;
   appendBlock(id, InstanceKind::Anchor, cov);
 }
 
 void CentralizedEkf::addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
                                   const Eigen::VectorXd& var_m2) {
   if (layout_.find(tag_id)) removeInstance(tag_id);
-  x_.tag_biases[tag_id] = TagBiasState{peers, gamma_m};
+  x_.tag_biases[tag_id] = BiasState{peers, gamma_m};
   appendBlock(tag_id, InstanceKind::Tag, var_m2.asDiagonal().toDenseMatrix());
 }
 

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "estimator/core/linearization.h"
@@ -19,6 +20,16 @@ struct UpdateResult {
   bool accepted = false;
   double nis = 0.0;  ///< normalized innovation squared rᵀ S⁻¹ r
 };
+
+/// Throws std::invalid_argument unless `cov` is square of size 3 + #peers and `biases` holds one γ
+/// per peer (the contract of FusionStrategy::addAnchor).
+inline void checkAnchorBlock(SensorId id, const Eigen::MatrixXd& cov, const BiasState& biases) {
+  const auto k = static_cast<Eigen::Index>(biases.peers.size());
+  if (biases.gamma_m.size() != k || cov.rows() != 3 + k || cov.cols() != 3 + k)
+    throw std::invalid_argument("addAnchor " + std::to_string(id) + ": covariance " + std::to_string(cov.rows()) + "x" +
+                                std::to_string(cov.cols()) + " does not fit 3 + " + std::to_string(k) +
+                                " bias states (" + std::to_string(biases.gamma_m.size()) + " values)");
+}
 
 class FusionStrategy {
  public:
@@ -34,8 +45,11 @@ class FusionStrategy {
   /// Adds a downward rangefinder's bias instance (uncorrelated with the rest; random walk
   /// `height.bias_rw_m_per_sqrt_s`). Replaces it if present.
   virtual void addHeight(SensorId id, double bias_m, double var_m2) = 0;
-  /// Adds an anchor position instance (uncorrelated with the rest). Replaces it if present.
-  virtual void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) = 0;
+  /// Adds an anchor instance (uncorrelated with the rest; replaces it if present): its position and,
+  /// when `biases` has peers, its pair biases γ towards them as states after the position, with
+  /// the joint covariance `cov` of [p_AinG, γ] ((3 + #peers)², e.g. the calibration's).
+  virtual void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::MatrixXd& cov,
+                         const BiasState& biases = {}) = 0;
   /// Adds a tag instance whose constant biases γ(tag, peer) towards exactly known anchors are
   /// estimated (prior mean `gamma_m`, variances `var_m2`, uncorrelated). Replaces it if present.
   virtual void addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,

@@ -40,16 +40,19 @@ void ModularFilter::addHeight(SensorId id, double bias_m, double var_m2) {
   cov_.add(id, InstanceKind::Height, Eigen::MatrixXd::Constant(1, 1, var_m2), x_.t);
 }
 
-void ModularFilter::addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) {
+void ModularFilter::addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::MatrixXd& cov,
+                              const BiasState& biases) {
+  checkAnchorBlock(id, cov, biases);
   if (cov_.has(id)) removeInstance(id);
   x_.anchor_p_AinG[id] = p_AinG;
+  if (!biases.peers.empty()) x_.anchor_biases[id] = biases;
   cov_.add(id, InstanceKind::Anchor, cov, x_.t);
 }
 
 void ModularFilter::addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
                                  const Eigen::VectorXd& var_m2) {
   if (cov_.has(tag_id)) removeInstance(tag_id);
-  x_.tag_biases[tag_id] = TagBiasState{peers, gamma_m};
+  x_.tag_biases[tag_id] = BiasState{peers, gamma_m};
   cov_.add(tag_id, InstanceKind::Tag, var_m2.asDiagonal().toDenseMatrix(), x_.t);
 }
 

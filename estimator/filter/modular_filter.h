@@ -33,7 +33,8 @@ class ModularFilter final : public FusionStrategy {
   void reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) override;
   void addBaro(SensorId id, double bias_m, double var_m2) override;
   void addHeight(SensorId id, double bias_m, double var_m2) override;
-  void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::Matrix3d& cov) override;
+  void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::MatrixXd& cov,
+                 const BiasState& biases = {}) override;
   void addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
                     const Eigen::VectorXd& var_m2) override;
   bool removeInstance(SensorId id) override;

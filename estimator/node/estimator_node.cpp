@@ -133,8 +133,26 @@ bool EstimatorNode::validate(const EstimatorInput& in) {
         Eigen::LLT<Eigen::Matrix3d>(0.5 * (a->cov_p_m2 + a->cov_p_m2.transpose())).info() != Eigen::Success)
       bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) + " with invalid position or covariance";
     for (const auto& b : a->biases)
-      if (!std::isfinite(b.gamma_m) || !std::isfinite(b.beta) || b.beta <= 0.0 || !std::isfinite(b.sigma_m))
+      if (!std::isfinite(b.gamma_m) || !std::isfinite(b.beta) || b.beta <= 0.0 || !std::isfinite(b.sigma_m) ||
+          !std::isfinite(b.sigma_gamma_m) || b.sigma_gamma_m < 0.0)
         bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) + " with invalid pair bias";
+    if (const std::string e = a->jointCovarianceError(); !e.empty())
+      bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) + ": " + e;
+    else if (a->hasJointCovariance() && bad.empty()) {
+      // Positive definite where it is used: the position and the γ with σ_γ > 0 (the candidates
+      // for states; a pair with σ_γ = 0 is an exact dictionary value with a zero row).
+      std::vector<Eigen::Index> rows = {0, 1, 2};
+      for (size_t i = 0; i < a->biases.size(); ++i)
+        if (a->biases[i].sigma_gamma_m > 0.0) rows.push_back(3 + static_cast<Eigen::Index>(i));
+      const Eigen::MatrixXd J = a->jointCovariance();
+      Eigen::MatrixXd used(rows.size(), rows.size());
+      for (size_t r = 0; r < rows.size(); ++r)
+        for (size_t c = 0; c < rows.size(); ++c)
+          used(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = J(rows[r], rows[c]);
+      if (Eigen::LLT<Eigen::MatrixXd>(used).info() != Eigen::Success)
+        bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) +
+              ": joint covariance of position and gamma not positive definite";
+    }
   }
   if (!bad.empty()) {
     diag_.report("bad_input", bad);
@@ -353,6 +371,11 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
     event(first, "range_dah_anchor_pair_skipped");  // a policy, not bad input (see UwbOptions)
     return;
   }
+  if (!options_.uwb.fuse_calibrated_anchor_pairs && cur_.network->isCalibrated(z.a) &&
+      cur_.network->isCalibrated(z.b)) {
+    event(first, "range_calibrated_anchor_pair_skipped");  // a policy (see UwbOptions)
+    return;
+  }
   propagateTo(s.t);
   ScopedStepTimer timer(timings_, "range_update");
   Linearization lin;
@@ -391,16 +414,45 @@ void EstimatorNode::applyAnchorInit(const AnchorInit& a, bool first) {
     return;
   }
   net->removeDevice(a.id);  // an exactly known anchor becomes an estimated one
+  net->setCalibrated(a.id, true);
   for (PairBias b : a.biases) {
     if (b.a != a.id && b.b != a.id) b.b = a.id;
     net->setPairBias(b);
   }
   cur_.network = std::move(net);
-  cur_.filter->addAnchor(a.id, a.p_AinG, 0.5 * (a.cov_p_m2 + a.cov_p_m2.transpose()));
+  // The anchor's γ with an uncertainty become states after its position (issue 10), with the
+  // calibration's joint covariance: a γ error and the position error along that reference's
+  // direction are strongly correlated, and fixing γ would let repeated ranges average away an
+  // error that is constant.
+  BiasState biases;
+  std::vector<Eigen::Index> rows = {0, 1, 2};  // rows of the joint [p, γ_1..γ_n] kept
+  std::vector<double> gamma;
+  if (options_.uwb.estimate_anchor_biases) {
+    for (size_t i = 0; i < a.biases.size(); ++i) {
+      const PairBias& b = a.biases[i];
+      const SensorId peer = b.a == a.id ? b.b : b.a;
+      if (peer == a.id || b.sigma_gamma_m <= 0.0 || biases.index(peer) >= 0) continue;
+      biases.peers.push_back(peer);
+      gamma.push_back(b.gamma_m);
+      rows.push_back(3 + static_cast<Eigen::Index>(i));
+    }
+  }
+  biases.gamma_m = Eigen::Map<const Eigen::VectorXd>(gamma.data(), static_cast<Eigen::Index>(gamma.size()));
+  AnchorInit marginal = a;
+  if (!options_.uwb.anchor_bias_joint_covariance) marginal.cov_gamma_p_m2.resize(0, 0), marginal.cov_gamma_m2.resize(0, 0);
+  const Eigen::MatrixXd J = marginal.jointCovariance();
+  Eigen::MatrixXd cov(rows.size(), rows.size());
+  for (size_t r = 0; r < rows.size(); ++r)
+    for (size_t c = 0; c < rows.size(); ++c) cov(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = J(rows[r], rows[c]);
+  cur_.filter->addAnchor(a.id, a.p_AinG, cov, biases);
   if (first) {
     diag_.count("anchor_init");
-    spdlog::info("estimator: anchor {} added at t={} p_AinG=[{:.3f}, {:.3f}, {:.3f}] with {} pair biases", a.id,
-                 formatSeconds(a.t), a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z(), a.biases.size());
+    spdlog::info("estimator: anchor {} added at t={} p_AinG=[{:.3f}, {:.3f}, {:.3f}] with {} pair biases, {} as states{}",
+                 a.id, formatSeconds(a.t), a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z(), a.biases.size(),
+                 biases.peers.size(),
+                 biases.peers.empty() ? ""
+                 : a.hasJointCovariance() && options_.uwb.anchor_bias_joint_covariance ? " (joint covariance)"
+                                                                                        : " (independent of the position)");
   }
 }
 
@@ -419,9 +471,10 @@ void EstimatorNode::applyCommand(const EstimatorCommand& c, bool first) {
         break;
       }
       bool removed = cur_.filter->removeInstance(c.id);
-      if (cur_.network->isTag(c.id) || cur_.network->exactAnchor(c.id)) {
+      if (cur_.network->isTag(c.id) || cur_.network->exactAnchor(c.id) || cur_.network->isCalibrated(c.id)) {
         auto net = std::make_shared<UwbNetwork>(*cur_.network);
         removed = net->removeDevice(c.id) || removed;
+        net->setCalibrated(c.id, false);
         cur_.network = std::move(net);
       }
       if (!removed) event(first, "bad_command", "ESTIMATOR_CMD: no instance " + std::to_string(c.id) + " to remove");
@@ -458,7 +511,8 @@ std::vector<AnchorEstimate> EstimatorNode::anchors() const {
   if (!initialized()) return out;
   const NominalState& x = cur_.filter->state();
   for (const auto& [id, p] : cur_.network->exactAnchors()) out.push_back({x.t, id, p, Eigen::Matrix3d::Zero()});
-  for (const auto& [id, p] : x.anchor_p_AinG) out.push_back({x.t, id, p, cur_.filter->covariance(id, id)});
+  for (const auto& [id, p] : x.anchor_p_AinG)
+    out.push_back({x.t, id, p, cur_.filter->covariance(id, id).topLeftCorner<3, 3>()});
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   return out;
 }

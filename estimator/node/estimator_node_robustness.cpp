@@ -54,8 +54,25 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   pending_height_bias_ = b.height_bias;  // the height instance is added at the first usable height
   for (const auto& [id, p] : setup_.abs_anchor_positions) {
     auto sig = setup_.abs_anchor_sigmas_m.find(id);
-    if (sig != setup_.abs_anchor_sigmas_m.end())
-      filter->addAnchor(id, p, Eigen::Matrix3d::Identity() * sig->second * sig->second);
+    if (sig == setup_.abs_anchor_sigmas_m.end()) continue;
+    // Known-but-uncertain: its a-priori γ towards exactly known anchors and towards uncertain
+    // anchors of smaller id (one owner per pair) become states too (independent a priori).
+    BiasState biases;
+    std::vector<double> gamma, var = {1.0, 1.0, 1.0};
+    if (options_.uwb.estimate_setup_anchor_biases) {
+      for (const auto& [peer, q] : setup_.abs_anchor_positions) {
+        if (peer == id || (setup_.abs_anchor_sigmas_m.count(peer) && peer > id)) continue;
+        const auto pb = setup_.findPairBias(id, peer);
+        if (!pb || pb->sigma_gamma_m <= 0.0) continue;
+        biases.peers.push_back(peer);
+        gamma.push_back(pb->gamma_m);
+        var.push_back(pb->sigma_gamma_m * pb->sigma_gamma_m);
+      }
+    }
+    biases.gamma_m = Eigen::Map<const Eigen::VectorXd>(gamma.data(), static_cast<Eigen::Index>(gamma.size()));
+    Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(var.data(), static_cast<Eigen::Index>(var.size()));
+    v.head<3>() *= sig->second * sig->second;
+    filter->addAnchor(id, p, v.asDiagonal().toDenseMatrix(), biases);
   }
   if (options_.uwb.estimate_tag_biases) {
     // Tag instances with state: γ towards the setup's anchors (exact or known-but-uncertain) whose
@@ -291,7 +308,10 @@ void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp 
   for (const auto& [id, b] : s.baro_bias_m)
     f->addBaro(id, b, std::max(old.covariance(id, id)(0, 0), std::pow(options_.baro.init_bias_sigma_m, 2)));
   for (const auto& [id, b] : s.height_bias_m) f->addHeight(id, b, old.covariance(id, id)(0, 0));
-  for (const auto& [id, p] : s.anchor_p_AinG) f->addAnchor(id, p, old.covariance(id, id));
+  for (const auto& [id, p] : s.anchor_p_AinG) {
+    auto b = s.anchor_biases.find(id);
+    f->addAnchor(id, p, old.covariance(id, id), b == s.anchor_biases.end() ? BiasState{} : b->second);
+  }
   for (const auto& [id, tb] : s.tag_biases)
     f->addTagBiases(id, tb.peers, tb.gamma_m, old.covariance(id, id).diagonal());
   cur_.filter = std::move(f);
@@ -346,13 +366,39 @@ EstimatorCheckpoint EstimatorNode::checkpoint() const {
     a.t = x.t;
     a.id = id;
     a.p_AinG = p;
-    a.cov_p_m2 = f.covariance(id, id);
+    const Eigen::MatrixXd C = f.covariance(id, id);
+    a.cov_p_m2 = C.topLeftCorner<3, 3>();
+    // γ states: their current values and the joint covariance with the position (row of each
+    // bias in C, or −1 for a dictionary value).
+    const auto gs = x.anchor_biases.find(id);
+    std::vector<int> row;
     for (SensorId d : devices) {
       if (d == id || !cur_.network->hasPairBias(d, id)) continue;
       PairBias pb = cur_.network->pairBias(d, id);
       pb.a = d;
       pb.b = id;
+      const int i = gs == x.anchor_biases.end() ? -1 : gs->second.index(d);
+      if (i >= 0) {
+        pb.gamma_m = gs->second.gamma_m(i);
+        pb.sigma_gamma_m = std::sqrt(C(3 + i, 3 + i));
+      }
+      row.push_back(i < 0 ? -1 : 3 + i);
       a.biases.push_back(pb);
+    }
+    if (gs != x.anchor_biases.end()) {
+      const auto n = static_cast<Eigen::Index>(a.biases.size());
+      a.cov_gamma_p_m2 = Eigen::MatrixXd::Zero(n, 3);
+      a.cov_gamma_m2 = Eigen::MatrixXd::Zero(n, n);
+      for (Eigen::Index k = 0; k < n; ++k) {
+        const int rk = row[static_cast<size_t>(k)];
+        if (rk < 0) {
+          a.cov_gamma_m2(k, k) = std::pow(a.biases[static_cast<size_t>(k)].sigma_gamma_m, 2);
+          continue;
+        }
+        a.cov_gamma_p_m2.row(k) = C.block(rk, 0, 1, 3);
+        for (Eigen::Index l = 0; l < n; ++l)
+          if (row[static_cast<size_t>(l)] >= 0) a.cov_gamma_m2(k, l) = C(rk, row[static_cast<size_t>(l)]);
+      }
     }
     c.anchors.push_back(std::move(a));
   }

@@ -33,21 +33,39 @@ std::optional<End> resolve(SensorId id, const NominalState& x, const UwbNetwork&
   return std::nullopt;
 }
 
-/// The estimated γ of the pair (a, b) when one end is a tag with a bias state towards the other:
-/// (tag id, index in the tag's state).
-std::optional<std::pair<SensorId, int>> gammaState(SensorId a, SensorId b, const NominalState& x) {
+/// Where the estimated γ of the pair (a, b) lives: the instance that holds it and its row in that
+/// instance's error state. An estimated anchor's own γ towards the other end comes first (the
+/// newest knowledge of the pair: its calibration), then a tag's γ towards the other end.
+struct GammaState {
+  SensorId owner = 0;
+  int row = 0;          ///< row in the owner's error state
+  bool anchor = false;  ///< owner is an anchor instance (rows 3..), else a tag instance
+  double value = 0.0;
+};
+
+std::optional<GammaState> gammaState(SensorId a, SensorId b, const NominalState& x) {
+  for (auto [owner, peer] : {std::make_pair(a, b), std::make_pair(b, a)}) {
+    auto it = x.anchor_biases.find(owner);
+    if (it == x.anchor_biases.end()) continue;
+    const int i = it->second.index(peer);
+    if (i >= 0) return GammaState{owner, 3 + i, true, it->second.gamma_m(i)};
+  }
   for (auto [tag, peer] : {std::make_pair(a, b), std::make_pair(b, a)}) {
     auto it = x.tag_biases.find(tag);
     if (it == x.tag_biases.end()) continue;
     const int i = it->second.index(peer);
-    if (i >= 0) return std::make_pair(tag, i);
+    if (i >= 0) return GammaState{tag, i, false, it->second.gamma_m(i)};
   }
   return std::nullopt;
 }
 
 /// γ of the pair: the estimated one if it is a state, else the dictionary's.
-double pairGamma(const PairBias& pb, const std::optional<std::pair<SensorId, int>>& gs, const NominalState& x) {
-  return gs ? x.tag_biases.at(gs->first).gamma_m(gs->second) : pb.gamma_m;
+double pairGamma(const PairBias& pb, const std::optional<GammaState>& gs) { return gs ? gs->value : pb.gamma_m; }
+
+/// Error-state dimension of an estimated anchor (3 + its γ states).
+int anchorDim(SensorId id, const NominalState& x) {
+  auto it = x.anchor_biases.find(id);
+  return 3 + (it == x.anchor_biases.end() ? 0 : static_cast<int>(it->second.peers.size()));
 }
 
 }  // namespace
@@ -72,7 +90,7 @@ std::optional<std::pair<double, double>> RangeModel::predict(const RangeMeasurem
   if (!a || !b) return std::nullopt;
   const PairBias pb = net.pairBias(z.a, z.b);
   const double d = (b->p_inG - a->p_inG).norm();
-  return std::make_pair(pb.beta * d + pairGamma(pb, gammaState(z.a, z.b, x), x), d);
+  return std::make_pair(pb.beta * d + pairGamma(pb, gammaState(z.a, z.b, x)), d);
 }
 
 RangeModel::Status RangeModel::linearize(const RangeMeasurement& z, const NominalState& x, const UwbNetwork& net,
@@ -95,21 +113,27 @@ RangeModel::Status RangeModel::linearize(const RangeMeasurement& z, const Nomina
 
   Linearization& lin = *out;
   lin.blocks.clear();
-  lin.residual = Eigen::VectorXd::Constant(1, z.z_m - (pb.beta * d + pairGamma(pb, gs, x)));
+  lin.residual = Eigen::VectorXd::Constant(1, z.z_m - (pb.beta * d + pairGamma(pb, gs)));
   lin.R = Eigen::MatrixXd::Constant(1, 1, sigma * sigma + var_gamma + d * d * pb.sigma_beta * pb.sigma_beta);
   if (a->kind == End::Kind::Tag) {
     Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, ImuErr::kDim);
     H.block<1, 3>(0, ImuErr::kP) = -pb.beta * u;
     H.block<1, 3>(0, ImuErr::kTheta) = pb.beta * u * x.imu.q_ItoG.toRotationMatrix() * so3::skew(*a->p_TinI);
     lin.blocks.push_back({x.imu_id, std::move(H)});
-  } else if (a->kind == End::Kind::StateAnchor) {
-    lin.blocks.push_back({a->id, Eigen::MatrixXd(-pb.beta * u)});
   }
-  if (b->kind == End::Kind::StateAnchor) lin.blocks.push_back({b->id, Eigen::MatrixXd(pb.beta * u)});
-  if (gs) {  // ∂z/∂δγ = 1
-    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, x.tag_biases.at(gs->first).gamma_m.size());
-    H(0, gs->second) = 1.0;
-    lin.blocks.push_back({gs->first, std::move(H)});
+  // An estimated anchor's block: ±β uᵀ on its position, zero on its γ states (but the pair's).
+  auto anchorBlock = [&](SensorId id, double sign) {
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, anchorDim(id, x));
+    H.leftCols<3>() = sign * pb.beta * u;
+    if (gs && gs->anchor && gs->owner == id) H(0, gs->row) = 1.0;  // ∂z/∂δγ = 1
+    lin.blocks.push_back({id, std::move(H)});
+  };
+  if (a->kind == End::Kind::StateAnchor) anchorBlock(a->id, -1.0);
+  if (b->kind == End::Kind::StateAnchor) anchorBlock(b->id, 1.0);
+  if (gs && !gs->anchor) {  // a tag's γ: ∂z/∂δγ = 1
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, x.tag_biases.at(gs->owner).gamma_m.size());
+    H(0, gs->row) = 1.0;
+    lin.blocks.push_back({gs->owner, std::move(H)});
   }
   return Status::Ok;
 }

@@ -7,7 +7,10 @@
 ///   ∂z/∂δp_IinG = −β uᵀ,  ∂z/∂δθ = β uᵀ R̂ [p_TinI]×,  ∂z/∂δp_A = β uᵀ (estimated anchor),
 ///   anchor–anchor: ∂z/∂δp_Aa = −β uᵀ, ∂z/∂δp_Ab = β uᵀ.
 /// Noise variance R = σ² + σ_γ² + (d σ_β)² (pair uncertainties inflate the noise), except when γ
-/// of a tag–anchor pair is a state of the tag instance: then ∂z/∂δγ = 1 and σ_γ is not added.
+/// of the pair is a state — of an estimated anchor at one end (its calibration's γ towards tags,
+/// known and earlier calibrated anchors, rows 3.. of the anchor's block; looked up first) or of
+/// a tag instance (γ towards exactly known anchors): then ∂z/∂δγ = 1 and σ_γ is not added.
+/// β stays a fixed value (its σ_β inflates R).
 
 #include <Eigen/Core>
 

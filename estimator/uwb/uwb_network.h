@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <map>
 #include <optional>
+#include <set>
 #include <utility>
 
 #include "common/setup.h"
@@ -36,6 +37,14 @@ class UwbNetwork {
   void setPairBias(const PairBias& b) { biases_[pairKey(b.a, b.b)] = b; }
   /// Forgets a tag or an exactly known anchor (its ranges become unknown). False if absent.
   bool removeDevice(SensorId id) { return tags_p_TinI_.erase(id) + exact_anchors_p_AinG_.erase(id) > 0; }
+  /// Anchors that came from a calibration (ANCHOR_INIT), until removed.
+  void setCalibrated(SensorId id, bool calibrated) {
+    if (calibrated)
+      calibrated_.insert(id);
+    else
+      calibrated_.erase(id);
+  }
+  bool isCalibrated(SensorId id) const { return calibrated_.count(id) > 0; }
   /// Range σ [m]: the pair's σ if the pair is in the dictionary, else setup.noise.sigma_range,
   /// else √R of the range when R > 0, else the config fallback.
   double rangeSigma(SensorId a, SensorId b, double R_m2) const;
@@ -44,6 +53,7 @@ class UwbNetwork {
   std::map<SensorId, Eigen::Vector3d> tags_p_TinI_;
   std::map<SensorId, Eigen::Vector3d> exact_anchors_p_AinG_;
   std::map<std::pair<SensorId, SensorId>, PairBias> biases_;
+  std::set<SensorId> calibrated_;
   std::optional<double> setup_sigma_m_;
   double fallback_sigma_m_ = 0.15;
 };

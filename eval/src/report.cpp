@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -349,7 +350,7 @@ void writeAnchorsEvalCsv(const RunEvaluation& ev, const std::string& path) {
   std::ofstream f(path);
   if (!f) throw std::runtime_error(path + ": cannot write");
   f << "id,known,has_truth,true_x,true_y,true_z,init_x,init_y,init_z,final_x,final_y,final_z,"
-       "init_err_m,final_err_m,init_nees\n";
+       "init_err_m,final_err_m,init_nees,final_nees\n";
   if (!ev.anchors) return;
   f.setf(std::ios::fixed);
   f.precision(5);
@@ -359,7 +360,7 @@ void writeAnchorsEvalCsv(const RunEvaluation& ev, const std::string& path) {
     for (int i = 0; i < 3; ++i) f << "," << a.initial.p_AinG[i];
     for (int i = 0; i < 3; ++i) f << "," << a.final_est.p_AinG[i];
     f << "," << (a.has_truth ? a.initial_error_m : NAN) << "," << (a.has_truth ? a.final_error_m : NAN) << ","
-      << (a.initial_nees ? *a.initial_nees : NAN) << "\n";
+      << (a.initial_nees ? *a.initial_nees : NAN) << "," << (a.final_nees ? *a.final_nees : NAN) << "\n";
   }
 }
 
@@ -422,6 +423,47 @@ TextTable makeBatchTable(const std::vector<BatchEntry>& entries) {
     mean_row.push_back(cnt[c] > 0 ? formatNumber(sum[c] / cnt[c], dec) : "–");
   }
   t.addRow(mean_row);
+  return t;
+}
+
+TextTable makeBatchAnchorSummary(const std::vector<BatchEntry>& entries) {
+  const double bound = chi2Quantile(3, 0.997);
+  int n = 0, init_ok = 0, fin_ok = 0, n_init_nees = 0, n_fin_nees = 0;
+  double sum_init = 0.0, sum_fin = 0.0;
+  std::vector<double> fin_nees;
+  for (const auto& e : entries) {
+    if (!e.ev.anchors) continue;
+    for (const auto& a : e.ev.anchors->anchors) {
+      if (a.known || !a.has_truth) continue;
+      ++n;
+      sum_init += a.initial_error_m;
+      sum_fin += a.final_error_m;
+      if (a.initial_nees) {
+        ++n_init_nees;
+        init_ok += *a.initial_nees <= bound;
+      }
+      if (a.final_nees) {
+        ++n_fin_nees;
+        fin_ok += *a.final_nees <= bound;
+        fin_nees.push_back(*a.final_nees);
+      }
+    }
+  }
+  TextTable t({"anchors", "mean★ [m]", "mean [m]", "final / initial", "NEES★ ≤ 13.93", "NEES ≤ 13.93",
+               "median NEES"});
+  if (n == 0) return t;
+  double median = std::numeric_limits<double>::quiet_NaN();
+  if (!fin_nees.empty()) {
+    std::sort(fin_nees.begin(), fin_nees.end());
+    const size_t m = fin_nees.size();
+    median = m % 2 ? fin_nees[m / 2] : 0.5 * (fin_nees[m / 2 - 1] + fin_nees[m / 2]);
+  }
+  auto frac = [](int k, int of) {
+    return std::to_string(k) + " / " + std::to_string(of) + " (" + formatNumber(of ? 100.0 * k / of : 0.0, 0) + " %)";
+  };
+  t.addRow({std::to_string(n), formatNumber(sum_init / n, 3), formatNumber(sum_fin / n, 3),
+            formatNumber(sum_init > 0 ? sum_fin / sum_init : std::numeric_limits<double>::quiet_NaN(), 2),
+            frac(init_ok, n_init_nees), frac(fin_ok, n_fin_nees), formatNumber(median, 1)});
   return t;
 }
 

@@ -316,6 +316,15 @@ anchor_init_t toLcm(const AnchorInit& s) {
   for (int i = 0; i < m.num_biases; ++i) m.biases.push_back(toLcm(s.biases[i]));
   m.num_inliers = s.n_inliers;
   m.num_outliers = s.n_outliers;
+  if (const std::string bad = s.jointCovarianceError(); !bad.empty())
+    throw std::invalid_argument("AnchorInit of anchor " + std::to_string(s.id) + ": " + bad);
+  m.num_gamma_cov = s.hasJointCovariance() ? m.num_biases : 0;
+  for (int i = 0; i < m.num_gamma_cov; ++i) {
+    m.cov_gamma_p.push_back({s.cov_gamma_p_m2(i, 0), s.cov_gamma_p_m2(i, 1), s.cov_gamma_p_m2(i, 2)});
+    std::vector<double> row(static_cast<size_t>(m.num_gamma_cov));
+    for (int j = 0; j < m.num_gamma_cov; ++j) row[static_cast<size_t>(j)] = s.cov_gamma_m2(i, j);
+    m.cov_gamma.push_back(std::move(row));
+  }
   return m;
 }
 AnchorInit fromLcm(const anchor_init_t& m) {
@@ -329,6 +338,26 @@ AnchorInit fromLcm(const anchor_init_t& m) {
   for (const auto& b : m.biases) s.biases.push_back(fromLcm(b));
   s.n_inliers = m.num_inliers;
   s.n_outliers = m.num_outliers;
+  if (m.num_gamma_cov != 0 && m.num_gamma_cov != m.num_biases)
+    throw InvalidMessage("num_gamma_cov " + std::to_string(m.num_gamma_cov) + " is neither 0 nor num_biases " +
+                         std::to_string(m.num_biases));
+  const int n = m.num_gamma_cov;
+  if (n > 0) {
+    s.cov_gamma_p_m2.resize(n, 3);
+    s.cov_gamma_m2.resize(n, n);
+    for (int i = 0; i < n; ++i) {
+      for (int c = 0; c < 3; ++c) {
+        const double v = m.cov_gamma_p[static_cast<size_t>(i)][static_cast<size_t>(c)];
+        requireFinite(v, "cov_gamma_p");
+        s.cov_gamma_p_m2(i, c) = v;
+      }
+      for (int j = 0; j < n; ++j) {
+        const double v = m.cov_gamma[static_cast<size_t>(i)][static_cast<size_t>(j)];
+        requireFinite(v, "cov_gamma");
+        s.cov_gamma_m2(i, j) = v;
+      }
+    }
+  }
   return s;
 }
 

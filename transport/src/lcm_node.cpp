@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
 
@@ -10,6 +11,33 @@
 #include "transport/stop_signal.h"
 
 namespace meshnav::transport {
+
+const std::vector<RetiredFingerprint>& retiredFingerprints() {
+  // Computed with the generated headers of the version named (lcm-gen's getHash()).
+  static const std::vector<RetiredFingerprint> kRetired = {
+      {static_cast<int64_t>(0xa4a10701fd07c42dULL),
+       "anchor_init_t version 1 (before issue 10: without the joint covariance of position and gammas)"},
+      {static_cast<int64_t>(0xcacef84225dccaafULL),
+       "estimator_cmd_t version 1 (before issue 10: its anchor_init_t without the joint covariance)"},
+  };
+  return kRetired;
+}
+
+std::string fingerprintMismatch(const lcm::ReceiveBuffer& rbuf, int64_t expected, const char* type_name) {
+  if (rbuf.data_size < 8) return "";
+  uint64_t found = 0;
+  const auto* b = static_cast<const uint8_t*>(rbuf.data);
+  for (int i = 0; i < 8; ++i) found = (found << 8) | b[i];  // big endian, as LCM encodes it
+  if (static_cast<int64_t>(found) == expected) return "";
+  for (const RetiredFingerprint& r : retiredFingerprints())
+    if (static_cast<int64_t>(found) == r.hash)
+      return std::string("an older message version, ") + r.what + ", which this build does not read as " +
+             type_name + " (re-record, or replay the dataset instead of the old log)";
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "fingerprint 0x%016llx is not %s's 0x%016llx (another type or version)",
+                static_cast<unsigned long long>(found), type_name, static_cast<unsigned long long>(expected));
+  return buf;
+}
 
 std::string resolveLcmUrl(const std::string& cli_value) {
   if (!cli_value.empty()) return cli_value;

@@ -47,11 +47,56 @@ TEST(CalibrationIo, YamlRoundTripIntoAnchorInit) {
     EXPECT_NEAR(a.biases[k].beta, ok.references[k].beta, 1e-8);
     EXPECT_NEAR(a.biases[k].sigma_gamma_m, ok.references[k].sigma_gamma_m, 1e-8);
   }
+  // The joint covariance of position and γ (issue 10): the calibration's own blocks, back unchanged.
+  const auto n = static_cast<Eigen::Index>(ok.references.size());
+  ASSERT_EQ(ok.cov_p_gamma_m2.rows(), 3 + n);
+  EXPECT_LT((ok.cov_p_gamma_m2.topLeftCorner<3, 3>() - ok.cov_p_m2).norm(), 1e-15);
+  for (Eigen::Index k = 0; k < n; ++k)
+    EXPECT_NEAR(std::sqrt(ok.cov_p_gamma_m2(3 + k, 3 + k)), ok.references[static_cast<size_t>(k)].sigma_gamma_m, 1e-12);
+  ASSERT_TRUE(a.hasJointCovariance());
+  EXPECT_LT((a.jointCovariance() - ok.cov_p_gamma_m2).norm(), 1e-12 * ok.cov_p_gamma_m2.norm());
+  // The γ of the moving tags are correlated with the position, not independent of it.
+  EXPECT_GT(a.cov_gamma_p_m2.cwiseAbs().maxCoeff(), 1e-3 * std::sqrt(a.cov_p_m2.trace() * a.cov_gamma_m2.trace()));
   std::ifstream in(path);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   for (const char* key : {"p_AinG_cov", "ref_ids", "const_biases", "dist_biases", "sigma_const_biases",
-                          "sigma_dist_biases", "n_inliers", "n_outliers", "refused", "too_few_measurements"})
+                          "sigma_dist_biases", "n_inliers", "n_outliers", "refused", "too_few_measurements",
+                          "cov_gamma_p", "cov_gamma"})
     EXPECT_NE(text.find(key), std::string::npos) << key;
+}
+
+TEST(CalibrationIo, JointCovarianceIsOptionalAndChecked) {
+  const std::string base = "anchors:\n  - {id: 109, p_AinG: [1, 2, 3], p_AinG_cov: [1, 0, 0, 0, 1, 0, 0, 0, 1], "
+                           "ref_ids: [100, 101], const_biases: [0.1, 0.2], dist_biases: [1, 1], "
+                           "sigma_const_biases: [0.02, 0.03], sigma_dist_biases: [0, 0]";
+  const std::string path = tmpFile("joint.yaml");
+  {
+    std::ofstream(path) << base << "}\n";  // a file written before issue 10
+  }
+  auto inits = readAnchorInitsYaml(path);
+  ASSERT_EQ(inits.size(), 1u);
+  EXPECT_FALSE(inits[0].hasJointCovariance());
+  EXPECT_DOUBLE_EQ(inits[0].jointCovariance()(4, 4), 0.03 * 0.03);
+  {
+    std::ofstream(path) << base << ", cov_gamma_p: [0.1, 0.2, 0.3, 0.4, 0.5, 0.6], cov_gamma: [0.0004, 1e-5, 1e-5, 0.0009]}\n";
+  }
+  inits = readAnchorInitsYaml(path);
+  ASSERT_TRUE(inits[0].hasJointCovariance());
+  EXPECT_EQ(inits[0].cov_gamma_p_m2(1, 0), 0.4);  // row-major: γ_1 with x
+  EXPECT_EQ(inits[0].cov_gamma_m2(0, 1), 1e-5);
+  for (const std::string bad : {", cov_gamma_p: [0.1, 0.2, 0.3], cov_gamma: [1, 0, 0, 1]}",
+                                ", cov_gamma_p: [0.1, 0.2, 0.3, 0.4, 0.5, 0.6]}",
+                                ", cov_gamma_p: [0.1, 0.2, 0.3, 0.4, 0.5, .nan], cov_gamma: [1, 0, 0, 1]}"}) {
+    {
+      std::ofstream(path) << base << bad << "\n";
+    }
+    try {
+      readAnchorInitsYaml(path);
+      FAIL() << "no throw for " << bad;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("anchors[0].cov_gamma"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(CalibrationIo, MalformedYamlNamesFileAndKey) {

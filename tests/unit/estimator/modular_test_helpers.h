@@ -32,6 +32,9 @@ inline double relativeDifference(const FusionStrategy& a, const FusionStrategy& 
     for (int i = 0; i < 3; ++i) rel(p(i) - y.anchor_p_AinG.at(id)(i), p(i));
   for (const auto& [id, g] : x.tag_biases)
     for (int i = 0; i < g.gamma_m.size(); ++i) rel(g.gamma_m(i) - y.tag_biases.at(id).gamma_m(i), g.gamma_m(i));
+  if (x.anchor_biases.size() != y.anchor_biases.size()) return 1e300;
+  for (const auto& [id, g] : x.anchor_biases)
+    for (int i = 0; i < g.gamma_m.size(); ++i) rel(g.gamma_m(i) - y.anchor_biases.at(id).gamma_m(i), g.gamma_m(i));
   for (const StateBlock& blk : a.layout().blocks()) {
     if (!b.layout().find(blk.id)) return 1e300;
     const Eigen::MatrixXd Pa = a.covariance(blk.id, blk.id), Pb = b.covariance(blk.id, blk.id);

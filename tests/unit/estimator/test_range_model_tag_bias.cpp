@@ -24,7 +24,7 @@ NominalState stateWithGamma(double gamma) {
   x.imu_id = 1;
   x.imu.p_IinG = {0.5, 1.0, 2.0};
   x.imu.q_ItoG = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()));
-  x.tag_biases[100] = TagBiasState{{101}, Eigen::VectorXd::Constant(1, gamma)};
+  x.tag_biases[100] = BiasState{{101}, Eigen::VectorXd::Constant(1, gamma)};
   return x;
 }
 

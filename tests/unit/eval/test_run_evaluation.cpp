@@ -168,6 +168,18 @@ TEST_F(RunEvaluationTest, AnchorGivenWithSigmaCountsAsEstimated) {
   entries.push_back({"seed01", ev});
   const std::string table = makeBatchTable(entries).plain();
   EXPECT_NE(table.find("A106★ [m]"), std::string::npos) << table;
+  // The anchor summary of the batch (issue 10): the two estimated anchors, their mean final error
+  // and how many final beliefs pass the χ²(3) bound.
+  const TextTable summary = makeBatchAnchorSummary(entries);
+  ASSERT_FALSE(summary.empty());
+  const std::string md = summary.markdown();
+  EXPECT_NE(md.find("| 2 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 0.200 |"), std::string::npos) << md;
+  int fin_ok = 0, with_nees = 0;
+  for (const auto& a : ev.anchors->anchors)
+    if (!a.known && a.final_nees) ++with_nees, fin_ok += *a.final_nees <= 13.93;
+  EXPECT_NE(md.find(std::to_string(fin_ok) + " / " + std::to_string(with_nees)), std::string::npos) << md;
+  EXPECT_TRUE(makeBatchAnchorSummary({}).empty());
 }
 
 TEST_F(RunEvaluationTest, BatchTableHasMeanRow) {

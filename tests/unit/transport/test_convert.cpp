@@ -49,6 +49,16 @@ AnchorInit someAnchorInit() {
   return a;
 }
 
+/// With the calibration's joint covariance of position and γ (issue 10).
+AnchorInit someAnchorInitWithJointCovariance() {
+  AnchorInit a = someAnchorInit();
+  a.cov_gamma_p_m2.resize(2, 3);
+  a.cov_gamma_p_m2 << -0.001, 0.002, -0.003, 0.0004, -0.0005, 0.0006;
+  a.cov_gamma_m2.resize(2, 2);
+  a.cov_gamma_m2 << 0.0004, -0.0001, -0.0001, 0.0025;
+  return a;
+}
+
 void expectAnchorInitEq(const AnchorInit& a, const AnchorInit& b) {
   EXPECT_EQ(a.t, b.t);
   EXPECT_EQ(a.id, b.id);
@@ -66,6 +76,11 @@ void expectAnchorInitEq(const AnchorInit& a, const AnchorInit& b) {
   }
   EXPECT_EQ(a.n_inliers, b.n_inliers);
   EXPECT_EQ(a.n_outliers, b.n_outliers);
+  EXPECT_EQ(a.hasJointCovariance(), b.hasJointCovariance());
+  ASSERT_EQ(a.cov_gamma_p_m2.rows(), b.cov_gamma_p_m2.rows());
+  ASSERT_EQ(a.cov_gamma_m2.rows(), b.cov_gamma_m2.rows());
+  EXPECT_EQ(a.cov_gamma_p_m2, b.cov_gamma_p_m2);  // exact: row (γ_i), column (x, y, z) as sent
+  EXPECT_EQ(a.cov_gamma_m2, b.cov_gamma_m2);
 }
 
 }  // namespace
@@ -200,6 +215,47 @@ TEST(Convert, Anchors) {
 }
 
 TEST(Convert, AnchorInit) { expectAnchorInitEq(fromLcm(wire(toLcm(someAnchorInit()))), someAnchorInit()); }
+
+TEST(Convert, AnchorInitWithJointCovariance) {
+  const AnchorInit a = someAnchorInitWithJointCovariance();
+  const anchor_init_t m = toLcm(a);
+  EXPECT_EQ(m.num_gamma_cov, 2);
+  EXPECT_EQ(m.cov_gamma_p[1][2], 0.0006);  // row = γ of bias 1, column z
+  EXPECT_EQ(m.cov_gamma[0][1], -0.0001);
+  expectAnchorInitEq(fromLcm(wire(m)), a);
+  // Without: no rows on the wire, none back.
+  EXPECT_EQ(toLcm(someAnchorInit()).num_gamma_cov, 0);
+  EXPECT_FALSE(fromLcm(wire(toLcm(someAnchorInit()))).hasJointCovariance());
+  // The joint matrix [p, γ]: the given blocks, or block-diagonal from σ_γ without them.
+  const Eigen::MatrixXd J = a.jointCovariance();
+  ASSERT_EQ(J.rows(), 5);
+  EXPECT_EQ(J(3, 2), -0.003);
+  EXPECT_EQ(J(2, 3), -0.003);
+  EXPECT_EQ(J(4, 4), 0.0025);
+  const Eigen::MatrixXd D = someAnchorInit().jointCovariance();
+  EXPECT_DOUBLE_EQ(D(4, 4), 0.05 * 0.05);
+  EXPECT_EQ(D(3, 0), 0.0);
+}
+
+TEST(Convert, AnchorInitJointCovarianceIsChecked) {
+  auto m = toLcm(someAnchorInitWithJointCovariance());
+  m.cov_gamma[1][0] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(fromLcm(m), InvalidMessage);
+  m = toLcm(someAnchorInitWithJointCovariance());
+  m.cov_gamma_p[0][1] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(fromLcm(m), InvalidMessage);
+  m = toLcm(someAnchorInitWithJointCovariance());
+  m.num_gamma_cov = 1;  // neither 0 nor num_biases
+  m.cov_gamma_p.resize(1);
+  m.cov_gamma.resize(1);
+  m.cov_gamma[0].resize(1);
+  EXPECT_THROW(fromLcm(m), InvalidMessage);
+  // A plain struct whose sizes do not fit its biases is not sent.
+  AnchorInit bad = someAnchorInitWithJointCovariance();
+  bad.biases.pop_back();
+  EXPECT_FALSE(bad.jointCovarianceError().empty());
+  EXPECT_THROW(toLcm(bad), std::invalid_argument);
+}
 
 TEST(Convert, EstimatorStatus) {
   EstimatorStatus s;

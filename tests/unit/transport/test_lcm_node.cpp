@@ -67,6 +67,47 @@ TEST(LcmNode, GarbageBytesAreCountedNotFatal) {
   EXPECT_EQ(node.received(channels::kImu), 1);
 }
 
+TEST(LcmNode, OlderAnchorInitVersionIsRefusedByName) {
+  // Issue 10 extended anchor_init_t (joint covariance of position and γ): a message of the old
+  // version, as in an older log, must be refused and named, never misread as the new layout.
+  LcmNode node("test", "memq://");
+  int n = 0;
+  node.subscribe<AnchorInit>(channels::kAnchorInit, [&](const AnchorInit&) { ++n; });
+  AnchorInit a;
+  a.id = 106;
+  a.biases.push_back(PairBias{100, 106, 0.1, 1.0, 0.1, 0.02, 0.0});
+  const auto msg = toLcm(a);
+  std::vector<uint8_t> buf(static_cast<size_t>(msg.getEncodedSize()));
+  msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  auto old = buf;
+  const uint64_t v1 = 0xa4a10701fd07c42dULL;  // anchor_init_t before issue 10
+  for (int i = 0; i < 8; ++i) old[static_cast<size_t>(i)] = static_cast<uint8_t>(v1 >> (56 - 8 * i));
+  old.resize(old.size() - 2);  // version 1 had no num_gamma_cov
+  publishBytes(node, channels::kAnchorInit, old);
+  publishBytes(node, channels::kAnchorInit, buf);
+  drain(node);
+  EXPECT_EQ(n, 1);
+  EXPECT_EQ(node.diagnostics().get("ANCHOR_INIT:decode_error"), 1);
+
+  lcm::ReceiveBuffer rb{};
+  rb.data = old.data();
+  rb.data_size = static_cast<uint32_t>(old.size());
+  const std::string why = fingerprintMismatch(rb, anchor_init_t::getHash(), anchor_init_t::getTypeName());
+  EXPECT_NE(why.find("anchor_init_t version 1"), std::string::npos) << why;
+  rb.data = buf.data();
+  EXPECT_EQ(fingerprintMismatch(rb, anchor_init_t::getHash(), anchor_init_t::getTypeName()), "");
+  std::vector<uint8_t> foreign(16, 0x11);
+  rb.data = foreign.data();
+  rb.data_size = 16;
+  EXPECT_NE(fingerprintMismatch(rb, anchor_init_t::getHash(), "anchor_init_t").find("0x1111111111111111"),
+            std::string::npos);
+  // The retired fingerprints are not the current ones.
+  for (const RetiredFingerprint& r : retiredFingerprints()) {
+    EXPECT_NE(r.hash, anchor_init_t::getHash());
+    EXPECT_NE(r.hash, estimator_cmd_t::getHash());
+  }
+}
+
 TEST(LcmNode, OversizedMessagesAreCounted) {
   // Issue 12, finding 5: messages of 1 MB vanished uncounted. A received one above the limit is
   // counted and dropped before decoding; one of ours is not sent, and counted at the sender.
