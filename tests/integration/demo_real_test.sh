@@ -4,7 +4,7 @@
 # namespace (scripts/lcm_netns.sh, as the other integration tests), evaluated against the
 # SE(3)-aligned truth. Checks: the messages the bridges published all reached the logger, the
 # estimate keeps the recording's Unix stamps and reaches the end of the data, the LCM run's ATE is
-# within 5 % of the in-process run's, the table prints meshnav beside multilateration, the PNGs
+# within 10 % of the in-process run's, the table prints meshnav beside multilateration, the PNGs
 # exist. First, with a copy of the script whose ../shared is empty: the missing recording is
 # named with where to put it, exit 1, no traceback.
 #
@@ -87,8 +87,11 @@ ate_lcm=$(row meshnav); ate_ml=$(row multilateration)
 ate_run=$(/usr/bin/python3 -c 'import sys, yaml; print(yaml.safe_load(open(sys.argv[1]))["pose"]["position"]["rmse_m"])' \
           "$D/run/metrics.yaml") || fail "no in-process metrics.yaml"
 echo "ATE (se3): LCM $ate_lcm m, in-process $ate_run m, multilateration $ate_ml m"
-awk -v a="$ate_lcm" -v b="$ate_run" 'BEGIN{d = a - b; if (d < 0) d = -d; exit !(d <= 0.05 * b)}' \
-  || fail "the LCM run's ATE $ate_lcm m is not within 5 % of the in-process run's $ate_run m"
+# 10 %: the in-motion alignment is tried every 0.5 s on the data that has arrived, so how the two
+# bridges' messages interleave can start the filter 1.5 s earlier with another heading (measured at
+# 10x: 0.266-0.284 m against 0.283 m in one process; docs/real_data.md).
+awk -v a="$ate_lcm" -v b="$ate_run" 'BEGIN{d = a - b; if (d < 0) d = -d; exit !(d <= 0.10 * b)}' \
+  || fail "the LCM run's ATE $ate_lcm m is not within 10 % of the in-process run's $ate_run m"
 awk -v a="$ate_lcm" 'BEGIN{exit !(a > 0 && a < 0.35)}' || fail "ATE $ate_lcm m (docs/real_data.md: 0.283 m)"
 awk -v a="$ate_ml" 'BEGIN{exit !(a > 0.226 && a < 0.286)}' || fail "multilateration ATE $ate_ml m (README: 0.256 m)"
 grep -q "Plots in $D/lcm/" "$WORK/demo.log" || fail "the demo does not say where the plots are"
