@@ -25,6 +25,9 @@ while [[ $# -gt 0 ]]; do
     *) echo "demo --real: unknown option $1 (see ./meshnav demo --real --help)" >&2; exit 2 ;;
   esac
 done
+# Paths as the user gave them, relative to where the command was started (the script changes to the
+# repository root below).
+bag="$(realpath -m -- "$bag")"; out="$(realpath -m -- "$out")"
 say() { printf '\033[1m[demo --real]\033[0m %s\n' "$*" >&2; }
 die() { printf '\033[1;31m[demo --real] error:\033[0m %s\n' "$*" >&2; exit 1; }
 [[ "$rate" =~ ^[0-9]+([.][0-9]+)?$ ]] && awk -v r="$rate" 'BEGIN{exit !(r > 0)}' \
