@@ -4,8 +4,17 @@
 # bridges with fly-by calibration of anchors 106-110 (mission config/missions/paper_s2.yaml),
 # then evaluate against ground truth: results table on the terminal, CSVs and PNG plots in OUT.
 #   scripts/demo.sh [--seed N] [--rate R] [--out DIR] [--strategy centralized|dp|dah]
+#   scripts/demo.sh --real [--bag FILE] [--rate R] [--out DIR]   the real ISAS-Walk1 recording instead
+#                   (../shared/data/real-isas-walk1/; scripts/demo_real.sh --help)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+for a in "$@"; do
+  if [[ "$a" == --real ]]; then
+    args=()
+    for b in "$@"; do [[ "$b" == --real ]] || args+=("$b"); done
+    exec "$ROOT/scripts/demo_real.sh" "${args[@]}"
+  fi
+done
 BIN="${MESHNAV_BUILD_DIR:-$ROOT/build}/bin"
 seed=1; rate=10; out="$ROOT/out/demo"; strategy=dah
 while [[ $# -gt 0 ]]; do
@@ -14,7 +23,7 @@ while [[ $# -gt 0 ]]; do
     --rate) rate="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --strategy) strategy="$2"; shift 2 ;;
-    -h|--help) sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "demo: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done

@@ -2,6 +2,7 @@
 /// @brief Evaluates a run against ground truth (pose RMSE/ARMSE/ANEES, anchor errors), writes
 /// metrics.yaml, errors.csv and plots; or, with --batch, the paper-style table over many runs.
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <stdexcept>
+#include <utility>
 
 #include "common/cli.h"
 #include "eval/plotting.h"
@@ -97,6 +99,18 @@ void writeOutputs(const RunEvaluation& ev, const fs::path& out, bool plots, cons
   if (fs::exists(est)) args.insert(args.end(), {"--estimate", est.string()});
   const fs::path track = fs::path(ev.run_dir) / "anchors.csv";
   if (fs::exists(track)) args.insert(args.end(), {"--anchor-track", track.string()});
+  // Truth in another frame: the plot draws it mapped into the estimate's frame with the fitted (R, t).
+  if (ev.alignment != AlignmentMode::None && ev.alignment_transform) {
+    const RigidTransform& a = *ev.alignment_transform;
+    std::string rt;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) rt += fmt::format("{:.17g},", a.R_EtoT(r, c));
+    rt += fmt::format("{:.17g},{:.17g},{:.17g}", a.t_EinT_m.x(), a.t_EinT_m.y(), a.t_EinT_m.z());
+    args.insert(args.end(), {"--alignment", rt, "--alignment-mode", toString(ev.alignment)});
+  }
+  // Range residuals along the estimate: the dataset's ranges, tag lever arms and known anchors.
+  for (const auto& [flag, file] : {std::pair{"--ranges", "ranges.csv"}, std::pair{"--setup", "setup.yaml"}})
+    if (const fs::path f = fs::path(dataset) / file; fs::exists(f)) args.insert(args.end(), {flag, f.string()});
   if (runPlotScript("plot_run.py", args)) spdlog::info("plots written to {}", out.string());
 }
 

@@ -4,16 +4,25 @@
 Writes into --out:
   trajectory_xy.png      top view: true (blue) and estimated (purple) trajectory, anchors as in the
                          paper's figures: true = black stars, initial estimate = blue triangles,
-                         final estimate = green diamonds
+                         final estimate = green diamonds. With --alignment (the truth lives in
+                         another frame) the truth is drawn mapped into the estimate's frame G,
+                         p_G = R^T (p_T - t), where the anchors are
   trajectory_3d.png      the same in 3D
   position_error.png     position error x/y/z (truth - estimate) [m] with +-3 sigma bounds
   orientation_error.png  orientation error x/y/z (local, Log(R_est^T R_true)) [deg] with +-3 sigma
   nees.png               NEES of position and orientation with the 95 % chi2(3) interval
   anchor_errors.png      per estimated anchor with a true position: error norm [m] and NEES (3 dof,
                          log scale, 95 % interval and 99.7 % threshold) over time, from anchors.csv
+  range_residuals.png    per anchor: tag-anchor range residual z - |p_IinG + R_ItoG p_TinI - p_AinG| [m]
+                         over time, with the estimate interpolated at the range's time (position
+                         linear, orientation of the nearest estimate), anchors from the run's last
+                         anchors.csv row or setup.yaml; raw ranges, no bias correction. Median and
+                         robust sigma (1.4826 MAD) per anchor in the titles
 
 Inputs: errors.csv and anchors_eval.csv written by meshnav_eval, groundtruth.csv (TUM, optional),
-estimate.csv and the run's anchors.csv (optional). Headless: uses the Agg backend.
+estimate.csv and the run's anchors.csv (optional), ranges.csv and setup.yaml of the dataset
+(optional, for the residuals). Time axes start at the first sample when the stamps are absolute
+(recordings in Unix seconds). Headless: uses the Agg backend.
 """
 import argparse
 import csv
@@ -59,6 +68,148 @@ def read_csv(path):
     return {h: arr[:, i] for i, h in enumerate(header)}
 
 
+def time_axis(t, t0=None):
+    """(t - t0, axis label): times from the first sample when the stamps are absolute (a recording
+    stamped in Unix seconds, 1.66e9 s), else unchanged."""
+    if t0 is None:
+        t0 = float(t[0]) if len(t) else 0.0
+    if abs(t0) < 1e5:
+        return t, "t [s]"
+    return t - t0, "t − %.3f [s]" % t0
+
+
+def read_alignment(text):
+    """(R_EtoT, t_EinT) from "r00,r01,...,r22,tx,ty,tz" (meshnav_eval --align: p_T = R p_E + t)."""
+    v = [float(x) for x in text.split(",")]
+    if len(v) != 12 or not np.all(np.isfinite(v)):
+        raise ValueError("--alignment needs 12 finite numbers (R row by row, then t), got %r" % text)
+    return np.array(v[:9]).reshape(3, 3), np.array(v[9:])
+
+
+def truth_in_estimate_frame(gt, alignment):
+    """The truth's positions mapped into the estimate's frame: p_E = R^T (p_T - t)."""
+    if gt is None or alignment is None:
+        return gt
+    R, t = alignment
+    p_T = np.stack([gt["tx"], gt["ty"], gt["tz"]], 1)
+    p_E = (p_T - t) @ R  # row-wise R^T (p_T - t)
+    out = dict(gt)
+    out["tx"], out["ty"], out["tz"] = p_E[:, 0], p_E[:, 1], p_E[:, 2]
+    return out
+
+
+def read_tag_anchor_ranges(path):
+    """Tag-anchor rows of a ranges.csv as arrays t, z, tag id, anchor id (either device may be
+    the initiator; anchor-anchor and tag-tag rows and unreadable rows are left out)."""
+    t, z, tag, anchor = [], [], [], []
+    if not path or not os.path.exists(path):
+        return None
+    types = {"T": "T", "84": "T", "A": "A", "65": "A"}
+    with open(path, newline="") as f:
+        for r in csv.DictReader(f):
+            try:
+                t1 = types.get(r["type_ID1"].strip().upper())
+                t2 = types.get(r["type_ID2"].strip().upper())
+                row = (float(r["t"]), float(r["range_raw"]), int(r["UWB_ID1"]), int(r["UWB_ID2"]))
+            except (KeyError, ValueError, AttributeError):
+                continue
+            if {t1, t2} != {"T", "A"}:
+                continue
+            t.append(row[0])
+            z.append(row[1])
+            tag.append(row[2] if t1 == "T" else row[3])
+            anchor.append(row[3] if t1 == "T" else row[2])
+    if not t:
+        return None
+    return {"t": np.array(t), "z": np.array(z), "tag": np.array(tag), "anchor": np.array(anchor)}
+
+
+def read_setup_geometry(path):
+    """({tag id: p_TinI}, {anchor id: p_AinG}) from setup.yaml; empty when PyYAML is missing."""
+    if not path or not os.path.exists(path):
+        return {}, {}
+    try:
+        import yaml
+    except ImportError:
+        print("plot_run.py: PyYAML missing (python3-yaml): no range residuals", file=sys.stderr)
+        return {}, {}
+    with open(path) as f:
+        setup = yaml.safe_load(f) or {}
+    tags = {int(k): np.array(v, float) for k, v in (setup.get("rel_tag_positions") or {}).items()}
+    anchors = {int(k): np.array(v, float) for k, v in (setup.get("abs_anchor_positions") or {}).items()}
+    return tags, anchors
+
+
+def rotate(q_xyzw, v):
+    """Rows of v rotated by the unit quaternions q (x, y, z, w), row by row: R(q) v."""
+    u, w = q_xyzw[:, :3], q_xyzw[:, 3:4]
+    c = np.cross(u, v)
+    return v + 2.0 * w * c + 2.0 * np.cross(u, c)
+
+
+def range_residuals(ranges, est, tags, anchors):
+    """{anchor id: (t, residual)} with residual = z - |p_IinG + R_ItoG p_TinI - p_AinG| for the
+    tag-anchor ranges within the estimate's time span whose tag and anchor positions are known.
+    Position interpolated linearly, orientation of the nearest estimate in time."""
+    out = {}
+    if ranges is None or est is None or len(est["t"]) < 2:
+        return out
+    te = est["t"]
+    keep = (ranges["t"] >= te[0]) & (ranges["t"] <= te[-1])
+    keep &= np.array([g in tags for g in ranges["tag"]], bool) & np.array([a in anchors for a in ranges["anchor"]], bool)
+    if not np.any(keep):
+        return out
+    t, z = ranges["t"][keep], ranges["z"][keep]
+    tag, anchor = ranges["tag"][keep], ranges["anchor"][keep]
+    p_IinG = np.stack([np.interp(t, te, est[k]) for k in ("tx", "ty", "tz")], 1)
+    i = np.clip(np.searchsorted(te, t), 1, len(te) - 1)
+    i -= (t - te[i - 1]) < (te[i] - t)  # the nearer neighbour
+    q = np.stack([est[k][i] for k in ("qx", "qy", "qz", "qw")], 1)
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    p_TinI = np.array([tags[g] for g in tag])
+    p_AinG = np.array([anchors[a] for a in anchor])
+    d = np.linalg.norm(p_IinG + rotate(q, p_TinI) - p_AinG, axis=1)
+    r = z - d
+    for a in sorted(set(anchor.tolist())):
+        m = anchor == a
+        out[int(a)] = (t[m], r[m])
+    return out
+
+
+def robust_stats(r):
+    """(median, 1.4826 MAD) of the residuals."""
+    med = float(np.median(r))
+    return med, 1.4826 * float(np.median(np.abs(r - med)))
+
+
+def plot_range_residuals(out, residuals):
+    ids = sorted(residuals)
+    t0 = min(float(v[0][0]) for v in residuals.values())
+    fig, axes = plt.subplots(len(ids), 1, figsize=(9, 1.6 + 1.5 * len(ids)), sharex=True, squeeze=False)
+    label = "t [s]"
+    for ax, aid in zip(axes[:, 0], ids):
+        t, r = residuals[aid]
+        tr, label = time_axis(t, t0)
+        med, sigma = robust_stats(r)
+        lim = min(max(0.3, 1.5 * float(np.percentile(np.abs(r), 99))), 3.0)
+        outside = int(np.sum(np.abs(r) > lim))
+        ax.plot(tr, np.clip(r, -lim, lim), ".", ms=2, color="tab:blue")
+        ax.axhline(0.0, color="k", lw=0.6)
+        ax.axhline(med, color="tab:red", lw=1.0)
+        ax.set_ylim(-lim * 1.05, lim * 1.05)
+        ax.set_ylabel("%d [m]" % aid)
+        ax.grid(True, alpha=0.3)
+        ax.set_title("anchor %d: %d ranges, median %+.3f m, robust σ %.3f m%s"
+                     % (aid, len(r), med, sigma, ", %d beyond ±%.2f m (drawn at the edge)" % (outside, lim)
+                        if outside else ""), fontsize=8)
+    axes[0, 0].figure.suptitle("Range residuals z − |p_T − p_A| along the estimate (raw ranges, red: median)",
+                               fontsize=10)
+    axes[-1, 0].set_xlabel(label)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "range_residuals.png"), dpi=110)
+    plt.close(fig)
+
+
 def thin(n):
     step = max(1, n // MAX_POINTS)
     return slice(None, None, step)
@@ -94,11 +245,13 @@ def plot_anchors(ax, anchors, three_d=False):
             ax.annotate("%d" % int(aid), (x, y), textcoords="offset points", xytext=(6, 6), fontsize=8)
 
 
-def plot_trajectories(out, gt, est, anchors):
+def plot_trajectories(out, gt, est, anchors, aligned=None):
+    """`aligned`: the alignment mode when `gt` was mapped into the estimate's frame (legend)."""
+    true_label = "true" if not aligned else "true (%s-aligned)" % aligned
     fig, ax = plt.subplots(figsize=(7, 8))
     if gt is not None:
         s = thin(len(gt["t"]))
-        ax.plot(gt["tx"][s], gt["ty"][s], color="tab:blue", lw=1.2, label="true")
+        ax.plot(gt["tx"][s], gt["ty"][s], color="tab:blue", lw=1.2, label=true_label)
     if est is not None:
         s = thin(len(est["t"]))
         ax.plot(est["tx"][s], est["ty"][s], color="tab:purple", lw=1.0, alpha=0.85, label="estimate")
@@ -117,7 +270,7 @@ def plot_trajectories(out, gt, est, anchors):
     ax = fig.add_subplot(111, projection="3d")
     if gt is not None:
         s = thin(len(gt["t"]))
-        ax.plot(gt["tx"][s], gt["ty"][s], gt["tz"][s], color="tab:blue", lw=1.0, label="true")
+        ax.plot(gt["tx"][s], gt["ty"][s], gt["tz"][s], color="tab:blue", lw=1.0, label=true_label)
     if est is not None:
         s = thin(len(est["t"]))
         ax.plot(est["tx"][s], est["ty"][s], est["tz"][s], color="tab:purple", lw=0.9, alpha=0.85,
@@ -134,7 +287,7 @@ def plot_trajectories(out, gt, est, anchors):
 
 
 def plot_errors(out, err, prefix, sigma_prefix, unit, fname, title):
-    t = err["t"]
+    t, t_label = time_axis(err["t"])
     s = thin(len(t))
     fig, axes = plt.subplots(3, 1, figsize=(9, 7), sharex=True)
     selected = err["selected"] > 0.5
@@ -153,7 +306,7 @@ def plot_errors(out, err, prefix, sigma_prefix, unit, fname, title):
             lim = max(np.percentile(np.abs(e), 99.5) * 1.5, 1e-3)
             lim = max(lim, min(np.percentile(sg, 50) * 1.2, 10 * lim))
             ax.set_ylim(-lim, lim)
-    axes[-1].set_xlabel("t [s]")
+    axes[-1].set_xlabel(t_label)
     axes[0].set_title(title)
     fig.tight_layout()
     fig.savefig(os.path.join(out, fname), dpi=130)
@@ -161,7 +314,7 @@ def plot_errors(out, err, prefix, sigma_prefix, unit, fname, title):
 
 
 def plot_nees(out, err):
-    t = err["t"]
+    t, t_label = time_axis(err["t"])
     s = thin(len(t))
     fig, axes = plt.subplots(2, 1, figsize=(9, 5.5), sharex=True)
     for ax, key, name in zip(axes, ("nees_p", "nees_theta"), ("position", "orientation")):
@@ -177,7 +330,7 @@ def plot_nees(out, err):
         ax.grid(True, alpha=0.3, which="both")
         ax.legend(loc="upper right", fontsize=7)
     axes[0].set_title("NEES (dashed: 95 % interval of χ²(3), dotted: 3)")
-    axes[-1].set_xlabel("t [s]")
+    axes[-1].set_xlabel(t_label)
     fig.tight_layout()
     fig.savefig(os.path.join(out, "nees.png"), dpi=130)
     plt.close(fig)
@@ -240,6 +393,11 @@ def main():
     ap.add_argument("--groundtruth", help="groundtruth.csv (TUM)")
     ap.add_argument("--estimate", help="estimate.csv")
     ap.add_argument("--anchor-track", help="anchors.csv of the run (anchor estimates over time)")
+    ap.add_argument("--alignment", help="r00,r01,...,r22,tx,ty,tz: the fitted p_T = R p_E + t of meshnav_eval "
+                    "--align; the truth is drawn mapped into the estimate's frame")
+    ap.add_argument("--alignment-mode", default="se3", help="name of the alignment for the legend")
+    ap.add_argument("--ranges", help="ranges.csv of the dataset (range residuals)")
+    ap.add_argument("--setup", help="setup.yaml of the dataset (tag lever arms, known anchors)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     gt = read_csv(args.groundtruth)
@@ -247,8 +405,10 @@ def main():
     anchors = read_csv(args.anchors)
     err = read_csv(args.errors)
     written = []
+    alignment = read_alignment(args.alignment) if args.alignment else None
     if gt is not None or est is not None:
-        plot_trajectories(args.out, gt, est, anchors)
+        plot_trajectories(args.out, truth_in_estimate_frame(gt, alignment), est, anchors,
+                          args.alignment_mode if alignment is not None else None)
         written += ["trajectory_xy.png", "trajectory_3d.png"]
     if err is not None:
         plot_errors(args.out, err, "ep", "sigma3_p", "m", "position_error.png",
@@ -257,10 +417,19 @@ def main():
                     "Orientation error Log(R_est^T R_true) (body frame) with ±3σ")
         plot_nees(args.out, err)
         written += ["position_error.png", "orientation_error.png", "nees.png"]
-    tracks = anchor_tracks(read_csv(args.anchor_track), anchors)
+    track = read_csv(args.anchor_track)
+    tracks = anchor_tracks(track, anchors)
     if tracks:
         plot_anchor_errors(args.out, tracks)
         written.append("anchor_errors.png")
+    tags, anchor_pos = read_setup_geometry(args.setup)
+    if track is not None:  # the run's own anchors in G (calibrated ones too): the last row of each
+        for k in range(len(track["t"])):
+            anchor_pos[int(track["id"][k])] = np.array([track["x"][k], track["y"][k], track["z"][k]])
+    residuals = range_residuals(read_tag_anchor_ranges(args.ranges), est, tags, anchor_pos)
+    if residuals:
+        plot_range_residuals(args.out, residuals)
+        written.append("range_residuals.png")
     if not written:
         print("plot_run.py: nothing to plot (no trajectory, no errors)", file=sys.stderr)
         return 1

@@ -96,6 +96,14 @@ YAML::Node num(double v) {
   return YAML::Node(std::string(buf));
 }
 YAML::Node optNum(const std::optional<double>& v) { return v ? num(*v) : YAML::Node(YAML::NodeType::Null); }
+/// A time stamp node to the microsecond ("%.6f"): "%.6g" would turn a recording's Unix seconds
+/// (1664959690.648354) into 1.66496e+09.
+YAML::Node timeNum(double t_s) {
+  if (!std::isfinite(t_s)) return YAML::Node(YAML::NodeType::Null);
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.6f", t_s);
+  return YAML::Node(std::string(buf));
+}
 YAML::Node vec(const Eigen::Vector3d& v) {
   YAML::Node n;
   for (int i = 0; i < 3; ++i) n.push_back(num(v[i]));
@@ -260,8 +268,8 @@ YAML::Node metricsNode(const RunEvaluation& ev) {
     YAML::Node p;
     p["n_associated"] = m.n_associated;
     p["n_evaluated"] = m.n_selected;
-    p["t_first_s"] = num(m.t_first_s);
-    p["t_last_s"] = num(m.t_last_s);
+    p["t_first_s"] = timeNum(m.t_first_s);
+    p["t_last_s"] = timeNum(m.t_last_s);
     p["position"] = statsNode(m.position, "m");
     p["orientation"] = statsNode(m.orientation, "deg");
     root["pose"] = p;

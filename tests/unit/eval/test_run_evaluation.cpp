@@ -156,6 +156,18 @@ TEST_F(RunEvaluationTest, MetricsTablesAndFiles) {
   EXPECT_EQ(lines, 200);
 }
 
+TEST_F(RunEvaluationTest, MetricsKeepUnixTimesToTheMicrosecond) {
+  // Real recordings are stamped in Unix seconds: metrics.yaml once said t_first_s: 1.66496e+09.
+  RunEvaluation ev;
+  ev.trajectory.n_associated = ev.trajectory.n_selected = 2;
+  ev.trajectory.t_first_s = 1664959690.648354;
+  ev.trajectory.t_last_s = 1664959736.089986;
+  writeMetricsYaml(ev, (run_ / "metrics.yaml").string());
+  const YAML::Node m = YAML::LoadFile((run_ / "metrics.yaml").string());
+  EXPECT_EQ(m["pose"]["t_first_s"].as<std::string>(), "1664959690.648354");
+  EXPECT_EQ(m["pose"]["t_last_s"].as<std::string>(), "1664959736.089986");
+}
+
 TEST_F(RunEvaluationTest, AnchorGivenWithSigmaCountsAsEstimated) {
   writeAll(true, true);
   const RunEvaluation ev = evaluateRun(ds_.string(), run_.string(), {});
