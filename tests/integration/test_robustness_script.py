@@ -36,10 +36,7 @@ class DrawTest(unittest.TestCase):
 
 class FixedListTest(unittest.TestCase):
     def test_fixed12_covers_every_kind_layout_and_tag_count_with_outliers(self):
-        # The twelve are split: fixed12.yaml must pass, open.yaml (disabled in CTest) does not yet.
-        fixed = robustness.load_scenarios(os.path.join(ROOT, "config", "robustness", "fixed12.yaml"))
-        still_open = robustness.load_scenarios(os.path.join(ROOT, "config", "robustness", "open.yaml"))
-        scs = fixed + still_open
+        scs = robustness.load_scenarios(os.path.join(ROOT, "config", "robustness", "fixed12.yaml"))
         self.assertEqual(len(scs), 12)
         self.assertEqual(len({s["name"] for s in scs}), 12)
         self.assertEqual({s["trajectory"] for s in scs}, set(robustness.TRAJECTORIES))
