@@ -1,3 +1,9 @@
+/// @file estimator_node.cpp
+/// @brief EstimatorNode, first part: input validation and ordering, processing, the IMU step,
+/// commands and the outputs (pose, anchors, status). The measurement updates (baro, height, range,
+/// anchor initialization) are in estimator_node_updates.cpp; initialization, health and recovery
+/// in estimator_node_robustness.cpp.
+
 #include "estimator/node/estimator_node.h"
 #include "common/plausibility.h"
 
@@ -9,18 +15,12 @@
 #include <chrono>
 #include <cmath>
 
-#include "common/atmosphere.h"
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/node/node_internals.h"
-#include "estimator/uwb/range_model.h"
 
 namespace meshnav::estimator {
 
-namespace {
-
-std::string where(const char* channel, Timestamp t) { return std::string(channel) + " t=" + formatSeconds(t); }
-
-}  // namespace
+using node_internal::where;
 
 std::vector<EstimatorInput> mergeInTimeOrder(const Dataset& ds) {
   std::vector<EstimatorInput> all;
@@ -292,167 +292,6 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
       last_pose_pub_ = s.t;
       sinks_.pose(makePose());
     }
-  }
-}
-
-void EstimatorNode::processBaro(const BaroSample& s, bool first) {
-  if (!options_.baro.enabled) return;
-  if (!baro_reference_pa_) {
-    event(first, "baro_no_reference");
-    return;
-  }
-  propagateTo(s.t);
-  ScopedStepTimer timer(timings_, "baro_update");
-  BaroMeasurement z;
-  z.t = s.t;
-  z.baro_id = setup_.baro_id;
-  z.height_m = atmosphere::heightFromPressure(s.pressure_pa, *baro_reference_pa_);
-  z.sigma_m = std::abs(atmosphere::dHeightDPressure(s.pressure_pa, *baro_reference_pa_)) * options_.baro.pressure_sigma_pa;
-  const UpdateResult r = cur_.filter->update(baro_model_.linearize(z, cur_.filter->state()), baro_gate_);
-  if (first) countScalarUpdate(s.t, setup_.baro_id, "baro", r);
-}
-
-void EstimatorNode::countScalarUpdate(Timestamp t, SensorId id, const std::string& type, const UpdateResult& r) {
-  InstanceStatus& st = instance_stats_[id];
-  health_.onUpdate(t, type, 0, r.accepted, r.nis);
-  if (r.accepted) {
-    ++st.n_updates;
-  } else {
-    ++st.n_rejected;
-    diag_.count("gated_" + type);
-  }
-}
-
-void EstimatorNode::processHeight(const HeightSample& s, bool first) {
-  if (!options_.height.enabled) return;
-  if (s.range_m < options_.height.min_range_m) {
-    event(first, "height_below_min_range");  // clamped at the bottom of the sensor's range
-    return;
-  }
-  if (!height_model_.valid(cur_.filter->state())) {
-    event(first, "height_tilted");
-    return;
-  }
-  if (!cur_.filter->state().height_bias_m.count(setup_.height_id)) {
-    // The floor is at z = 0 of G: the bias is near zero unless the sensor sits far from the IMU.
-    const double b = pending_height_bias_ ? pending_height_bias_->first : 0.0;
-    const double var = pending_height_bias_ ? pending_height_bias_->second : std::pow(options_.height.init_bias_sigma_m, 2);
-    cur_.filter->addHeight(setup_.height_id, b, var);
-    if (first)
-      spdlog::info("estimator: height sensor {} added at t={} with bias {:.3f} m (σ {:.3f} m)", setup_.height_id,
-                   formatSeconds(s.t), b, std::sqrt(var));
-  }
-  propagateTo(s.t);
-  ScopedStepTimer timer(timings_, "height_update");
-  const HeightMeasurement z{s.t, setup_.height_id, s.range_m, options_.height.sigma_m};
-  const UpdateResult r = cur_.filter->update(height_model_.linearize(z, cur_.filter->state()), height_gate_);
-  if (first) countScalarUpdate(s.t, setup_.height_id, "height", r);
-}
-
-void EstimatorNode::processRange(const RangeSample& s, bool first) {
-  if (!options_.uwb.enabled) return;
-  RangeMeasurement z;
-  z.t = s.t;
-  z.a = s.id_initiator;
-  z.b = s.id_responder;
-  z.z_m = options_.uwb.use_corrected_range ? s.range_corr_m : s.range_m;
-  z.R_m2 = s.R_m2;
-  const RangeModel::Status status = RangeModel::classify(z, cur_.filter->state(), *cur_.network);
-  if (status != RangeModel::Status::Ok) {
-    if (status == RangeModel::Status::UnknownId)
-      event(first, "unknown_id",
-            where("RANGE", s.t) + ": unknown device in range " + std::to_string(z.a) + "–" + std::to_string(z.b));
-    else
-      event(first, RangeModel::statusName(status));
-    return;
-  }
-  if (skip_estimated_anchor_pairs_ && cur_.filter->state().anchor_p_AinG.count(z.a) &&
-      cur_.filter->state().anchor_p_AinG.count(z.b)) {
-    event(first, "range_dah_anchor_pair_skipped");  // a policy, not bad input (see UwbOptions)
-    return;
-  }
-  if (!options_.uwb.fuse_calibrated_anchor_pairs && cur_.network->isCalibrated(z.a) &&
-      cur_.network->isCalibrated(z.b)) {
-    event(first, "range_calibrated_anchor_pair_skipped");  // a policy (see UwbOptions)
-    return;
-  }
-  propagateTo(s.t);
-  ScopedStepTimer timer(timings_, "range_update");
-  Linearization lin;
-  const RangeModel::Status st = RangeModel::linearize(z, cur_.filter->state(), *cur_.network, &lin);
-  if (st != RangeModel::Status::Ok) {
-    event(first, RangeModel::statusName(st));
-    return;
-  }
-  const UpdateResult r = cur_.filter->update(lin, range_gate_);
-  const bool tag_range = cur_.network->isTag(z.a) || cur_.network->isTag(z.b);
-  // H P Hᵀ / R from NIS = ν²/S, S = H P Hᵀ + R (scalar range).
-  const double nu2 = lin.residual(0) * lin.residual(0), R = lin.R(0, 0);
-  const double prior_ratio = r.nis > 0.0 && R > 0.0 ? std::max(0.0, nu2 / r.nis - R) / R : 0.0;
-  if (tag_range && cur_.noise_adapter.onRangeNis(r.nis, prior_ratio) && first) {
-    diag_.count("process_noise_scale_change");
-    spdlog::info("estimator: IMU noise scale {:.3g} at t={} (median range NIS {:.2f} of its expected value)",
-                 cur_.noise_adapter.scale(), formatSeconds(s.t), cur_.noise_adapter.lastRatio());
-  }
-  if (!first) return;
-  if (!r.accepted) diag_.count("gated_range");
-  // Tag ranges tell whether the pose is right; ranges between anchors do not.
-  if (tag_range)
-    health_.onUpdate(s.t, "range", cur_.network->isTag(z.a) ? z.b : z.a, r.accepted, r.nis);
-  else
-    health_.onUpdate(s.t, "anchor_range", 0, r.accepted, r.nis);
-  for (SensorId id : {z.a, z.b}) {
-    InstanceStatus& is = instance_stats_[id];
-    ++(r.accepted ? is.n_updates : is.n_rejected);
-  }
-}
-
-void EstimatorNode::applyAnchorInit(const AnchorInit& a, bool first) {
-  auto net = std::make_shared<UwbNetwork>(*cur_.network);
-  if (net->isTag(a.id)) {
-    event(first, "bad_command", where("ANCHOR_INIT", a.t) + ": id " + std::to_string(a.id) + " is a tag");
-    return;
-  }
-  net->removeDevice(a.id);  // an exactly known anchor becomes an estimated one
-  net->setCalibrated(a.id, true);
-  for (PairBias b : a.biases) {
-    if (b.a != a.id && b.b != a.id) b.b = a.id;
-    net->setPairBias(b);
-  }
-  cur_.network = std::move(net);
-  // The anchor's γ with an uncertainty become states after its position (issue 10), with the
-  // calibration's joint covariance: a γ error and the position error along that reference's
-  // direction are strongly correlated, and fixing γ would let repeated ranges average away an
-  // error that is constant.
-  BiasState biases;
-  std::vector<Eigen::Index> rows = {0, 1, 2};  // rows of the joint [p, γ_1..γ_n] kept
-  std::vector<double> gamma;
-  if (options_.uwb.estimate_anchor_biases) {
-    for (size_t i = 0; i < a.biases.size(); ++i) {
-      const PairBias& b = a.biases[i];
-      const SensorId peer = b.a == a.id ? b.b : b.a;
-      if (peer == a.id || b.sigma_gamma_m <= 0.0 || biases.index(peer) >= 0) continue;
-      biases.peers.push_back(peer);
-      gamma.push_back(b.gamma_m);
-      rows.push_back(3 + static_cast<Eigen::Index>(i));
-    }
-  }
-  biases.gamma_m = Eigen::Map<const Eigen::VectorXd>(gamma.data(), static_cast<Eigen::Index>(gamma.size()));
-  AnchorInit marginal = a;
-  if (!options_.uwb.anchor_bias_joint_covariance) marginal.cov_gamma_p_m2.resize(0, 0), marginal.cov_gamma_m2.resize(0, 0);
-  const Eigen::MatrixXd J = marginal.jointCovariance();
-  Eigen::MatrixXd cov(rows.size(), rows.size());
-  for (size_t r = 0; r < rows.size(); ++r)
-    for (size_t c = 0; c < rows.size(); ++c) cov(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = J(rows[r], rows[c]);
-  cur_.filter->addAnchor(a.id, a.p_AinG, cov, biases);
-  if (first) {
-    diag_.count("anchor_init");
-    spdlog::info("estimator: anchor {} added at t={} p_AinG=[{:.3f}, {:.3f}, {:.3f}] with {} pair biases, {} as states{}",
-                 a.id, formatSeconds(a.t), a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z(), a.biases.size(),
-                 biases.peers.size(),
-                 biases.peers.empty() ? ""
-                 : a.hasJointCovariance() && options_.uwb.anchor_bias_joint_covariance ? " (joint covariance)"
-                                                                                        : " (independent of the position)");
   }
 }
 

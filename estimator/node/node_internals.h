@@ -1,20 +1,25 @@
 #pragma once
 /// @file node_internals.h
-/// @brief Helpers shared by the two translation units of EstimatorNode (estimator_node.cpp: input
-/// handling, processing and outputs; estimator_node_robustness.cpp: alignment, health, recovery,
-/// IMU gaps). Internal to the node.
+/// @brief Helpers shared by the translation units of EstimatorNode (estimator_node.cpp: input
+/// handling, processing and outputs; estimator_node_updates.cpp: the measurement updates;
+/// estimator_node_robustness.cpp: alignment, health, recovery, IMU gaps). Internal to the node.
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
 
+#include "common/time.h"
 #include "estimator/core/estimator_options.h"
 #include "estimator/core/imu_state.h"
 #include "estimator/node/motion_aligner.h"
 
 namespace meshnav::estimator::node_internal {
+
+/// "CHANNEL t=<seconds>": where a rejected or odd input came from, for messages.
+inline std::string where(const char* channel, Timestamp t) { return std::string(channel) + " t=" + formatSeconds(t); }
 
 inline MotionAlignerOptions alignerOptions(const EstimatorOptions& o, const Eigen::Vector3d& p_IH) {
   MotionAlignerOptions a;

@@ -1,0 +1,357 @@
+/// @file factorized_covariance_dah_scalar.cpp
+/// @brief FactorizedCovariance, second part: the DAH fast path for a scalar update (UWB range,
+/// baro), updateDahScalar(), with its stack-storage types and fixed-size kernels. The first part,
+/// factorized_covariance.cpp, holds the instances, propagation, the general update and the
+/// write-backs (DP and DAH) and the invariant check.
+
+#include "estimator/filter/factorized_covariance.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "estimator/core/imu_state.h"
+#include "estimator/filter/dense_ekf_update.h"
+#include "estimator/filter/factorized_covariance_internals.h"
+
+namespace meshnav::estimator {
+
+namespace {
+
+using Eigen::MatrixXd;
+using factorized_internal::roughCondition;
+using factorized_internal::shared;
+
+// ---- DAH scalar fast path (updateDahScalar): stack storage, fixed-size kernels per instance. ----
+constexpr int kMaxParticipants = 4;
+constexpr int kMaxInstanceDim = 15;  ///< the IMU
+constexpr int kMaxStackedDim = 32;
+/// The stacked Σ_PP and vectors over it without heap allocation.
+using StackMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxStackedDim, kMaxStackedDim>;
+using StackVec = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxStackedDim, 1>;
+/// One instance's matrices (factors, L_i⁻¹) without heap allocation.
+using InstMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxInstanceDim, kMaxInstanceDim>;
+
+/// The true factor S = L_i S̄ of one side of a pair into `out`; false when it is the identity.
+bool trueFactorInto(const InstanceBelief& b, const FactorEntry& e, InstMat& out) {
+  if (!e.S_bar) {
+    if (!b.L.size()) return false;
+    out = b.L;
+  } else if (!b.L.size()) {
+    out = *e.S_bar;
+  } else if (b.dim == ImuErr::kDim && e.S_bar->cols() == 3) {
+    // Σ_IA factor of the IMU towards an anchor: fixed-size kernel.
+    using M15 = Eigen::Matrix<double, ImuErr::kDim, ImuErr::kDim>;
+    using M15x3 = Eigen::Matrix<double, ImuErr::kDim, 3>;
+    out.resize(ImuErr::kDim, 3);
+    Eigen::Map<M15x3>(out.data()).noalias() =
+        Eigen::Map<const M15>(b.L.data()).lazyProduct(Eigen::Map<const M15x3>(e.S_bar->data()));
+  } else {
+    out.noalias() = b.L * *e.S_bar;
+  }
+  return true;
+}
+
+/// A⁻¹ of a fixed-size square matrix by Gauss elimination with partial pivoting on [A | I] (the
+/// pivots and the elimination of Eigen's unblocked PartialPivLU; whole contiguous rows of row-major
+/// storage, so every step is a fixed-size vector operation), then back substitution. Allocation-free;
+/// a singular A gives non-finite entries (as Eigen's inverse does), which the caller checks.
+template <int D>
+Eigen::Matrix<double, D, D> luInverse(const Eigen::Matrix<double, D, D>& A) {
+  // Rows padded to an even length (zero columns stay zero): aligned packets, no scalar tail.
+  constexpr int kCols = D + D % 2;
+  using RowMat = Eigen::Matrix<double, D, kCols, Eigen::RowMajor>;
+  RowMat U = RowMat::Zero();
+  U.template leftCols<D>() = A;
+  RowMat X = RowMat::Identity();
+  for (int k = 0; k < D; ++k) {
+    int piv = k;
+    double biggest = std::abs(U(k, k));
+    for (int i = k + 1; i < D; ++i)
+      if (std::abs(U(i, k)) > biggest) biggest = std::abs(U(i, k)), piv = i;
+    if (biggest == 0.0) continue;  // singular: U(k, k) = 0 makes the result non-finite
+    if (piv != k) {
+      U.row(k).swap(U.row(piv));
+      X.row(k).swap(X.row(piv));
+    }
+    // Rows i > k: the columns < k are zero in rows i and k; column k is not read again.
+    for (int i = k + 1; i < D; ++i) {
+      const double l = U(i, k) / U(k, k);
+      U.row(i) -= l * U.row(k);
+      X.row(i) -= l * X.row(k);
+    }
+  }
+  for (int k = D - 1; k >= 0; --k) {
+    X.row(k) *= 1.0 / U(k, k);
+    for (int i = 0; i < k; ++i) X.row(i) -= U(i, k) * X.row(k);
+  }
+  return X.template leftCols<D>();
+}
+
+/// w = Σ⁻¹ u for a symmetric positive definite Σ of fixed size by Cholesky (Σ = C Cᵀ); false when
+/// Σ is not numerically positive definite (the caller then uses Eigen's LDLT).
+template <int D, typename UV>
+bool choleskySolve(const Eigen::Map<const Eigen::Matrix<double, D, D>>& S, const UV& u, Eigen::Matrix<double, D, 1>* w) {
+  Eigen::Matrix<double, D, D> C;  // lower triangle used
+  for (int j = 0; j < D; ++j) {
+    double d = S(j, j);
+    for (int k = 0; k < j; ++k) d -= C(j, k) * C(j, k);
+    if (!(d > 0.0)) return false;
+    const double cjj = std::sqrt(d);
+    C(j, j) = cjj;
+    for (int i = j + 1; i < D; ++i) {
+      double v = S(i, j);
+      for (int k = 0; k < j; ++k) v -= C(i, k) * C(j, k);
+      C(i, j) = v / cjj;
+    }
+  }
+  Eigen::Matrix<double, D, 1>& x = *w;
+  for (int i = 0; i < D; ++i) {  // C y = u
+    double v = u(i);
+    for (int k = 0; k < i; ++k) v -= C(i, k) * x(k);
+    x(i) = v / C(i, i);
+  }
+  for (int i = D - 1; i >= 0; --i) {  // Cᵀ x = y
+    double v = x(i);
+    for (int k = i + 1; k < D; ++k) v -= C(k, i) * x(k);
+    x(i) = v / C(i, i);
+  }
+  return true;
+}
+
+/// DAH correction of a participant i of a joint scalar update: L_i ← (Σ_ii' Σ_ii⁻¹) L_i. With
+/// u = the participant's rows of Σ_PP hᵀ, s = h Σ_PP hᵀ + R and the optimal gain,
+/// Σ_ii' = Σ_ii − u uᵀ / s, so Σ_ii' Σ_ii⁻¹ = I − u wᵀ / s with w = Σ_ii⁻¹ u and
+/// L_i' = L_i − u (wᵀ L_i) / s: one solve and O(dim²), instead of dim right-hand sides of
+/// Σ_ii Mᵀ = Σ_ii' and a dim³ product (the same matrix up to rounding).
+template <int D, typename UV>
+void foldDahCorrection(InstanceBelief& b, const UV& u, double s) {
+  using Mat = Eigen::Matrix<double, D, D>;
+  using Vec = Eigen::Matrix<double, D, 1>;
+  const int d = b.dim;
+  const Eigen::Map<const Mat> S_old(b.Sigma.data(), d, d);
+  Vec w(d);
+  if constexpr (D == Eigen::Dynamic) {
+    w = S_old.ldlt().solve(u);
+  } else {
+    if (!choleskySolve<D>(S_old, u, &w)) w = S_old.ldlt().solve(u);
+  }
+  if (!b.L.size()) {
+    b.L.resize(d, d);
+    for (int j = 0; j < d; ++j)
+      for (int i = 0; i < d; ++i) b.L(i, j) = (i == j ? 1.0 : 0.0) - u(i) * (w(j) / s);
+    return;
+  }
+  Eigen::Map<Mat> L(b.L.data(), d, d);
+  const Eigen::Matrix<double, 1, D> v = (w.transpose() * L) / s;
+  for (int j = 0; j < d; ++j)
+    for (int i = 0; i < d; ++i) L(i, j) -= u(i) * v(j);
+}
+
+/// L_i⁻¹ into `out`; false when L_i must be re-normalized instead (old, not finite, badly conditioned).
+template <int D>
+bool invertPending(const InstanceBelief& b, int max_lazy_steps, double max_condition, InstMat& out) {
+  using Mat = Eigen::Matrix<double, D, D>;
+  const Eigen::Map<const Mat> L(b.L.data(), b.dim, b.dim);
+  Mat inv;
+  if constexpr (D == Eigen::Dynamic)
+    inv = L.partialPivLu().inverse();
+  else
+    inv = luInverse<D>(L);
+  if (b.lazy_steps > max_lazy_steps || !inv.allFinite() || roughCondition(L, inv) > max_condition) return false;
+  out = inv;
+  return true;
+}
+
+}  // namespace
+
+bool FactorizedCovariance::updateDahScalar(const Linearization& lin, double nis_gate, Timestamp t, Result* res) {
+  if (lin.dim() != 1 || lin.R.rows() != 1 || lin.R.cols() != 1 || lin.blocks.empty() ||
+      lin.blocks.size() > static_cast<size_t>(kMaxParticipants))
+    return false;
+  // Participants P in layout order, their offsets in the stacked state.
+  struct Part {
+    int k = 0, off = 0, dim = 0;
+    SensorId id = 0;
+  };
+  std::array<int, kMaxParticipants> ks{};
+  int np = 0;
+  for (const JacobianBlock& jb : lin.blocks) {
+    if (!has(jb.id)) throw std::logic_error("FactorizedCovariance::update: no instance " + std::to_string(jb.id));
+    ks[static_cast<size_t>(np++)] = index(jb.id);
+  }
+  std::sort(ks.begin(), ks.begin() + np);
+  np = static_cast<int>(std::unique(ks.begin(), ks.begin() + np) - ks.begin());
+  std::array<Part, kMaxParticipants> pp;
+  int n = 0;
+  for (int a = 0; a < np; ++a) {
+    const StateBlock& b = layout_.blocks()[static_cast<size_t>(ks[static_cast<size_t>(a)])];
+    if (b.dim > kMaxInstanceDim) return false;
+    pp[static_cast<size_t>(a)] = Part{ks[static_cast<size_t>(a)], n, b.dim, b.id};
+    n += b.dim;
+  }
+  if (n > kMaxStackedDim) return false;
+  auto partOf = [&](SensorId id) -> const Part* {
+    for (int a = 0; a < np; ++a)
+      if (pp[static_cast<size_t>(a)].id == id) return &pp[static_cast<size_t>(a)];
+    return nullptr;
+  };
+  for (const JacobianBlock& jb : lin.blocks)
+    if (jb.H.rows() != 1 || jb.H.cols() != partOf(jb.id)->dim)
+      throw std::logic_error("EKF update: Jacobian block of " + std::to_string(jb.id) + " has wrong size");
+
+  // Stack Σ_PP: blocks Σ_ii and Σ_ij = S_ij S_jiᵀ (identity factors are not multiplied).
+  StackMat P(n, n);
+  InstMat A, B;
+  for (int a = 0; a < np; ++a) {
+    const Part& pa = pp[static_cast<size_t>(a)];
+    const InstanceBelief& ba = *inst_[static_cast<size_t>(pa.k)];
+    P.block(pa.off, pa.off, pa.dim, pa.dim) = ba.Sigma;
+    for (int c = a + 1; c < np; ++c) {
+      const Part& pc = pp[static_cast<size_t>(c)];
+      const InstanceBelief& bc = *inst_[static_cast<size_t>(pc.k)];
+      auto C = P.block(pa.off, pc.off, pa.dim, pc.dim);
+      const FactorEntry* eac = ba.factors->find(bc.id);
+      if (!eac) {
+        C.setZero();
+      } else {
+        const FactorEntry* eca = bc.factors->find(ba.id);
+        if (!eca)
+          throw std::logic_error("FactorizedCovariance: factor of pair (" + std::to_string(ba.id) + ", " +
+                                 std::to_string(bc.id) + ") present on one side only");
+        const bool fa = trueFactorInto(ba, *eac, A), fc = trueFactorInto(bc, *eca, B);
+        if (fa && fc)
+          C.noalias() = A * B.transpose();
+        else if (fa)
+          C = A;
+        else if (fc)
+          C = B.transpose();
+        else
+          C.setIdentity();
+      }
+      P.block(pc.off, pa.off, pc.dim, pa.dim) = C.transpose();
+    }
+  }
+
+  // Scalar EKF update (the arithmetic of denseEkfUpdate with m = 1): u = Σ_PP hᵀ, s = h u + R,
+  // NIS = r² / s, K = u / s, Joseph form P ← P − K uᵀ − u Kᵀ + K s Kᵀ (or P ← P − K uᵀ), symmetrized.
+  StackVec U = StackVec::Zero(n);
+  for (const JacobianBlock& jb : lin.blocks) {
+    const Part& p = *partOf(jb.id);
+    U.noalias() += P.middleCols(p.off, p.dim) * jb.H.transpose();
+  }
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 1, 1> S = lin.R;
+  for (const JacobianBlock& jb : lin.blocks) {
+    const Part& p = *partOf(jb.id);
+    S.noalias() += jb.H * U.middleRows(p.off, p.dim);
+  }
+  const double s = S(0, 0);
+  const bool invertible = std::abs(s) > std::numeric_limits<double>::min();  // LDLT's pseudo-inverse
+  const double r = lin.residual(0);
+  res->nis = r * (invertible ? r / s : 0.0);
+  if (!std::isfinite(res->nis) || (nis_gate > 0.0 && res->nis > nis_gate)) return true;
+  StackVec K(n);
+  for (int i = 0; i < n; ++i) K(i) = invertible ? U(i) / s : 0.0;
+  if (joseph_) {
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        P(i, j) = P(i, j) + ((-(K(i) * U(j)) - K(j) * U(i)) + (K(i) * s) * K(j));
+  } else {
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) P(i, j) -= K(i) * U(j);
+  }
+  for (int j = 0; j < n; ++j)
+    for (int i = j + 1; i < n; ++i) P(i, j) = P(j, i) = 0.5 * (P(i, j) + P(j, i));
+  res->accepted = true;
+  res->dx.resize(n);
+  for (int i = 0; i < n; ++i) res->dx(i) = K(i) * r;
+  res->blocks.resize(static_cast<size_t>(np));
+  for (int a = 0; a < np; ++a) {
+    const Part& p = pp[static_cast<size_t>(a)];
+    res->blocks[static_cast<size_t>(a)] = StateBlock{p.id, layout_.blocks()[static_cast<size_t>(p.k)].kind, p.off, p.dim};
+  }
+
+  // 1. Σ_ii' and the pending factors.
+  if (np == 1) {
+    // Private update: Σ_ik' = (I − K h_i) Σ_ik exactly: L_i ← (I − K h_i) L_i = L_i − K (h_i L_i).
+    const Part& p = pp[0];
+    const JacobianBlock& jb = *lin.find(p.id);
+    InstanceBelief& b = mut(p.k);
+    if (!b.L.size()) {
+      b.L.resize(p.dim, p.dim);
+      for (int j = 0; j < p.dim; ++j)
+        for (int i = 0; i < p.dim; ++i) b.L(i, j) = (i == j ? 1.0 : 0.0) - K(i) * jb.H(0, j);
+    } else if (p.dim == ImuErr::kDim) {
+      using M15 = Eigen::Matrix<double, ImuErr::kDim, ImuErr::kDim>;
+      Eigen::Map<M15> L(b.L.data());
+      const Eigen::Matrix<double, 1, ImuErr::kDim> hL = Eigen::Map<const Eigen::Matrix<double, 1, ImuErr::kDim>>(jb.H.data()) * L;
+      L.noalias() -= Eigen::Map<const Eigen::Matrix<double, ImuErr::kDim, 1>>(K.data()) * hL;
+    } else {
+      const Eigen::RowVectorXd hL = jb.H * b.L;
+      b.L.noalias() -= K.head(p.dim) * hL;
+    }
+    b.Sigma = P;
+    b.t = t;
+    if (++b.lazy_steps > kMaxLazySteps) renormalize(p.id);
+    return true;
+  }
+  for (int a = 0; a < np; ++a) {
+    const Part& p = pp[static_cast<size_t>(a)];
+    InstanceBelief& b = mut(p.k);
+    if (invertible) {  // else K = 0: nothing changed
+      const auto u = U.segment(p.off, p.dim);
+      if (p.dim == ImuErr::kDim)
+        foldDahCorrection<ImuErr::kDim>(b, u, s);
+      else if (p.dim == 3)
+        foldDahCorrection<3>(b, u, s);
+      else
+        foldDahCorrection<Eigen::Dynamic>(b, u, s);
+    }
+    b.Sigma = P.block(p.off, p.off, p.dim, p.dim);
+    b.t = t;
+    ++b.lazy_steps;
+  }
+  // 2. L_i'⁻¹ of the participants (re-normalize when L_i' is badly conditioned or old).
+  std::array<InstMat, kMaxParticipants> Linv;
+  std::array<bool, kMaxParticipants> has_inv{};
+  for (int a = 0; a < np; ++a) {
+    const Part& p = pp[static_cast<size_t>(a)];
+    const InstanceBelief& b = *inst_[static_cast<size_t>(p.k)];
+    if (b.L.size() == 0) continue;
+    const bool ok = p.dim == ImuErr::kDim ? invertPending<ImuErr::kDim>(b, kMaxLazySteps, kMaxLazyCondition, Linv[a])
+                    : p.dim == 3          ? invertPending<3>(b, kMaxLazySteps, kMaxLazyCondition, Linv[a])
+                                          : invertPending<Eigen::Dynamic>(b, kMaxLazySteps, kMaxLazyCondition, Linv[a]);
+    if (ok)
+      has_inv[static_cast<size_t>(a)] = true;
+    else
+      renormalize(p.id);
+  }
+  // 3. Pair factors within P: smaller id S̄_ij = L_i'⁻¹ Σ_ij', larger id S̄_ji = L_j'⁻¹ (S_ji = I).
+  for (int a = 0; a < np; ++a) {
+    for (int c = a + 1; c < np; ++c) {
+      const bool a_small = pp[static_cast<size_t>(a)].id < pp[static_cast<size_t>(c)].id;
+      const size_t si = static_cast<size_t>(a_small ? a : c), li = static_cast<size_t>(a_small ? c : a);
+      const Part &ps = pp[si], &pl = pp[li];
+      const auto C = P.block(ps.off, pl.off, ps.dim, pl.dim);
+      MatrixXd S_bar(ps.dim, pl.dim);
+      if (!has_inv[si]) {
+        S_bar = C;
+      } else if (ps.dim == ImuErr::kDim && pl.dim == 3) {
+        using M15 = Eigen::Matrix<double, ImuErr::kDim, ImuErr::kDim>;
+        using M15x3 = Eigen::Matrix<double, ImuErr::kDim, 3>;
+        Eigen::Map<M15x3>(S_bar.data()).noalias() = Eigen::Map<const M15>(Linv[si].data()).lazyProduct(M15x3(C));
+      } else {
+        S_bar.noalias() = Linv[si] * C;
+      }
+      mutDict(mut(ps.k)).set(pl.id, shared(std::move(S_bar)));
+      mutDict(mut(pl.k)).set(ps.id, has_inv[li] ? shared(MatrixXd(Linv[li])) : nullptr);
+    }
+  }
+  return true;
+}
+
+}  // namespace meshnav::estimator

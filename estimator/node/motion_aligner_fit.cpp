@@ -1,0 +1,324 @@
+/// @file motion_aligner_fit.cpp
+/// @brief MotionAligner, second part: the fit of the window. Start points over yaw, Levenberg–
+/// Marquardt with Huber weights and bias priors, the robust variance factor, and the covariance,
+/// end state and acceptance checks of the best fit. The window and the observation model are in
+/// motion_aligner.cpp.
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "estimator/core/huber.h"
+#include "estimator/core/so3.h"
+#include "estimator/node/motion_aligner.h"
+#include "estimator/node/motion_aligner_internals.h"
+
+namespace meshnav::estimator {
+
+namespace {
+
+using motion_aligner_internal::kBh;
+using motion_aligner_internal::kDim;
+using motion_aligner_internal::MatU;
+using motion_aligner_internal::VecU;
+
+constexpr double kDeg = M_PI / 180.0;
+
+Eigen::Matrix3d rotZ(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+
+}  // namespace
+
+double MotionAligner::fit(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights, Unknowns& x,
+                          MatU* info) const {
+  const double prior_ba = 1.0 / (options_.sigma_bias_acc_m_s2 * options_.sigma_bias_acc_m_s2);
+  const double prior_bg = 1.0 / (options_.sigma_bias_gyro_rad_s * options_.sigma_bias_gyro_rad_s);
+  const double prior_bh = 1.0 / (options_.sigma_bias_height_m * options_.sigma_bias_height_m);
+  auto cost = [&](const Unknowns& u) {
+    double c = prior_ba * u.ba.squaredNorm() + prior_bg * u.dbg.squaredNorm() + prior_bh * u.bh * u.bh;
+    for (const Obs& o : obs)
+      if (o.use) c += huber::cost(residual(o, u) / o.r.sigma_m);
+    for (const HeightObs& o : heights)
+      if (o.use) c += huber::cost(residual(o, u) / o.h.sigma_m);
+    return c;
+  };
+  double c = cost(x), lambda = 1e-3;
+  MatU H;
+  for (int it = 0; it < 25; ++it) {
+    H.setZero();
+    VecU g = VecU::Zero();
+    for (const Obs& o : obs) {
+      if (!o.use) continue;
+      const double r = residual(o, x);
+      const double e = std::abs(r) / o.r.sigma_m;
+      const double w = huber::weight(e) / (o.r.sigma_m * o.r.sigma_m);
+      const Eigen::Matrix<double, 1, 16> J = jacobian(o, x);
+      H += w * J.transpose() * J;
+      g += w * J.transpose() * r;
+    }
+    for (const HeightObs& o : heights) {
+      if (!o.use) continue;
+      const double r = residual(o, x);
+      const double w = huber::weight(std::abs(r) / o.h.sigma_m) / (o.h.sigma_m * o.h.sigma_m);
+      const Eigen::Matrix<double, 1, 16> J = jacobian(o, x);
+      H += w * J.transpose() * J;
+      g += w * J.transpose() * r;
+    }
+    H(kBh, kBh) += prior_bh;
+    g(kBh) += prior_bh * x.bh;
+    H.block<3, 3>(9, 9).diagonal().array() += prior_ba;
+    g.segment<3>(9) += prior_ba * x.ba;
+    H.block<3, 3>(12, 12).diagonal().array() += prior_bg;
+    g.segment<3>(12) += prior_bg * x.dbg;
+    bool improved = false;
+    for (int tries = 0; tries < 6 && !improved; ++tries) {
+      MatU A = H;
+      A.diagonal() += lambda * H.diagonal().cwiseMax(1e-9);
+      const VecU step = -A.ldlt().solve(g);
+      const Unknowns xn = x.plus(step);
+      const double cn = cost(xn);
+      if (std::isfinite(cn) && cn < c) {
+        improved = true;
+        const bool small = step.norm() < 1e-7 || c - cn < 1e-9 * (1.0 + c);
+        x = xn;
+        c = cn;
+        lambda = std::max(lambda / 4.0, 1e-9);
+        if (small) it = 1000;
+      } else {
+        lambda *= 8.0;
+      }
+    }
+    if (!improved) break;
+  }
+  if (info) *info = H;
+  return c;
+}
+
+ImuState MotionAligner::endState(const Unknowns& x, const Increments& end, const Eigen::Vector3d& bias_gyro) const {
+  const Eigen::Vector3d g(0.0, 0.0, -options_.gravity_m_s2);
+  const double T = end.tau_s;
+  ImuState s;
+  s.p_IinG = x.p0 + x.v0 * T + 0.5 * g * T * T + x.R0 * (end.S + end.JS * x.dbg - end.M * x.ba);
+  s.v_IinG = x.v0 + g * T + x.R0 * (end.V + end.JV * x.dbg - end.N * x.ba);
+  s.q_ItoG = Eigen::Quaterniond(x.R0 * end.C * so3::expMap(end.JC * x.dbg)).normalized();
+  s.bias_gyro_rad_s = bias_gyro + x.dbg;
+  s.bias_acc_m_s2 = x.ba;
+  return s;
+}
+
+std::vector<MotionAligner::Unknowns> MotionAligner::starts(const std::vector<Obs>& obs) const {
+  std::map<SensorId, Eigen::Vector3d> anchors;
+  for (const Obs& o : obs) anchors[o.r.anchor] = o.r.p_AinG;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& [id, p] : anchors) centroid += p;
+  centroid /= static_cast<double>(anchors.size());
+  // Static position fit (the window's mean position), multi-start.
+  auto staticCost = [&](const Eigen::Vector3d& p) {
+    double c = 0.0;
+    for (const Obs& o : obs) c += huber::cost((o.r.d_m - (o.r.p_AinG - p).norm()) / o.r.sigma_m);
+    return c;
+  };
+  auto staticFit = [&](Eigen::Vector3d p) {
+    for (int it = 0; it < 20; ++it) {
+      Eigen::Matrix3d A = Eigen::Matrix3d::Identity() * 1e-6;
+      Eigen::Vector3d b = Eigen::Vector3d::Zero();
+      for (const Obs& o : obs) {
+        const Eigen::Vector3d d = o.r.p_AinG - p;
+        const double n = std::max(d.norm(), 1e-6);
+        const Eigen::Vector3d J = d / n;  // ∂r/∂p
+        const double r = o.r.d_m - n;
+        A += J * J.transpose();
+        b += J * r;
+      }
+      p -= A.ldlt().solve(b);
+    }
+    return p;
+  };
+  Eigen::Vector3d best = centroid;
+  double best_c = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& off : {Eigen::Vector3d(0, 0, -1.5), Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(-2, 0, 0),
+                                     Eigen::Vector3d(0, 2, 0), Eigen::Vector3d(0, -2, 0), Eigen::Vector3d(0, 0, 1.5)}) {
+    const Eigen::Vector3d p = staticFit(centroid + off);
+    const double c = staticCost(p);
+    if (p.allFinite() && c < best_c) best_c = c, best = p;
+  }
+  std::vector<Eigen::Vector3d> positions{best};
+  // Nearly coplanar anchors: the mirror image across their plane fits the ranges as well.
+  Eigen::MatrixXd D(3, anchors.size());
+  int i = 0;
+  for (const auto& [id, p] : anchors) D.col(i++) = p - centroid;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(D, Eigen::ComputeFullU);
+  if (svd.singularValues()(2) / std::sqrt(static_cast<double>(anchors.size())) < 0.3) {
+    const Eigen::Vector3d n = svd.matrixU().col(2);
+    positions.push_back(best - 2.0 * n.dot(best - centroid) * n);
+  }
+  // Roll and pitch from the mean specific force (gravity dominates over a few seconds).
+  Eigen::Vector3d f = Eigen::Vector3d::Zero();
+  const Timestamp t0 = windowStart();
+  for (const ImuSample& s : imu_)
+    if (s.t >= t0) f += s.acc_m_s2;
+  const double roll = std::atan2(f.y(), f.z()), pitch = std::atan2(-f.x(), std::hypot(f.y(), f.z()));
+  const Eigen::Matrix3d R_rp =
+      (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
+  std::vector<Unknowns> out;
+  for (const Eigen::Vector3d& p : positions)
+    for (int k = 0; k < options_.yaw_starts; ++k) {
+      Unknowns x;
+      x.p0 = p;
+      x.R0 = rotZ(2.0 * M_PI * k / options_.yaw_starts) * R_rp;
+      out.push_back(x);
+    }
+  return out;
+}
+
+std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_gyro_rad_s) {
+  if (spanSeconds() < options_.min_span_s) {
+    reason_ = "motion alignment: " + std::to_string(spanSeconds()) + " s of IMU data, need " +
+              std::to_string(options_.min_span_s) + " s";
+    return std::nullopt;
+  }
+  Increments end;
+  std::vector<HeightObs> heights;
+  std::vector<Obs> obs = buildObservations(bias_gyro_rad_s, &end, &heights);
+  std::set<SensorId> anchor_ids;
+  for (const Obs& o : obs) anchor_ids.insert(o.r.anchor);
+  if (static_cast<int>(obs.size()) < options_.min_ranges || static_cast<int>(anchor_ids.size()) < options_.min_anchors) {
+    reason_ = "motion alignment: " + std::to_string(obs.size()) + " tag ranges to " + std::to_string(anchor_ids.size()) +
+              " known anchors in the window, need " + std::to_string(options_.min_ranges) + " to " +
+              std::to_string(options_.min_anchors);
+    return std::nullopt;
+  }
+  // Multi-start, then keep the distinct local minima.
+  struct Candidate {
+    Unknowns x;
+    double cost;
+    ImuState end;
+  };
+  std::vector<Candidate> cands;
+  for (Unknowns x : starts(obs)) {
+    const double c = fit(obs, heights, x, nullptr);
+    if (std::isfinite(c)) cands.push_back({x, c, endState(x, end, bias_gyro_rad_s)});
+  }
+  if (cands.empty()) {
+    reason_ = "motion alignment: no fit converged";
+    return std::nullopt;
+  }
+  std::sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
+  auto distinct = [&](const ImuState& a, const ImuState& b) {
+    const double dyaw = std::remainder(so3::yawOf(a.q_ItoG) - so3::yawOf(b.q_ItoG), 2 * M_PI);
+    return (a.p_IinG - b.p_IinG).norm() > 0.5 || std::abs(dyaw) > 15.0 * kDeg;
+  };
+  // Outliers by the best candidate, then refit the best and the best distinct rival on the inliers.
+  Unknowns best = cands.front().x;
+  int n_used = 0;
+  for (Obs& o : obs) {
+    o.use = std::abs(residual(o, best)) <= std::max(options_.outlier_m, 4.0 * o.r.sigma_m);
+    n_used += o.use;
+  }
+  for (HeightObs& o : heights) o.use = std::abs(residual(o, best)) <= std::max(0.3, 4.0 * o.h.sigma_m);
+  MatU info;
+  const double best_cost = fit(obs, heights, best, &info);
+  const ImuState best_end = endState(best, end, bias_gyro_rad_s);
+  // Distinct rivals are refitted on the same inliers: first the best of those elsewhere (> 0.5 m
+  // away: a mirror image across nearly coplanar anchors), then by first-pass cost, up to 6 in all.
+  // The first-pass order includes the outliers, so the closest rival need not come first, and a
+  // handful of heading variants at the same place must not crowd out the mirror image (a walk
+  // under three anchors was initialized 1.15 m below the truth that way).
+  // Costs are compared in units of the residuals' own scatter: ranges that fit worse than their σ
+  // (unmodelled drift over the window, heavier noise) make a cost difference mean less.
+  const double margin = options_.ambiguity_chi2 * robustVarianceFactor(obs, best);
+  std::vector<size_t> order;
+  for (size_t k = 1; k < cands.size(); ++k)
+    if ((cands[k].end.p_IinG - best_end.p_IinG).norm() > 0.5) {
+      order.push_back(k);
+      break;
+    }
+  for (size_t k = 1; k < cands.size(); ++k)
+    if (order.empty() || order.front() != k) order.push_back(k);
+  std::vector<ImuState> checked;
+  for (const size_t k : order) {
+    if (checked.size() >= 6) break;
+    if (!distinct(cands[k].end, best_end)) continue;
+    if (std::any_of(checked.begin(), checked.end(), [&](const ImuState& c) { return !distinct(cands[k].end, c); }))
+      continue;
+    checked.push_back(cands[k].end);
+    Unknowns rival = cands[k].x;
+    const double c = fit(obs, heights, rival, nullptr);
+    const ImuState rival_end = endState(rival, end, bias_gyro_rad_s);
+    if (c - best_cost < margin && distinct(rival_end, best_end)) {
+      reason_ = "motion alignment: ambiguous (two poses " + std::to_string((rival_end.p_IinG - best_end.p_IinG).norm()) +
+                " m apart fit the ranges within " + std::to_string(c - best_cost) +
+                "): anchor geometry or motion cannot fix the pose yet";
+      return std::nullopt;
+    }
+  }
+  (void)n_used;
+  return finish(obs, heights, best, info, end, bias_gyro_rad_s);
+}
+
+double MotionAligner::robustVarianceFactor(const std::vector<Obs>& obs, const Unknowns& x) const {
+  std::vector<double> abs_e;
+  for (const Obs& o : obs)
+    if (o.use) abs_e.push_back(std::abs(residual(o, x)) / o.r.sigma_m);
+  if (abs_e.size() < 8) return 1.0;
+  auto mid = abs_e.begin() + static_cast<std::ptrdiff_t>(abs_e.size() / 2);
+  std::nth_element(abs_e.begin(), mid, abs_e.end());
+  const double s = 1.4826 * *mid;  // robust σ of the normalized residuals (1 if the stated σ holds)
+  return std::max(1.0, s * s);
+}
+
+std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights,
+                                                     const Unknowns& x, const MatU& info, const Increments& end,
+                                                     const Eigen::Vector3d& bias_gyro) {
+  const MatU Sigma = options_.cov_inflation * info.ldlt().solve(MatU::Identity());
+  const ImuState e0 = endState(x, end, bias_gyro);
+  Eigen::Matrix<double, 15, kDim> J;
+  for (int j = 0; j < kDim; ++j) {
+    VecU d = VecU::Zero();
+    d(j) = 1e-6;
+    J.col(j) = (endState(x.plus(d), end, bias_gyro).boxminus(e0) - endState(x.plus(-d), end, bias_gyro).boxminus(e0)) / 2e-6;
+  }
+  AlignmentResult res;
+  res.imu = e0;
+  res.cov = J * Sigma * J.transpose();
+  res.cov = (0.5 * (res.cov + res.cov.transpose())).eval();
+  for (int i = 0; i < 3; ++i) {  // floors: the fit's model is not exact
+    res.cov(ImuErr::kP + i, ImuErr::kP + i) += 0.02 * 0.02;
+    res.cov(ImuErr::kV + i, ImuErr::kV + i) += 0.05 * 0.05;
+    res.cov(ImuErr::kTheta + i, ImuErr::kTheta + i) += std::pow(0.5 * kDeg, 2);
+  }
+  res.t = imu_.back().t;
+  res.last_imu = imu_.back();
+  res.window_s = spanSeconds();
+  res.height_bias_m = x.bh;
+  res.height_bias_var_m2 = Sigma(kBh, kBh);
+  for (const HeightObs& o : heights) res.n_heights += o.use;
+  std::set<SensorId> used_anchors;
+  double sq = 0.0;
+  for (const Obs& o : obs) {
+    if (!o.use) continue;
+    ++res.n_ranges;
+    used_anchors.insert(o.r.anchor);
+    const double r = residual(o, x);
+    sq += r * r;
+  }
+  res.n_anchors = static_cast<int>(used_anchors.size());
+  res.rms_m = res.n_ranges ? std::sqrt(sq / res.n_ranges) : 0.0;
+  res.sigma_yaw_deg = std::sqrt(so3::yawVariance(e0.q_ItoG, res.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta))) / kDeg;
+  res.sigma_p_m = std::sqrt(res.cov.block<3, 3>(ImuErr::kP, ImuErr::kP).diagonal().maxCoeff());
+  if (!res.cov.allFinite() || res.sigma_yaw_deg > options_.max_sigma_yaw_deg || res.sigma_p_m > options_.max_sigma_p_m) {
+    reason_ = "motion alignment: pose not determined yet (σ_yaw " + std::to_string(res.sigma_yaw_deg) + " deg, σ_p " +
+              std::to_string(res.sigma_p_m) + " m; needs horizontal acceleration and spread anchors)";
+    return std::nullopt;
+  }
+  if (res.n_ranges < options_.min_ranges || res.n_anchors < options_.min_anchors) {
+    reason_ = "motion alignment: too few inlier ranges (" + std::to_string(res.n_ranges) + ")";
+    return std::nullopt;
+  }
+  reason_.clear();
+  return res;
+}
+
+}  // namespace meshnav::estimator
