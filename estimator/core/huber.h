@@ -4,7 +4,10 @@
 /// (StaticInitializer, MotionAligner): quadratic within k, linear beyond, so NLOS outliers do not
 /// pick the minimum. Iteratively reweighted least squares uses weight(e) = ρ'(e) / (2e).
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <vector>
 
 namespace meshnav::estimator::huber {
 
@@ -20,6 +23,17 @@ inline double cost(double e) {
 inline double weight(double e) {
   const double a = std::abs(e);
   return a <= kThreshold ? 1.0 : kThreshold / a;
+}
+
+/// Robust variance factor of normalized residuals |e_i| = |r_i|/σ_i: max(1, (1.4826 · median|e|)²),
+/// 1 when the ranges fit as well as their stated σ; 1 with fewer than 8 residuals. Used to scale a
+/// fit's covariance and its cost margins when the ranges fit worse than σ says.
+inline double varianceFactor(std::vector<double> abs_e) {
+  if (abs_e.size() < 8) return 1.0;
+  auto mid = abs_e.begin() + static_cast<std::ptrdiff_t>(abs_e.size() / 2);
+  std::nth_element(abs_e.begin(), mid, abs_e.end());
+  const double s = 1.4826 * *mid;
+  return std::max(1.0, s * s);
 }
 
 }  // namespace meshnav::estimator::huber

@@ -15,8 +15,9 @@
 /// Gravity fixes roll and pitch, horizontal accelerations fix yaw, the ranges fix p₀ and v₀.
 /// Gauss–Newton with Huber weights from a grid of yaw starts (and the mirror image of the start
 /// position when the anchors are nearly coplanar); a second local minimum within
-/// `ambiguity_chi2` × v of the best one makes the window ambiguous (refused), v = max(1,
-/// (1.4826 median|e|)²) the robust variance factor of the normalized residuals. The covariance is (Jᵀ W J + prior)⁻¹ inflated by `cov_inflation`, carried to the window's end by the numeric
+/// `ambiguity_chi2` × v of the best one makes the window ambiguous (refused), v the robust
+/// variance factor of the normalized residuals (huber::varianceFactor). The covariance is
+/// (Jᵀ W J + prior)⁻¹ inflated by `cov_inflation`, carried to the window's end by the numeric
 /// Jacobian of the end state. Refused (with a reason) while the geometry or the motion cannot
 /// fix the pose: too few ranges or anchors, σ_yaw or σ_p above their limits, ambiguity.
 ///
@@ -151,7 +152,7 @@ class MotionAligner {
                                      std::vector<HeightObs>* heights) const;
   /// Levenberg–Marquardt with Huber weights; returns the cost (Huber terms and bias priors).
   double fit(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights, Unknowns& x, Info* info) const;
-  /// max(1, (1.4826 · median|e_i|)²) over the inlier ranges: how much noisier than their σ they fit.
+  /// huber::varianceFactor of the inlier ranges: how much noisier than their σ they fit.
   double robustVarianceFactor(const std::vector<Obs>& obs, const Unknowns& x) const;
   double residual(const Obs& o, const Unknowns& x) const;
   /// ∂residual/∂[δp₀, δv₀, δθ, δb_a, δb_ω, δb_H] (analytic; the noise-free unit test converges with it).

@@ -262,11 +262,7 @@ double MotionAligner::robustVarianceFactor(const std::vector<Obs>& obs, const Un
   std::vector<double> abs_e;
   for (const Obs& o : obs)
     if (o.use) abs_e.push_back(std::abs(residual(o, x)) / o.r.sigma_m);
-  if (abs_e.size() < 8) return 1.0;
-  auto mid = abs_e.begin() + static_cast<std::ptrdiff_t>(abs_e.size() / 2);
-  std::nth_element(abs_e.begin(), mid, abs_e.end());
-  const double s = 1.4826 * *mid;  // robust σ of the normalized residuals (1 if the stated σ holds)
-  return std::max(1.0, s * s);
+  return huber::varianceFactor(std::move(abs_e));
 }
 
 std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights,

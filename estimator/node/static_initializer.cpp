@@ -206,23 +206,6 @@ double StaticInitializer::solveFit(const Eigen::Matrix3d& R_rp, const std::vecto
   return cost;
 }
 
-double StaticInitializer::robustVarianceFactor(const Eigen::Matrix3d& R_rp, const std::vector<bool>& use,
-                                               const Eigen::Vector3d& p, double yaw) const {
-  std::vector<double> abs_e;
-  const Eigen::Matrix3d R = rotZ(yaw) * R_rp;
-  for (size_t i = 0; i < ranges_.size(); ++i) {
-    if (!use[i]) continue;
-    const InitRange& r = ranges_[i];
-    const double d = (setup_.abs_anchor_positions.at(r.anchor) - p - R * setup_.rel_tag_positions.at(r.tag)).norm();
-    abs_e.push_back(std::abs(r.d_m - d) / r.sigma_m);
-  }
-  if (abs_e.size() < 8) return 1.0;
-  auto mid = abs_e.begin() + static_cast<std::ptrdiff_t>(abs_e.size() / 2);
-  std::nth_element(abs_e.begin(), mid, abs_e.end());
-  const double s = 1.4826 * *mid;  // robust σ of the normalized residuals (1 if the stated σ holds)
-  return std::max(1.0, s * s);
-}
-
 bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p_out, double& yaw_out,
                                         Eigen::Matrix4d& cov_out, double& rms_out, int& n_used) {
   waiting_for_.clear();
@@ -293,15 +276,17 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
   }
   if (n_used < 4) return false;
   solve(best_p, best_yaw, &cov_out);
-  cov_out *= robustVarianceFactor(R_rp, use, best_p, best_yaw);  // ranges noisier than their σ
   double sq = 0.0;
+  std::vector<double> abs_e;
   const Eigen::Matrix3d R2 = rotZ(best_yaw) * R_rp;
   for (size_t i = 0; i < ranges_.size(); ++i) {
     if (!use[i]) continue;
     const InitRange& r = ranges_[i];
     const double d = (setup_.abs_anchor_positions.at(r.anchor) - best_p - R2 * setup_.rel_tag_positions.at(r.tag)).norm();
     sq += (r.d_m - d) * (r.d_m - d);
+    abs_e.push_back(std::abs(r.d_m - d) / r.sigma_m);
   }
+  cov_out *= huber::varianceFactor(std::move(abs_e));  // ranges noisier than their σ
   rms_out = std::sqrt(sq / n_used);
   p_out = best_p;
   yaw_out = best_yaw;

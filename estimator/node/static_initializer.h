@@ -12,7 +12,7 @@
 ///    `static_max_sigma_yaw_deg` (one tag: only its lever arm shows yaw at rest), a second
 ///    local minimum as good as the best (nearly coplanar anchors mirror the position); the node
 ///    then waits for motion (MotionAligner). The fit's covariance is scaled by the robust
-///    variance factor of its residuals, max(1, (1.4826 median|e|)²);
+///    variance factor of its residuals (huber::varianceFactor);
 ///  - baro reference pressure from setup or the mean landed pressure; bias so that the mean
 ///    height matches the initial baro height.
 /// The orientation covariance is local (I): Σ_θ = σ_rp² (I − n nᵀ) + σ_yaw² n nᵀ, n = R̂ᵀ e_z.
@@ -80,9 +80,6 @@ class StaticInitializer {
   /// the Huber cost Σ ρ(e_i), e_i = (d_i − ‖p_A − p − R p_T‖)/σ_i.
   double solveFit(const Eigen::Matrix3d& R_rp, const std::vector<bool>& use, Eigen::Vector3d& p, double& yaw,
                   Eigen::Matrix4d* cov) const;
-  /// max(1, (1.4826 · median|e_i|)²): how much noisier than their stated σ the ranges fit.
-  double robustVarianceFactor(const Eigen::Matrix3d& R_rp, const std::vector<bool>& use, const Eigen::Vector3d& p,
-                              double yaw) const;
   /// Least-squares [p, yaw]; returns false when it does not converge.
   bool fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p, double& yaw, Eigen::Matrix4d& cov,
                        double& rms, int& n_used);
