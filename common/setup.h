@@ -19,6 +19,13 @@ struct InitialPose {
   double sigma_yaw_deg = 5.0;                        ///< [deg]
 };
 
+/// A hand-held rig carried at a roughly constant height above the floor (z = 0 of G): what its user
+/// knows about the height when there is no barometer or height sensor (docs/formats.md).
+struct CarriedHeight {
+  double height_m = 1.2;  ///< usual height of the IMU above the floor [m]
+  double sigma_m = 0.3;   ///< how far the actual carrying height may be from height_m (1σ) [m]
+};
+
 /// Optional noise figures overriding the tuning defaults.
 struct NoiseFigures {
   std::optional<double> sigma_range_m;
@@ -43,6 +50,7 @@ struct SystemSetup {
   std::optional<double> baro_reference_pressure_pa;      ///< null: taken on the ground at start
   Eigen::Vector3d height_p_IH = Eigen::Vector3d::Zero(); ///< rangefinder in IMU frame [m] (unknown: 0)
   std::optional<InitialPose> initial_pose;
+  std::optional<CarriedHeight> carried_height;  ///< hand-held rig: its usual height
   NoiseFigures noise;
 
   bool isTag(SensorId id) const { return rel_tag_positions.count(id) > 0; }

@@ -33,6 +33,9 @@ class Trajectory {
   virtual bool hasLandedPhase() const { return false; }
   /// True for vehicles that carry a barometer (every flight; not the hand-held rig).
   virtual bool hasBarometer() const { return true; }
+  /// Carried by hand at a roughly constant height: the setup then states that height
+  /// (SystemSetup::carried_height, what the rig's user knows).
+  virtual bool isHandCarried() const { return false; }
   /// Short kind name ("spiral", "walk", ...).
   virtual std::string kind() const = 0;
   /// One line with the motion's parameters and units.

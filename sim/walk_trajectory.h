@@ -28,6 +28,7 @@ class WalkTrajectory : public Trajectory {
   TrajectoryState evaluate(double t_s) const override;
   double duration() const override { return duration_s_; }
   bool hasBarometer() const override { return false; }
+  bool isHandCarried() const override { return true; }
   std::string kind() const override { return "walk"; }
   std::string toString() const override;
   double stepFrequency() const { return step_hz_; }

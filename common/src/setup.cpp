@@ -244,6 +244,15 @@ SystemSetup loadSetup(const std::string& path) {
     if (p.sigma_yaw_deg <= 0) y.fail("initial_pose.sigma_yaw_deg", "must be > 0 [deg]");
     s.initial_pose = p;
   }
+  if (y.has("carried_height")) {
+    CarriedHeight c;  // height_m has no sensible default: required
+    y.require("carried_height.height_m", c.height_m);
+    y.read("carried_height.sigma_m", c.sigma_m);
+    if (!(c.height_m > 0.0 && c.height_m < plausible::kMaxHeight_m))
+      y.fail("carried_height.height_m", "must be a height above the floor in (0, 100) m");
+    if (!(c.sigma_m > 0.0)) y.fail("carried_height.sigma_m", "must be > 0 [m]");
+    s.carried_height = c;
+  }
   y.read("noise.sigma_range", s.noise.sigma_range_m);
   y.read("noise.imu_acc_noise_density", s.noise.imu_acc_noise_density);
   y.read("noise.imu_gyro_noise_density", s.noise.imu_gyro_noise_density);
@@ -313,6 +322,14 @@ void saveSetup(const SystemSetup& s, const std::string& path) {
     e << YAML::Key << "yaw_deg" << YAML::Value << p.yaw_deg;
     e << YAML::Key << "sigma_p" << YAML::Value << p.sigma_p_m;
     e << YAML::Key << "sigma_yaw_deg" << YAML::Value << p.sigma_yaw_deg;
+    e << YAML::EndMap;
+  }
+  if (s.carried_height) {
+    e << YAML::Key << "carried_height"
+      << YAML::Comment("hand-held rig: usual IMU height above the floor (z = 0) and its 1 sigma [m]") << YAML::Value
+      << YAML::BeginMap;
+    e << YAML::Key << "height_m" << YAML::Value << s.carried_height->height_m;
+    e << YAML::Key << "sigma_m" << YAML::Value << s.carried_height->sigma_m;
     e << YAML::EndMap;
   }
   const auto& n = s.noise;

@@ -67,6 +67,11 @@ void forEachField(Opt& o, Visitor&& v) {
   v("height.tilt_correction", o.height.tilt_correction, "h = p_z / cos(tilt) (false: h = p_z)");
   v("height.max_tilt_deg", o.height.max_tilt_deg, "not used while tilted more [deg]");
   v("height.align_rate_hz", o.height.align_rate_hz, "rate fed to the in-motion alignment, 0 = not used there [Hz]");
+  v("carried_height.enabled", o.carried_height.enabled, "used when setup.yaml has carried_height (hand-held rig)");
+  v("carried_height.rate_hz", o.carried_height.rate_hz, "pseudo-readings per second of IMU time [Hz]");
+  v("carried_height.sigma_m", o.carried_height.sigma_m, "sigma of one reading (gait bob and sway) [m]");
+  v("carried_height.bias_rw_m_per_sqrt_s", o.carried_height.bias_rw_m_per_sqrt_s,
+    "random walk of the carrying height [m/sqrt(s)]");
   v("uwb.enabled", o.uwb.enabled, "");
   v("uwb.sigma_range_m", o.uwb.sigma_range_m, "fallback range sigma [m]");
   v("uwb.gate_probability", o.uwb.gate_probability, "chi^2 gate, 0 = off [-]");
@@ -193,6 +198,8 @@ void EstimatorOptions::validate() const {
            height.min_range_m >= 0 && height.max_tilt_deg > 0 && height.max_tilt_deg < 90 && height.align_rate_hz >= 0,
        "height: sigma_m > 0, bias_rw >= 0, init_bias_sigma_m > 0, min_range_m >= 0, max_tilt_deg in (0, 90), align_rate_hz >= 0");
   need(height.gate_probability >= 0 && height.gate_probability < 1, "height.gate_probability in [0, 1)");
+  need(carried_height.rate_hz > 0 && carried_height.sigma_m > 0 && carried_height.bias_rw_m_per_sqrt_s >= 0,
+       "carried_height: rate_hz > 0, sigma_m > 0, bias_rw_m_per_sqrt_s >= 0");
   need(init.motion_max_window_s >= init.motion_window_s, "init.motion_max_window_s >= init.motion_window_s");
   need(uwb.sigma_range_m > 0 && uwb.max_range_m > 0, "uwb.sigma_range_m > 0, uwb.max_range_m > 0");
   need(uwb.gate_probability >= 0 && uwb.gate_probability < 1, "uwb.gate_probability in [0, 1)");

@@ -93,6 +93,18 @@ struct HeightOptions {
   double align_rate_hz = 5.0;
 };
 
+/// A hand-held rig carried at a roughly constant height (setup.yaml `carried_height`, docs/robustness.md
+/// "Carried height"): a pseudo-reading h = height_m of the height model without lever arm or tilt
+/// correction, h = p_z + b_C, whose bias instance b_C (prior σ from the setup) takes the unknown
+/// carrying height and its slow changes; the reading's own σ covers the gait's bob. It uses the
+/// height sensor's instance (setup `height_id`): a real height.csv is then ignored and counted.
+struct CarriedHeightOptions {
+  bool enabled = true;                   ///< used when setup.yaml has `carried_height`
+  double rate_hz = 2.0;                  ///< pseudo-readings per second of IMU time [Hz]
+  double sigma_m = 0.05;                 ///< σ of one reading (gait bob and sway) [m]
+  double bias_rw_m_per_sqrt_s = 0.02;    ///< random walk of the carrying height [m/√s]
+};
+
 struct UwbOptions {
   bool enabled = true;
   double sigma_range_m = 0.15;           ///< fallback range σ [m]
@@ -162,6 +174,7 @@ struct EstimatorOptions {
   InitOptions init;
   BaroOptions baro;
   HeightOptions height;
+  CarriedHeightOptions carried_height;
   UwbOptions uwb;
   ZuptOptions zupt;
   HealthOptions health;

@@ -42,6 +42,7 @@ EstimatorNode::Snapshot EstimatorNode::Snapshot::copy() const {
   s.last_imu = last_imu;
   s.landed = landed;
   s.last_zupt = last_zupt;
+  s.last_carried_height = last_carried_height;
   s.noise_adapter = noise_adapter;
   return s;
 }
@@ -50,26 +51,48 @@ using node_internal::alignerOptions;
 using node_internal::weakestPositionAxis;
 
 namespace {
-EstimatorOptions withSetupNoise(EstimatorOptions o, const SystemSetup& setup) {
+bool carriedHeightUsed(const EstimatorOptions& o, const SystemSetup& setup) {
+  return setup.carried_height && o.carried_height.enabled;
+}
+
+/// The options with the setup's noise figures, and for a carried rig (setup `carried_height`) the
+/// height model turned into the carried-height pseudo-sensor: reading σ, the bias's prior σ from
+/// the setup and its random walk, no tilt correction and no minimum range.
+EstimatorOptions withSetup(EstimatorOptions o, const SystemSetup& setup) {
   o.applySetupNoise(setup.noise);
+  if (carriedHeightUsed(o, setup)) {
+    o.height.enabled = true;
+    o.height.sigma_m = o.carried_height.sigma_m;
+    o.height.bias_rw_m_per_sqrt_s = o.carried_height.bias_rw_m_per_sqrt_s;
+    o.height.init_bias_sigma_m = setup.carried_height->sigma_m;
+    o.height.tilt_correction = false;
+    o.height.min_range_m = 0.0;
+  }
   return o;
+}
+
+/// The height model's lever arm: the rangefinder's, or none for the carried height (h = p_z + b).
+Eigen::Vector3d heightLever(const EstimatorOptions& o, const SystemSetup& setup) {
+  return carriedHeightUsed(o, setup) ? Eigen::Vector3d::Zero() : setup.height_p_IH;
 }
 
 }  // namespace
 
 EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup& setup, EstimatorSinks sinks)
-    : options_(withSetupNoise(options, setup)),
+    : options_(withSetup(options, setup)),
       setup_(setup),
       sinks_(std::move(sinks)),
       baro_model_(setup.baro_p_IP),
-      height_model_(setup.height_p_IH, options_.height.tilt_correction, options_.height.max_tilt_deg * M_PI / 180.0),
+      height_model_(heightLever(options, setup), options_.height.tilt_correction,
+                    options_.height.max_tilt_deg * M_PI / 180.0),
       zupt_model_(Eigen::Vector3d(0.0, 0.0, -options.gravity_m_s2)),
-      aligner_(alignerOptions(options_, setup.height_p_IH), setup.rel_tag_positions),
+      aligner_(alignerOptions(options_, heightLever(options, setup)), setup.rel_tag_positions),
       still_detector_(StillnessOptions{}, options_.imu.acc_noise_density, options_.imu.gyro_noise_density,
                       options_.gravity_m_s2),
       health_(options_.health),
       time_guard_(options_.time) {
   options_.validate();
+  carried_height_ = carriedHeightUsed(options_, setup_);
   if (!strategyImplemented(options_.strategy))
     throw std::invalid_argument("strategy '" + options_.strategy + "' is not implemented yet (next issue)");
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
@@ -233,7 +256,12 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
         if constexpr (std::is_same_v<T, ImuSample>) processImu(m, first);
         if constexpr (std::is_same_v<T, BaroSample>) processBaro(m, first);
         if constexpr (std::is_same_v<T, RangeSample>) processRange(m, first);
-        if constexpr (std::is_same_v<T, HeightSample>) processHeight(m, first);
+        if constexpr (std::is_same_v<T, HeightSample>) {
+          if (carried_height_)
+            event(first, "height_ignored_carried_height");  // the carried height uses the height instance
+          else
+            processHeight(m, first);
+        }
         if constexpr (std::is_same_v<T, FlightStateSample>) cur_.landed = m.landed;
         if constexpr (std::is_same_v<T, AnchorInit>) applyAnchorInit(m, first);
         if constexpr (std::is_same_v<T, EstimatorCommand>) applyCommand(m, first);
@@ -284,6 +312,11 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
     if (!f.update(lin, gate).accepted) event(first, "gated_zupt");
     cur_.last_zupt = s.t;
     if (first) ++instance_stats_[setup_.imu_id].n_updates;
+  }
+  if (carried_height_ &&
+      (s.t - cur_.last_carried_height).sec() >= 1.0 / options_.carried_height.rate_hz - 1e-9) {
+    cur_.last_carried_height = s.t;
+    processHeight(HeightSample{s.t, setup_.carried_height->height_m}, first);
   }
   if (first && sinks_.pose) {
     const bool due = options_.pose_output_rate_hz <= 0.0 || !last_pose_pub_ ||

@@ -129,6 +129,7 @@ class EstimatorNode {
     std::optional<ImuSample> last_imu;
     bool landed = true;
     Timestamp last_zupt;
+    Timestamp last_carried_height;  ///< last carried-height pseudo-reading (IMU time)
     ProcessNoiseAdapter noise_adapter;  ///< IMU noise scale from the range innovations
     Snapshot copy() const;
   };
@@ -151,6 +152,8 @@ class EstimatorNode {
   void processBaro(const BaroSample& s, bool first);
   void processRange(const RangeSample& s, bool first);
   void processHeight(const HeightSample& s, bool first);
+  /// A height reading (rangefinder or carried height) for the in-motion alignment, thinned.
+  void feedAlignerHeight(const HeightSample& h);
   /// Instance statistics, health and the "gated_<type>" counter of a scalar update (baro, height).
   void countScalarUpdate(Timestamp t, SensorId id, const std::string& type, const UpdateResult& r);
   void applyAnchorInit(const AnchorInit& a, bool first);
@@ -189,6 +192,8 @@ class EstimatorNode {
   bool tryResume(const ImuSample& s);
   BaroModel baro_model_;
   HeightModel height_model_;
+  /// setup `carried_height` in use: the height model reads the carried height (CarriedHeightOptions).
+  bool carried_height_ = false;
   /// The height bias the in-motion alignment estimated (mean, variance), for the height instance.
   std::optional<std::pair<double, double>> pending_height_bias_;
   std::optional<Timestamp> last_align_height_;  ///< thinning of heights fed to the aligner

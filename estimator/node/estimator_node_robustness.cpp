@@ -127,9 +127,21 @@ std::string EstimatorNode::waitingFor() const {
   return initializer_->waitingFor() + (aligner_.reason().empty() ? "" : "; " + aligner_.reason());
 }
 
+void EstimatorNode::feedAlignerHeight(const HeightSample& h) {
+  // Usable readings only, thinned to height.align_rate_hz (a vertical constraint, not a trajectory).
+  if (!options_.height.enabled || options_.height.align_rate_hz <= 0.0 || h.range_m < options_.height.min_range_m)
+    return;
+  if (last_align_height_ && (h.t - *last_align_height_).sec() < 1.0 / options_.height.align_rate_hz - 1e-6 &&
+      h.t >= *last_align_height_)
+    return;
+  last_align_height_ = h.t;
+  aligner_.addHeight({h.t, h.range_m, options_.height.sigma_m});
+}
+
 void EstimatorNode::feedAligner(const EstimatorInput& in) {
   if (const auto* s = std::get_if<ImuSample>(&in)) {
     aligner_.addImu(*s);
+    if (carried_height_) feedAlignerHeight(HeightSample{s->t, setup_.carried_height->height_m});
     // Stillness is the evidence of rest only while no flight state was received.
     if (!have_flight_state_ && options_.zupt.detect_stillness) {
       const bool still = still_detector_.add(*s);
@@ -144,14 +156,7 @@ void EstimatorNode::feedAligner(const EstimatorInput& in) {
   } else if (const auto* b = std::get_if<BaroSample>(&in)) {
     last_pressure_pa_ = b->pressure_pa;
   } else if (const auto* h = std::get_if<HeightSample>(&in)) {
-    // Usable readings only, thinned to height.align_rate_hz (a vertical constraint, not a trajectory).
-    if (!options_.height.enabled || options_.height.align_rate_hz <= 0.0 || h->range_m < options_.height.min_range_m)
-      return;
-    if (last_align_height_ && (h->t - *last_align_height_).sec() < 1.0 / options_.height.align_rate_hz - 1e-6 &&
-        h->t >= *last_align_height_)
-      return;
-    last_align_height_ = h->t;
-    aligner_.addHeight({h->t, h->range_m, options_.height.sigma_m});
+    if (!carried_height_) feedAlignerHeight(*h);
   } else if (const auto* r = std::get_if<RangeSample>(&in)) {
     SensorId tag = r->id_initiator, anchor = r->id_responder;
     if (!cur_.network->isTag(tag)) std::swap(tag, anchor);

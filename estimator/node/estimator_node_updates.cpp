@@ -51,7 +51,7 @@ void EstimatorNode::processHeight(const HeightSample& s, bool first) {
     event(first, "height_below_min_range");  // clamped at the bottom of the sensor's range
     return;
   }
-  if (!height_model_.valid(cur_.filter->state())) {
+  if (!carried_height_ && !height_model_.valid(cur_.filter->state())) {
     event(first, "height_tilted");
     return;
   }
@@ -61,14 +61,15 @@ void EstimatorNode::processHeight(const HeightSample& s, bool first) {
     const double var = pending_height_bias_ ? pending_height_bias_->second : std::pow(options_.height.init_bias_sigma_m, 2);
     cur_.filter->addHeight(setup_.height_id, b, var);
     if (first)
-      spdlog::info("estimator: height sensor {} added at t={} with bias {:.3f} m (σ {:.3f} m)", setup_.height_id,
-                   formatSeconds(s.t), b, std::sqrt(var));
+      spdlog::info("estimator: {} {} added at t={} with bias {:.3f} m (σ {:.3f} m)",
+                   carried_height_ ? "carried height" : "height sensor", setup_.height_id, formatSeconds(s.t), b,
+                   std::sqrt(var));
   }
   propagateTo(s.t);
   ScopedStepTimer timer(timings_, "height_update");
   const HeightMeasurement z{s.t, setup_.height_id, s.range_m, options_.height.sigma_m};
   const UpdateResult r = cur_.filter->update(height_model_.linearize(z, cur_.filter->state()), height_gate_);
-  if (first) countScalarUpdate(s.t, setup_.height_id, "height", r);
+  if (first) countScalarUpdate(s.t, setup_.height_id, carried_height_ ? "carried_height" : "height", r);
 }
 
 void EstimatorNode::processRange(const RangeSample& s, bool first) {

@@ -56,6 +56,15 @@ TEST(Setup, RoundTrip) {
   const auto rh = loadSetup((d / "height.yaml").string());
   EXPECT_EQ(rh.height_id, 7);
   EXPECT_TRUE(rh.height_p_IH.isApprox(h.height_p_IH));
+  EXPECT_FALSE(rh.carried_height);
+  // A hand-held rig's carrying height, written only when given.
+  auto c = s;
+  c.carried_height = CarriedHeight{1.35, 0.25};
+  saveSetup(c, (d / "carried.yaml").string());
+  const auto rc = loadSetup((d / "carried.yaml").string());
+  ASSERT_TRUE(rc.carried_height);
+  EXPECT_DOUBLE_EQ(rc.carried_height->height_m, 1.35);
+  EXPECT_DOUBLE_EQ(rc.carried_height->sigma_m, 0.25);
 }
 
 TEST(Setup, ReadsThePublishedToolboxConfig) {
@@ -130,6 +139,13 @@ TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
   EXPECT_NE(error(base + "height: {p_IH: [0, 0]}\n").find("height.p_IH"), std::string::npos);
   EXPECT_NE(error(base + "noise: {sigma_range: -0.1}\n").find("key 'noise.sigma_range' must be > 0"), std::string::npos);
   EXPECT_NE(error(base + "noise: {sigma_rnage: 0.1}\n").find("unknown key 'noise.sigma_rnage'"), std::string::npos);
+  EXPECT_NE(error(base + "carried_height: {sigma_m: 0.3}\n").find("carried_height.height_m"), std::string::npos);
+  EXPECT_NE(error(base + "carried_height: {height_m: -1}\n").find("key 'carried_height.height_m' must be a height"),
+            std::string::npos);
+  EXPECT_NE(error(base + "carried_height: {height_m: 1.2, sigma_m: 0}\n").find("key 'carried_height.sigma_m' must be > 0"),
+            std::string::npos);
+  EXPECT_NE(error(base + "carried_height: {height_m: 1.2, sigma: 0.3}\n").find("unknown key 'carried_height.sigma'"),
+            std::string::npos);
   EXPECT_NE(error(base + "baro: {reference_pressure: 1e9}\n").find("key 'baro.reference_pressure'"), std::string::npos);
   EXPECT_NE(error("abs_anchor_positions: {4294967297: [0, 0, 0]}\n").find("'4294967297' is not a device id"),
             std::string::npos);
