@@ -49,6 +49,8 @@ void forEachField(Opt& o, Visitor&& v) {
   v("init.motion_min_ranges", o.init.motion_min_ranges, "in-motion alignment ranges needed [-]");
   v("init.motion_max_sigma_yaw_deg", o.init.motion_max_sigma_yaw_deg, "in-motion alignment refused above [deg]");
   v("init.motion_max_sigma_p_m", o.init.motion_max_sigma_p_m, "in-motion alignment refused above [m]");
+  v("init.motion_use_baro", o.init.motion_use_baro,
+    "baro heights (setup reference pressure given) constrain the in-motion alignment's height");
   v("init.resume_max_age_s", o.init.resume_max_age_s, "a restart resumes from a checkpoint at most this old [s]");
   v("init.resume_max_outage_s", o.init.resume_max_outage_s, "longer restart outages re-initialize the pose (anchors kept) [s]");
   v("init.resume_max_acc_m_s2", o.init.resume_max_acc_m_s2, "largest acceleration during a restart's outage [m/s^2]");

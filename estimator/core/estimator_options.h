@@ -60,6 +60,9 @@ struct InitOptions {
   /// σ_yaw 15–24° left the filter heading errors of 25–60° it did not pull back (docs/robustness.md)
   double motion_max_sigma_yaw_deg = 15.0;
   double motion_max_sigma_p_m = 0.5;       ///< in-motion alignment: refuse above [m]
+  /// Baro heights against the setup's reference pressure as the in-motion alignment's vertical
+  /// constraint (not with a carried height): nearly coplanar anchors then cannot mirror the height.
+  bool motion_use_baro = true;
   double resume_max_age_s = 5.0;           ///< a checkpoint (resumeFrom) older than this is not used [s]
   double resume_max_outage_s = 0.3;        ///< longer outages re-initialize the pose (anchors still kept) [s]
   double resume_max_acc_m_s2 = 3.0;        ///< largest acceleration assumed during the outage [m/s²]

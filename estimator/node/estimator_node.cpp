@@ -76,6 +76,22 @@ Eigen::Vector3d heightLever(const EstimatorOptions& o, const SystemSetup& setup)
   return carriedHeightUsed(o, setup) ? Eigen::Vector3d::Zero() : setup.height_p_IH;
 }
 
+/// The barometer is the in-motion alignment's height source when the setup gives its reference
+/// pressure (absolute heights) and no carried height is stated.
+bool baroAligns(const EstimatorOptions& o, const SystemSetup& setup) {
+  return o.init.motion_use_baro && !carriedHeightUsed(o, setup) && setup.baro_reference_pressure_pa && o.baro.enabled;
+}
+
+/// The alignment's options; its height model is the baro's (lever p_IP, no tilt correction, bias
+/// prior baro.init_bias_sigma_m) when the baro aligns, else the height model's.
+MotionAlignerOptions alignerOptionsFor(const EstimatorOptions& o, const SystemSetup& setup) {
+  if (!baroAligns(o, setup)) return alignerOptions(o, heightLever(o, setup));
+  MotionAlignerOptions a = alignerOptions(o, setup.baro_p_IP);
+  a.height_tilt_correction = false;
+  a.sigma_bias_height_m = o.baro.init_bias_sigma_m;
+  return a;
+}
+
 }  // namespace
 
 EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup& setup, EstimatorSinks sinks)
@@ -86,13 +102,14 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       height_model_(heightLever(options, setup), options_.height.tilt_correction,
                     options_.height.max_tilt_deg * M_PI / 180.0),
       zupt_model_(Eigen::Vector3d(0.0, 0.0, -options.gravity_m_s2)),
-      aligner_(alignerOptions(options_, heightLever(options, setup)), setup.rel_tag_positions),
+      aligner_(alignerOptionsFor(options_, setup), setup.rel_tag_positions),
       still_detector_(StillnessOptions{}, options_.imu.acc_noise_density, options_.imu.gyro_noise_density,
                       options_.gravity_m_s2),
       health_(options_.health),
       time_guard_(options_.time) {
   options_.validate();
   carried_height_ = carriedHeightUsed(options_, setup_);
+  baro_aligns_ = baroAligns(options_, setup_);
   if (!strategyImplemented(options_.strategy))
     throw std::invalid_argument("strategy '" + options_.strategy + "' is not implemented yet (next issue)");
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);

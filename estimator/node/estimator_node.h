@@ -154,6 +154,8 @@ class EstimatorNode {
   void processHeight(const HeightSample& s, bool first);
   /// A height reading (rangefinder or carried height) for the in-motion alignment, thinned.
   void feedAlignerHeight(const HeightSample& h);
+  /// A height from the baro's pressure against the setup's reference, for the in-motion alignment.
+  void feedAlignerBaro(const BaroSample& b);
   /// Instance statistics, health and the "gated_<type>" counter of a scalar update (baro, height).
   void countScalarUpdate(Timestamp t, SensorId id, const std::string& type, const UpdateResult& r);
   void applyAnchorInit(const AnchorInit& a, bool first);
@@ -194,6 +196,8 @@ class EstimatorNode {
   HeightModel height_model_;
   /// setup `carried_height` in use: the height model reads the carried height (CarriedHeightOptions).
   bool carried_height_ = false;
+  /// The baro (setup reference pressure given) is the in-motion alignment's height source.
+  bool baro_aligns_ = false;
   /// The height bias the in-motion alignment estimated (mean, variance), for the height instance.
   std::optional<std::pair<double, double>> pending_height_bias_;
   std::optional<Timestamp> last_align_height_;  ///< thinning of heights fed to the aligner

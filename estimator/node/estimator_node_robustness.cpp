@@ -9,6 +9,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/atmosphere.h"
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/node/node_internals.h"
@@ -138,6 +139,17 @@ void EstimatorNode::feedAlignerHeight(const HeightSample& h) {
   aligner_.addHeight({h.t, h.range_m, options_.height.sigma_m});
 }
 
+void EstimatorNode::feedAlignerBaro(const BaroSample& b) {
+  if (options_.height.align_rate_hz <= 0.0) return;
+  if (last_align_height_ && (b.t - *last_align_height_).sec() < 1.0 / options_.height.align_rate_hz - 1e-6 &&
+      b.t >= *last_align_height_)
+    return;
+  last_align_height_ = b.t;
+  const double ref = *setup_.baro_reference_pressure_pa;
+  const double sigma_m = std::abs(atmosphere::dHeightDPressure(b.pressure_pa, ref)) * options_.baro.pressure_sigma_pa;
+  aligner_.addHeight({b.t, atmosphere::heightFromPressure(b.pressure_pa, ref), sigma_m});
+}
+
 void EstimatorNode::feedAligner(const EstimatorInput& in) {
   if (const auto* s = std::get_if<ImuSample>(&in)) {
     aligner_.addImu(*s);
@@ -155,8 +167,9 @@ void EstimatorNode::feedAligner(const EstimatorInput& in) {
     have_flight_state_ = true;
   } else if (const auto* b = std::get_if<BaroSample>(&in)) {
     last_pressure_pa_ = b->pressure_pa;
+    if (baro_aligns_) feedAlignerBaro(*b);
   } else if (const auto* h = std::get_if<HeightSample>(&in)) {
-    if (!carried_height_) feedAlignerHeight(*h);
+    if (!carried_height_ && !baro_aligns_) feedAlignerHeight(*h);
   } else if (const auto* r = std::get_if<RangeSample>(&in)) {
     SensorId tag = r->id_initiator, anchor = r->id_responder;
     if (!cur_.network->isTag(tag)) std::swap(tag, anchor);
@@ -206,7 +219,7 @@ InitialBelief EstimatorNode::beliefFromAlignment(const AlignmentResult& r) const
   b.range_fit_rms_m = r.rms_m;
   b.last_imu = r.last_imu;
   b.landed = landedAt(r.t);
-  if (r.n_heights > 0) {
+  if (r.n_heights > 0 && !baro_aligns_) {
     b.height_bias = std::make_pair(r.height_bias_m, r.height_bias_var_m2);
     b.n_heights_used = r.n_heights;
   }
@@ -215,6 +228,10 @@ InitialBelief EstimatorNode::beliefFromAlignment(const AlignmentResult& r) const
     b.baro_reference_pa = *setup_.baro_reference_pressure_pa;
     b.baro_bias_m = 0.0;
     b.baro_bias_var_m2 = std::pow(options_.baro.init_bias_sigma_m, 2);
+    if (baro_aligns_ && r.n_heights > 0) {  // the alignment estimated the baro's bias with the pose
+      b.baro_bias_m = r.height_bias_m;
+      b.baro_bias_var_m2 = r.height_bias_var_m2;
+    }
   } else if (last_pressure_pa_) {  // reference: the current pressure at the aligned height
     b.baro_reference_pa = *last_pressure_pa_;
     b.baro_bias_m = -baro_z;

@@ -195,6 +195,14 @@ double StaticInitializer::solveFit(const Eigen::Matrix3d& R_rp, const std::vecto
       g += w * J * res;
       cost += huber::cost(e);
     }
+    if (height_prior_) {  // ∂(z_h − p_z)/∂[p, yaw] = −e_z (roll and pitch fixed: the lever's z does not depend on yaw)
+      const double res = height_prior_->z_m - p.z();
+      const double e = res / height_prior_->sigma_m;
+      const double w = huber::weight(e) / (height_prior_->sigma_m * height_prior_->sigma_m);
+      A(2, 2) += w;
+      g(2) -= w * res;
+      cost += huber::cost(e);
+    }
     A.diagonal().array() += 1e-9;
     A(3, 3) += 1.0 / (M_PI * M_PI);  // weak yaw prior: one tag leaves yaw (nearly) unobservable
     const Eigen::Vector4d step = -A.ldlt().solve(g);
@@ -206,9 +214,24 @@ double StaticInitializer::solveFit(const Eigen::Matrix3d& R_rp, const std::vecto
   return cost;
 }
 
+std::optional<StaticInitializer::HeightPrior> StaticInitializer::heightPrior(const Eigen::Matrix3d& R_rp) const {
+  if (setup_.baro_reference_pressure_pa && n_baro_ > 0 && options_.baro.enabled) {
+    const double p_mean = sum_pressure_ / n_baro_;
+    const double ref = *setup_.baro_reference_pressure_pa;
+    const double sigma_h = std::abs(atmosphere::dHeightDPressure(p_mean, ref)) * options_.baro.pressure_sigma_pa;
+    return HeightPrior{atmosphere::heightFromPressure(p_mean, ref) - (R_rp * setup_.baro_p_IP).z(),
+                       std::sqrt(std::pow(options_.baro.init_bias_sigma_m, 2) + sigma_h * sigma_h / n_baro_)};
+  }
+  if (setup_.carried_height && options_.carried_height.enabled)
+    return HeightPrior{setup_.carried_height->height_m,
+                       std::hypot(setup_.carried_height->sigma_m, options_.carried_height.sigma_m)};
+  return std::nullopt;
+}
+
 bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p_out, double& yaw_out,
                                         Eigen::Matrix4d& cov_out, double& rms_out, int& n_used) {
   waiting_for_.clear();
+  height_prior_ = heightPrior(R_rp);
   std::set<SensorId> anchors;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const auto& r : ranges_) anchors.insert(r.anchor);
@@ -230,10 +253,14 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
     double yaw;
   };
   std::vector<Minimum> minima;
-  // Starts near the floor (a landed pad) and at the anchors' mean height (a body at rest in the
-  // air): anchors in a narrow height band mirror the height, and only a start on each side lets
-  // the ambiguity check below see both.
-  for (const double z0 : {0.5, centroid.z()})
+  // Starts near the floor (a landed pad) and 1.5 m below and above the anchors' mean height (a
+  // body at rest in the air): anchors in a narrow height band mirror the height, and only a start
+  // on each side lets the ambiguity check below see both (a start at the mean height itself may
+  // slide to either side: a body above three anchors at one height was fitted at its mirror image
+  // without refusal, StaticInitializer.CoplanarAnchors…).
+  std::vector<double> z_starts{0.5, centroid.z() - 1.5, centroid.z() + 1.5};
+  if (height_prior_) z_starts.push_back(height_prior_->z_m);
+  for (const double z0 : z_starts)
   for (int sx = -1; sx <= 1; ++sx)
     for (int sy = -1; sy <= 1; ++sy)
       for (int k = 0; k < 4; ++k) {

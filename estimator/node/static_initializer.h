@@ -77,9 +77,20 @@ class StaticInitializer {
   void restart();
   std::optional<InitialBelief> build(const Eigen::Matrix3d& R_rp);
   /// Gauss–Newton on [p, yaw] over the ranges marked in `use`, Huber weights (k = 2σ); returns
-  /// the Huber cost Σ ρ(e_i), e_i = (d_i − ‖p_A − p − R p_T‖)/σ_i.
+  /// the Huber cost Σ ρ(e_i), e_i = (d_i − ‖p_A − p − R p_T‖)/σ_i, plus ρ((z_h − p_z)/σ_h) of the
+  /// height prior when there is one.
   double solveFit(const Eigen::Matrix3d& R_rp, const std::vector<bool>& use, Eigen::Vector3d& p, double& yaw,
                   Eigen::Matrix4d* cov) const;
+  /// A prior on the IMU's height for the range fit from what else knows it: the barometer when
+  /// the setup gives its reference pressure (h = height from the mean pressure minus the baro's
+  /// lever arm, σ² = baro.init_bias_sigma_m² + the pressure noise over the samples), else the
+  /// setup's carried height (σ² = its sigma_m² + carried_height.sigma_m²). Without one, nearly
+  /// coplanar anchors leave the height's mirror image to the ambiguity check alone.
+  struct HeightPrior {
+    double z_m = 0.0;
+    double sigma_m = 1.0;
+  };
+  std::optional<HeightPrior> heightPrior(const Eigen::Matrix3d& R_rp) const;
   /// Least-squares [p, yaw]; returns false when it does not converge.
   bool fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p, double& yaw, Eigen::Matrix4d& cov,
                        double& rms, int& n_used);
@@ -97,6 +108,7 @@ class StaticInitializer {
   int n_baro_ = 0;
   double sum_pressure_ = 0.0;
   std::vector<InitRange> ranges_;
+  std::optional<HeightPrior> height_prior_;  ///< of the fit in progress (fitPoseToRanges)
   std::string waiting_for_ = "landed IMU data";
 };
 
