@@ -40,7 +40,8 @@ int main(int argc, char** argv) {
       "(ANCHOR_INIT), groundtruth.csv (GROUND_TRUTH), and on exit summary.yaml (messages per channel, last "
       "ESTIMATOR_STATUS / CALIB_STATUS / MISSION_STATUS, counters). Files (CSVs and --lcmlog) are flushed every "
       "--flush-period of wall time and on SIGINT/SIGTERM: a stop loses nothing received, a kill -9 at most the last "
-      "period.");
+      "period. A logger restarted with the same --run-id cuts the half-written last row or event a kill left, then "
+      "continues the files.");
   std::string out, lcmlog_path, channel_regex = ".*", run_id;
   double flush_period_s = 0.5, idle_s = 0.0;
   Cli& cli = process.cli();
