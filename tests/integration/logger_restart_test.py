@@ -139,9 +139,10 @@ def sent_record(path):
     return sent
 
 
-def check_after_kill(t_kill, sent, label):
-    """Every POSE / ANCHORS sent more than P + SLACK before the kill is in the files; only the
-    newest are missing. Returns the figures."""
+def check_after_kill(t_kill, t_dead, sent, label):
+    """Every POSE / ANCHORS sent more than P + SLACK before the kill (t_kill: just before the
+    signal; t_dead: once the logger was gone) is in the files; only the newest are missing; none
+    sent after t_dead is there. Returns the figures."""
     bound = P + SLACK_S
     est, _ = csv_rows(os.path.join(RUN, "estimate.csv"), ESTIMATE_HEADER, 20)
     anc, _ = csv_rows(os.path.join(RUN, "anchors.csv"), ANCHORS_HEADER, 11)
@@ -158,7 +159,7 @@ def check_after_kill(t_kill, sent, label):
     for name, got in have.items():
         before = sorted(i for (ch, i), w in sent.items() if ch == channel[name] and w < t_kill)
         lost = [i for i in before if i not in got]
-        late = sorted(got - set(before))
+        late = sorted(got - {i for (ch, i), w in sent.items() if ch == channel[name] and w < t_dead})
         if late:
             fail(f"{label} {name}: rows {late[:5]} sent after the kill")
         if lost and got and min(lost) < max(got):
@@ -200,6 +201,7 @@ def main():
     t_kill = time.time()
     log1.send_signal(signal.SIGKILL)
     log1.wait()
+    t_dead = time.time()
     # What the kill left, before anything else touches the files.
     left = {name: text(os.path.join(RUN, name)) for name in ("estimate.csv", "anchors.csv")}
     left_lcmlog_bytes = os.path.getsize(LCMLOG)
@@ -217,7 +219,7 @@ def main():
     wait_for(lambda: text(os.path.join(WORK, "logging.log")).count("recording into") >= 2, "the restart", 30)
     if "continuing the files" not in text(os.path.join(WORK, "logging.log")):
         fail("the restarted logger did not continue its files")
-    figures = check_after_kill(t_kill, sent1, "first incarnation")
+    figures = check_after_kill(t_kill, t_dead, sent1, "first incarnation")
     pub2 = start("publish2", ["meshnav_publish_sequence", "--first", str(N1), "--count", str(N2), "--rate",
                               str(RATE_HZ), "--anchors-every", "10", "--anchor-inits", "103",
                               "--record", os.path.join(WORK, "sent2.csv")])
