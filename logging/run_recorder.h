@@ -7,7 +7,8 @@
 ///  - estimate.csv    every POSE (common/estimate_io.h)
 ///  - anchors.csv     every anchor of every ANCHORS message
 ///  - anchor_init.yaml  every ANCHOR_INIT, in the calibration YAML format (`anchors:` list),
-///                    rewritten at each one (so a kill -9 loses none)
+///                    rewritten at each one (into a temporary file renamed over it: a kill -9
+///                    loses none and never leaves it half written)
 ///  - groundtruth.csv GROUND_TRUTH when present (TUM)
 ///  - summary.yaml    written by finish(): messages and bytes per channel, the last
 ///                    ESTIMATOR_STATUS / CALIB_STATUS / MISSION_STATUS, and the recorder's counters
@@ -38,8 +39,10 @@ class RunRecorder {
  public:
   /// Creates `out_dir` and opens estimate.csv and anchors.csv there (header written at once).
   /// `append` (a logger restarted within the same run): the files are continued, and the
-  /// ANCHOR_INITs of anchor_init.yaml are taken back. Throws std::runtime_error when the folder
-  /// or files cannot be written.
+  /// ANCHOR_INITs of anchor_init.yaml are taken back. A row the killed logger left half written at
+  /// the end of a CSV is cut off first (logging/torn_tail.h) and counted as
+  /// "<file>:torn_row_cut" in diagnostics(). Throws std::runtime_error when the folder or files
+  /// cannot be written.
   explicit RunRecorder(const std::string& out_dir, bool append = false);
   ~RunRecorder();
 
@@ -57,7 +60,7 @@ class RunRecorder {
   /// Flushes the CSV files (call periodically, so readers see progress).
   void flush();
   /// Flushes everything and writes anchor_init.yaml, groundtruth.csv and summary.yaml (with the
-  /// process's own counters `process_diag`). Idempotent.
+  /// process's own counters `process_diag` and the recorder's diagnostics()). Idempotent.
   void finish(const Diagnostics& process_diag);
 
   /// Multi-line human-readable summary (what finish() also logs).
@@ -67,6 +70,8 @@ class RunRecorder {
   int64_t posesWritten() const { return n_poses_; }
   int64_t anchorRowsWritten() const { return n_anchor_rows_; }
   const std::string& outDir() const { return out_dir_; }
+  /// The recorder's own counters (torn rows cut on a restart).
+  const Diagnostics& diagnostics() const { return diag_; }
 
  private:
   std::string out_dir_;
@@ -81,6 +86,7 @@ class RunRecorder {
   int64_t n_poses_ = 0;
   int64_t n_anchor_rows_ = 0;
   bool finished_ = false;
+  Diagnostics diag_;
 };
 
 }  // namespace meshnav::logging

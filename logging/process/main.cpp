@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "logging/run_recorder.h"
+#include "logging/torn_tail.h"
 #include "transport/channels.h"
 #include "transport/process_main.h"
 
@@ -16,9 +17,15 @@ namespace {
 using namespace meshnav;
 
 /// The --lcmlog file opened for writing (its folder created); throws naming it when it cannot be.
-std::unique_ptr<lcm::LogFile> openLcmLog(const std::string& path, bool append) {
+/// `append`: continued, after cutting an event the killed logger left half written (counted as
+/// "lcmlog:torn_event_cut"): LCM's reader would stop there and lose every event appended after.
+std::unique_ptr<lcm::LogFile> openLcmLog(const std::string& path, bool append, Diagnostics& diag) {
   const std::filesystem::path p(path);
   if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
+  if (const int64_t cut = append ? logging::cutTornLcmLogEvent(path) : 0; cut > 0)
+    diag.report("lcmlog:torn_event_cut", fmt::format("{}: cut a half-written last event of {} bytes (the previous "
+                                                     "logger was killed while writing it)",
+                                                     path, cut));
   auto log = std::make_unique<lcm::LogFile>(p.string(), append ? "a" : "w");
   if (!log->good()) throw std::runtime_error(p.string() + ": cannot open for writing");
   return log;
@@ -33,7 +40,8 @@ int main(int argc, char** argv) {
       "(ANCHOR_INIT), groundtruth.csv (GROUND_TRUTH), and on exit summary.yaml (messages per channel, last "
       "ESTIMATOR_STATUS / CALIB_STATUS / MISSION_STATUS, counters). Files (CSVs and --lcmlog) are flushed every "
       "--flush-period of wall time and on SIGINT/SIGTERM: a stop loses nothing received, a kill -9 at most the last "
-      "period.");
+      "period. A logger restarted with the same --run-id cuts the half-written last row or event a kill left, then "
+      "continues the files.");
   std::string out, lcmlog_path, channel_regex = ".*", run_id;
   double flush_period_s = 0.5, idle_s = 0.0;
   Cli& cli = process.cli();
@@ -72,7 +80,7 @@ int main(int argc, char** argv) {
     logging::RunRecorder recorder(out, append);
     if (!run_id.empty()) std::ofstream(id_file) << run_id << "\n";
     transport::LcmNode& node = process.lcm();
-    std::unique_ptr<lcm::LogFile> lcmlog = lcmlog_path.empty() ? nullptr : openLcmLog(lcmlog_path, append);
+    std::unique_ptr<lcm::LogFile> lcmlog = lcmlog_path.empty() ? nullptr : openLcmLog(lcmlog_path, append, node.diagnostics());
     int64_t last_msg_wall = 0;
     node.subscribeRaw(channel_regex, [&](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
       if (ch == "LCM_SELF_TEST") return;  // udpm's own start-up probe
@@ -113,6 +121,7 @@ int main(int argc, char** argv) {
     lcmlog.reset();
     spdlog::info("{}", recorder.summaryText());
     if (node.diagnostics().total() > 0) spdlog::warn("counters: {}", node.diagnostics().summary());
+    if (recorder.diagnostics().total() > 0) spdlog::warn("recorder: {}", recorder.diagnostics().summary());
     return rc;
   });
 }

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "common/dataset.h"
+#include "logging/torn_tail.h"
 
 namespace meshnav::logging {
 namespace fs = std::filesystem;
@@ -24,12 +25,30 @@ void writeYaml(const YAML::Emitter& e, const std::string& path) {
   out << e.c_str() << "\n";
 }
 
+/// anchor_init.yaml through a temporary file renamed over it: whenever the logger is killed, the
+/// file holds every ANCHOR_INIT of the previous rewrite or of this one, never half of it.
+void writeAnchorInitsAtomically(const std::vector<AnchorInit>& inits, const fs::path& path) {
+  const fs::path tmp = path.string() + ".tmp";
+  writeAnchorInitsYaml(inits, tmp.string());
+  fs::rename(tmp, path);
+}
+
 }  // namespace
 
 RunRecorder::RunRecorder(const std::string& out_dir, bool append) : out_dir_(out_dir) {
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec) throw std::runtime_error(out_dir + ": cannot create folder: " + ec.message());
+  if (append) {
+    for (const char* name : {"estimate.csv", "anchors.csv"}) {
+      const std::string path = (fs::path(out_dir) / name).string();
+      if (const int64_t cut = cutTornLine(path); cut > 0)
+        diag_.report(std::string(name) + ":torn_row_cut",
+                     fmt::format("{}: cut a half-written last row of {} bytes (the previous logger was killed "
+                                 "while writing it)",
+                                 path, cut));
+    }
+  }
   estimate_ = std::make_unique<EstimateCsvWriter>((fs::path(out_dir) / "estimate.csv").string(), append);
   anchors_ = std::make_unique<AnchorsCsvWriter>((fs::path(out_dir) / "anchors.csv").string(), append);
   const fs::path inits = fs::path(out_dir) / "anchor_init.yaml";
@@ -60,7 +79,7 @@ void RunRecorder::onAnchors(const std::vector<AnchorEstimate>& anchors) {
 
 void RunRecorder::onAnchorInit(const AnchorInit& a) {
   anchor_inits_.push_back(a);
-  writeAnchorInitsYaml(anchor_inits_, (fs::path(out_dir_) / "anchor_init.yaml").string());
+  writeAnchorInitsAtomically(anchor_inits_, fs::path(out_dir_) / "anchor_init.yaml");
 }
 
 void RunRecorder::onGroundTruth(const PoseSample& p) { ground_truth_.push_back(p); }
@@ -76,7 +95,7 @@ void RunRecorder::finish(const Diagnostics& process_diag) {
   flush();
   const fs::path dir(out_dir_);
 
-  if (!anchor_inits_.empty()) writeAnchorInitsYaml(anchor_inits_, (dir / "anchor_init.yaml").string());
+  if (!anchor_inits_.empty()) writeAnchorInitsAtomically(anchor_inits_, dir / "anchor_init.yaml");
   if (!ground_truth_.empty()) writeTumCsv(ground_truth_, (dir / "groundtruth.csv").string());
 
   YAML::Emitter e;
@@ -142,7 +161,10 @@ void RunRecorder::finish(const Diagnostics& process_diag) {
     e << YAML::EndMap;
   }
   e << YAML::Key << "logger_counters" << YAML::Value << YAML::BeginMap;
-  for (const auto& [k, v] : process_diag.snapshot()) e << YAML::Key << k << YAML::Value << v;
+  Diagnostics counters;
+  counters.merge(process_diag);
+  counters.merge(diag_);
+  for (const auto& [k, v] : counters.snapshot()) e << YAML::Key << k << YAML::Value << v;
   e << YAML::EndMap;
   e << YAML::EndMap;
   writeYaml(e, (dir / "summary.yaml").string());

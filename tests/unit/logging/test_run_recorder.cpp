@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "common/dataset.h"
 #include "common/anchor_init_io.h"
@@ -173,6 +174,36 @@ TEST(RunRecorder, ARestartedLoggerContinuesItsFiles) {
     fresh.flush();
   }
   EXPECT_EQ(readEstimateCsv((d / "estimate.csv").string(), diag).size(), 1u);
+  fs::remove_all(d);
+}
+
+TEST(RunRecorder, ARestartedLoggerCutsTheRowItsPredecessorLeftHalfWritten) {
+  // A kill -9 while a row was being written leaves half of it at the end of estimate.csv; the
+  // respawned logger cuts it (counted) instead of gluing its first row onto it.
+  const auto d = freshDir("torn");
+  {
+    RunRecorder first(d.string());
+    first.onPose(pose(1.0));
+    first.onPose(pose(1.5));
+    first.flush();
+  }
+  std::ofstream(d / "estimate.csv", std::ios::app) << "2.000000,0.12";  // the torn row
+  {
+    RunRecorder second(d.string(), true);
+    EXPECT_EQ(second.diagnostics().get("estimate.csv:torn_row_cut"), 1);
+    EXPECT_EQ(second.diagnostics().get("anchors.csv:torn_row_cut"), 0);
+    second.onPose(pose(2.5));
+    second.finish(Diagnostics{});
+  }
+  Diagnostics diag;
+  const auto est = readEstimateCsv((d / "estimate.csv").string(), diag);
+  EXPECT_EQ(diag.total(), 0);  // no bad row
+  ASSERT_EQ(est.size(), 3u);
+  EXPECT_NEAR(est[2].t.sec(), 2.5, 1e-9);
+  EXPECT_NEAR(est[2].p_IinG.y(), 5.0, 1e-9);
+  const YAML::Node s = YAML::LoadFile((d / "summary.yaml").string());
+  EXPECT_EQ(s["logger_counters"]["estimate.csv:torn_row_cut"].as<int>(), 1);
+  EXPECT_FALSE(fs::exists(d / "anchor_init.yaml.tmp"));
   fs::remove_all(d);
 }
 
