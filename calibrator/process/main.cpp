@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
     const Duration pose_period = Duration::fromSec(config.pose_rate_hz > 0 ? 1.0 / config.pose_rate_hz : 0.0);
     // What the node consumed goes to the journal first, so a kill -9 right after loses nothing.
     std::unique_ptr<transport::InputJournal> journal;
-    auto journaled = [&](const std::string& channel, const auto& value, Timestamp t) {
+    auto journaled = [&](auto channel, const auto& value, Timestamp t) {
       if (journal && !replaying) journal->write(channel, value, t.us);
     };
     auto onRange = [&](const RangeSample& r) {
@@ -110,10 +110,10 @@ int main(int argc, char** argv) {
         PoseEstimate p;
         std::vector<AnchorEstimate> a;
         CalibCommand c;
-        if (ch == channels::kRange && transport::InputJournal::decode(rb, ch, r, diag)) onRange(r);
-        if (ch == channels::kPose && transport::InputJournal::decode(rb, ch, p, diag)) onPose(p);
-        if (ch == channels::kAnchors && transport::InputJournal::decode(rb, ch, a, diag)) onAnchors(a);
-        if (ch == channels::kCalibCmd && transport::InputJournal::decode(rb, ch, c, diag)) onCommand(c);
+        if (ch == channels::kRange.name && transport::InputJournal::decode(rb, channels::kRange, r, diag)) onRange(r);
+        if (ch == channels::kPose.name && transport::InputJournal::decode(rb, channels::kPose, p, diag)) onPose(p);
+        if (ch == channels::kAnchors.name && transport::InputJournal::decode(rb, channels::kAnchors, a, diag)) onAnchors(a);
+        if (ch == channels::kCalibCmd.name && transport::InputJournal::decode(rb, channels::kCalibCmd, c, diag)) onCommand(c);
       });
       replaying = false;
       if (n > 0) {
@@ -123,10 +123,10 @@ int main(int argc, char** argv) {
       }
       journal = std::make_unique<transport::InputJournal>(path);
     }
-    lcm.subscribe<RangeSample>(channels::kRange, onRange);
-    lcm.subscribe<PoseEstimate>(channels::kPose, onPose);
-    lcm.subscribe<std::vector<AnchorEstimate>>(channels::kAnchors, onAnchors);
-    lcm.subscribe<CalibCommand>(channels::kCalibCmd, onCommand);
+    lcm.subscribe(channels::kRange, onRange);
+    lcm.subscribe(channels::kPose, onPose);
+    lcm.subscribe(channels::kAnchors, onAnchors);
+    lcm.subscribe(channels::kCalibCmd, onCommand);
     const int64_t progress_period_us = 10'000'000;  // a progress line every 10 s of wall time
     int64_t next_progress = replay::wallUtimeNow() + progress_period_us;
     process.heartbeat<CalibStatus>(channels::kCalibStatus, config.heartbeat_s, [&] { return node.status(); },

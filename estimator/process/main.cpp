@@ -83,13 +83,13 @@ int main(int argc, char** argv) {
     }
     spdlog::info("estimator options:\n{}", node.options().toString());
 
-    lcm.subscribe<ImuSample>(channels::kImu, [&](const ImuSample& s) { node.onImu(s); });
-    lcm.subscribe<BaroSample>(channels::kBaro, [&](const BaroSample& s) { node.onBaro(s); });
-    lcm.subscribe<HeightSample>(channels::kHeight, [&](const HeightSample& s) { node.onHeight(s); });
-    lcm.subscribe<RangeSample>(channels::kRange, [&](const RangeSample& s) { node.onRange(s); });
-    lcm.subscribe<FlightStateSample>(channels::kFlightState, [&](const FlightStateSample& s) { node.onFlightState(s); });
-    lcm.subscribe<AnchorInit>(channels::kAnchorInit, [&](const AnchorInit& a) { node.onAnchorInit(a); });
-    lcm.subscribe<EstimatorCommand>(channels::kEstimatorCmd, [&](const EstimatorCommand& c) { node.onCommand(c); });
+    lcm.subscribe(channels::kImu, [&](const ImuSample& s) { node.onImu(s); });
+    lcm.subscribe(channels::kBaro, [&](const BaroSample& s) { node.onBaro(s); });
+    lcm.subscribe(channels::kHeight, [&](const HeightSample& s) { node.onHeight(s); });
+    lcm.subscribe(channels::kRange, [&](const RangeSample& s) { node.onRange(s); });
+    lcm.subscribe(channels::kFlightState, [&](const FlightStateSample& s) { node.onFlightState(s); });
+    lcm.subscribe(channels::kAnchorInit, [&](const AnchorInit& a) { node.onAnchorInit(a); });
+    lcm.subscribe(channels::kEstimatorCmd, [&](const EstimatorCommand& c) { node.onCommand(c); });
     // This host's clock is the reference of every stamp the estimator fuses: bridges on other
     // hosts estimate their offset to it (transport/time_sync.h, docs/deployment.md).
     transport::serveTimeSync(lcm);

@@ -82,15 +82,13 @@ int main(int argc, char** argv) {
       lcm::LogEvent ev{0, rbuf.recv_utime, ch, static_cast<int32_t>(rbuf.data_size), rbuf.data};
       if (lcmlog->writeEvent(&ev) != 0) node.diagnostics().report("lcmlog:write_error", "lcmlog write failed");
     });
-    node.subscribe<PoseEstimate>(channels::kPose, [&](const PoseEstimate& e) { recorder.onPose(e); });
-    node.subscribe<std::vector<AnchorEstimate>>(channels::kAnchors,
-                                                [&](const std::vector<AnchorEstimate>& a) { recorder.onAnchors(a); });
-    node.subscribe<AnchorInit>(channels::kAnchorInit, [&](const AnchorInit& a) { recorder.onAnchorInit(a); });
-    node.subscribe<PoseSample>(channels::kGroundTruth, [&](const PoseSample& p) { recorder.onGroundTruth(p); });
-    node.subscribe<EstimatorStatus>(channels::kEstimatorStatus,
-                                    [&](const EstimatorStatus& s) { recorder.onEstimatorStatus(s); });
-    node.subscribe<CalibStatus>(channels::kCalibStatus, [&](const CalibStatus& s) { recorder.onCalibStatus(s); });
-    node.subscribe<MissionStatus>(channels::kMissionStatus, [&](const MissionStatus& s) { recorder.onMissionStatus(s); });
+    node.subscribe(channels::kPose, [&](const PoseEstimate& e) { recorder.onPose(e); });
+    node.subscribe(channels::kAnchors, [&](const std::vector<AnchorEstimate>& a) { recorder.onAnchors(a); });
+    node.subscribe(channels::kAnchorInit, [&](const AnchorInit& a) { recorder.onAnchorInit(a); });
+    node.subscribe(channels::kGroundTruth, [&](const PoseSample& p) { recorder.onGroundTruth(p); });
+    node.subscribe(channels::kEstimatorStatus, [&](const EstimatorStatus& s) { recorder.onEstimatorStatus(s); });
+    node.subscribe(channels::kCalibStatus, [&](const CalibStatus& s) { recorder.onCalibStatus(s); });
+    node.subscribe(channels::kMissionStatus, [&](const MissionStatus& s) { recorder.onMissionStatus(s); });
 
     const int64_t progress_period_us = 10'000'000;
     int64_t next_progress = replay::wallUtimeNow() + progress_period_us;

@@ -15,16 +15,17 @@
 
 namespace {
 
-template <class Msg>
-bool writeEvent(lcm::LogFile& log, const std::string& channel, int64_t utime, const Msg& msg,
+template <class T>
+bool writeEvent(lcm::LogFile& log, meshnav::channels::Channel<T> channel, int64_t utime, const std::type_identity_t<T>& value,
                 std::vector<uint8_t>& buf) {
+  const auto msg = meshnav::transport::toWire(value);
   const int n = msg.getEncodedSize();
   buf.resize(static_cast<size_t>(n));
   if (msg.encode(buf.data(), 0, n) != n) return false;
   lcm::LogEvent ev;
   ev.eventnum = 0;
   ev.timestamp = utime;
-  ev.channel = channel;
+  ev.channel = channel.name;
   ev.datalen = n;
   ev.data = buf.data();
   return log.writeEvent(&ev) == 0;
@@ -70,12 +71,12 @@ int main(int argc, char** argv) {
     for (const auto& ev : events) {
       bool ok = false;
       switch (ev.stream) {
-        case 0: ok = writeEvent(log, channels::kFlightState, ev.t.us, transport::toLcm(ds.flight_states[ev.index]), buf); break;
-        case 1: ok = writeEvent(log, channels::kImu, ev.t.us, transport::toLcm(ds.imu[ev.index]), buf); break;
-        case 2: ok = writeEvent(log, channels::kBaro, ev.t.us, transport::toLcm(ds.baro[ev.index]), buf); break;
-        case 3: ok = writeEvent(log, channels::kRange, ev.t.us, transport::toLcm(ds.ranges[ev.index]), buf); break;
-        case 4: ok = writeEvent(log, channels::kGroundTruth, ev.t.us, transport::toLcm(ds.ground_truth[ev.index]), buf); break;
-        case 5: ok = writeEvent(log, channels::kHeight, ev.t.us, transport::toLcm(ds.heights[ev.index]), buf); break;
+        case 0: ok = writeEvent(log, channels::kFlightState, ev.t.us, ds.flight_states[ev.index], buf); break;
+        case 1: ok = writeEvent(log, channels::kImu, ev.t.us, ds.imu[ev.index], buf); break;
+        case 2: ok = writeEvent(log, channels::kBaro, ev.t.us, ds.baro[ev.index], buf); break;
+        case 3: ok = writeEvent(log, channels::kRange, ev.t.us, ds.ranges[ev.index], buf); break;
+        case 4: ok = writeEvent(log, channels::kGroundTruth, ev.t.us, ds.ground_truth[ev.index], buf); break;
+        case 5: ok = writeEvent(log, channels::kHeight, ev.t.us, ds.heights[ev.index], buf); break;
         default: break;
       }
       if (!ok) {

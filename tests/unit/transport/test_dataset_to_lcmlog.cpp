@@ -47,7 +47,7 @@ TEST(DatasetToLcmlog, WritesEverySampleTimeSorted) {
     EXPECT_GE(ev->timestamp, last);
     last = ev->timestamp;
     ++counts[ev->channel];
-    if (ev->channel == channels::kRange) {
+    if (ev->channel == channels::kRange.name) {
       meshnav::range_t m;
       ASSERT_GT(m.decode(ev->data, 0, ev->datalen), 0);
       EXPECT_EQ(m.utime, ev->timestamp);  // event time = data time
