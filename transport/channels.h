@@ -1,31 +1,53 @@
 #pragma once
 /// @file channels.h
-/// @brief LCM channel names (docs/channels.md), UPPER_SNAKE. Every process uses these constants; a
-/// launch file may remap nothing, so the names are the contract between processes.
+/// @brief LCM channels (docs/channels.md): each a name (UPPER_SNAKE) and the message it carries.
+/// Every process uses these constants; a launch file may remap nothing, so the names are the
+/// contract between processes.
+///
+/// A channel's type is part of the constant, `Channel<Msg>`, and LcmNode's typed publish and
+/// subscribe take the constant: `node.subscribe(channels::kBaro, [](const ImuSample&) {...})`
+/// or `node.publish(channels::kImu, BaroSample{})` does not compile
+/// (tests/unit/transport/test_channels.cpp). `Msg` is the plain struct of common/ when the
+/// message has one (converted by transport/convert.h), else the LCM type itself (time_sync_t).
+/// A plain string is left only where a name is really dynamic: the logger's raw regex, and the
+/// mission's --time-channels, which it matches against these constants.
+
+#include <vector>
+
+#include "common/messages.h"
+#include "common/types.h"
+#include "meshnav/time_sync_t.hpp"
 
 namespace meshnav::channels {
 
-inline constexpr const char* kImu = "IMU";                          ///< imu_t, imu_bridge → estimator
-inline constexpr const char* kBaro = "BARO";                        ///< baro_t
-inline constexpr const char* kRange = "RANGE";                      ///< range_t, uwb_bridge → estimator, calibrator
-inline constexpr const char* kFlightState = "FLIGHT_STATE";         ///< flight_state_t
-inline constexpr const char* kHeight = "HEIGHT";                    ///< height_t, imu_bridge → estimator
-inline constexpr const char* kGroundTruth = "GROUND_TRUTH";         ///< ground_truth_t (simulator, logs)
-inline constexpr const char* kAnchorInit = "ANCHOR_INIT";           ///< anchor_init_t, calibrator → estimator
-inline constexpr const char* kPose = "POSE";                        ///< pose_t, estimator →
-inline constexpr const char* kAnchors = "ANCHORS";                  ///< anchors_t, estimator →
-inline constexpr const char* kEstimatorStatus = "ESTIMATOR_STATUS"; ///< estimator_status_t (heartbeat)
-inline constexpr const char* kEstimatorCmd = "ESTIMATOR_CMD";       ///< estimator_cmd_t, mission → estimator
-inline constexpr const char* kCalibCmd = "CALIB_CMD";               ///< calib_cmd_t, mission → calibrator
-inline constexpr const char* kCalibStatus = "CALIB_STATUS";         ///< calib_status_t (heartbeat)
-inline constexpr const char* kMissionStatus = "MISSION_STATUS";     ///< mission_status_t (heartbeat)
-inline constexpr const char* kTimeSyncRequest = "TIME_SYNC_REQUEST"; ///< time_sync_t, bridges → estimator (clock reference)
-inline constexpr const char* kTimeSync = "TIME_SYNC";                ///< time_sync_t, estimator → bridges (replies)
+/// A channel name with the type of its messages.
+template <class Msg>
+struct Channel {
+  using Message = Msg;
+  const char* name;
+};
 
-/// Every channel above, for tools that list or record them.
-inline constexpr const char* kAll[] = {kImu,         kBaro,           kRange,           kFlightState,
-                                       kGroundTruth, kAnchorInit,     kPose,            kAnchors,
-                                       kEstimatorStatus, kEstimatorCmd, kCalibCmd,     kCalibStatus,
-                                       kMissionStatus, kHeight, kTimeSyncRequest, kTimeSync};
+inline constexpr Channel<ImuSample> kImu{"IMU"};                              ///< imu_t, imu_bridge → estimator
+inline constexpr Channel<BaroSample> kBaro{"BARO"};                           ///< baro_t
+inline constexpr Channel<RangeSample> kRange{"RANGE"};                        ///< range_t, uwb_bridge → estimator, calibrator
+inline constexpr Channel<FlightStateSample> kFlightState{"FLIGHT_STATE"};     ///< flight_state_t
+inline constexpr Channel<HeightSample> kHeight{"HEIGHT"};                     ///< height_t, imu_bridge → estimator
+inline constexpr Channel<PoseSample> kGroundTruth{"GROUND_TRUTH"};            ///< ground_truth_t (simulator, logs)
+inline constexpr Channel<AnchorInit> kAnchorInit{"ANCHOR_INIT"};              ///< anchor_init_t, calibrator → estimator
+inline constexpr Channel<PoseEstimate> kPose{"POSE"};                         ///< pose_t, estimator →
+inline constexpr Channel<std::vector<AnchorEstimate>> kAnchors{"ANCHORS"};    ///< anchors_t, estimator →
+inline constexpr Channel<EstimatorStatus> kEstimatorStatus{"ESTIMATOR_STATUS"}; ///< estimator_status_t (heartbeat)
+inline constexpr Channel<EstimatorCommand> kEstimatorCmd{"ESTIMATOR_CMD"};    ///< estimator_cmd_t, mission → estimator
+inline constexpr Channel<CalibCommand> kCalibCmd{"CALIB_CMD"};                ///< calib_cmd_t, mission → calibrator
+inline constexpr Channel<CalibStatus> kCalibStatus{"CALIB_STATUS"};           ///< calib_status_t (heartbeat)
+inline constexpr Channel<MissionStatus> kMissionStatus{"MISSION_STATUS"};     ///< mission_status_t (heartbeat)
+inline constexpr Channel<time_sync_t> kTimeSyncRequest{"TIME_SYNC_REQUEST"};  ///< time_sync_t, bridges → estimator (clock reference)
+inline constexpr Channel<time_sync_t> kTimeSync{"TIME_SYNC"};                 ///< time_sync_t, estimator → bridges (replies)
+
+/// The name of every channel above, for tools that list or record them.
+inline constexpr const char* kAll[] = {
+    kImu.name,         kBaro.name,        kRange.name,          kFlightState.name, kGroundTruth.name, kAnchorInit.name,
+    kPose.name,        kAnchors.name,     kEstimatorStatus.name, kEstimatorCmd.name, kCalibCmd.name,  kCalibStatus.name,
+    kMissionStatus.name, kHeight.name,   kTimeSyncRequest.name, kTimeSync.name};
 
 }  // namespace meshnav::channels

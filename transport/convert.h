@@ -13,6 +13,8 @@
 
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+#include <vector>
 
 #include "common/messages.h"
 #include "common/types.h"
@@ -95,5 +97,36 @@ template <> struct LcmTypeOf<CalibCommand> { using type = calib_cmd_t; };
 template <> struct LcmTypeOf<CalibStatus> { using type = calib_status_t; };
 template <> struct LcmTypeOf<MissionStatus> { using type = mission_status_t; };
 template <> struct LcmTypeOf<std::vector<AnchorEstimate>> { using type = anchors_t; };
+
+/// What a channel of `T` carries on the wire (channels::Channel<T>): LcmTypeOf<T> for a plain
+/// struct, `T` itself for an LCM type that has no plain struct (time_sync_t).
+template <class T>
+struct WireTypeOf {
+  using type = T;
+};
+template <class T>
+  requires requires { typename LcmTypeOf<T>::type; }
+struct WireTypeOf<T> {
+  using type = typename LcmTypeOf<T>::type;
+};
+template <class T>
+using WireType = typename WireTypeOf<T>::type;
+
+/// `value` as its wire message (toLcm, or itself for an LCM type).
+template <class T>
+WireType<T> toWire(const T& value) {
+  if constexpr (std::is_same_v<WireType<T>, T>)
+    return value;
+  else
+    return toLcm(value);
+}
+/// A decoded wire message as `T` (fromLcm, which validates, or itself for an LCM type).
+template <class T>
+T fromWire(const WireType<T>& msg) {
+  if constexpr (std::is_same_v<WireType<T>, T>)
+    return msg;
+  else
+    return fromLcm(msg);
+}
 
 }  // namespace meshnav::transport

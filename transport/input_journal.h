@@ -15,9 +15,11 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "common/diagnostics.h"
+#include "transport/channels.h"
 #include "transport/convert.h"
 
 namespace meshnav::transport {
@@ -30,13 +32,13 @@ class InputJournal {
   InputJournal(const InputJournal&) = delete;
   InputJournal& operator=(const InputJournal&) = delete;
 
-  /// Appends the plain struct `value` as its LCM message on `channel`, stamped `utime`.
-  template <class Plain>
-  void write(const std::string& channel, const Plain& value, int64_t utime) {
-    const auto msg = toLcm(value);
+  /// Appends `value` (of the channel's type) as its LCM message on `channel`, stamped `utime`.
+  template <class T>
+  void write(channels::Channel<T> channel, const std::type_identity_t<T>& value, int64_t utime) {
+    const auto msg = toWire(value);
     std::vector<uint8_t> buf(static_cast<size_t>(msg.getEncodedSize()));
     msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
-    writeRaw(channel, buf, utime);
+    writeRaw(channel.name, buf, utime);
   }
   void writeRaw(const std::string& channel, const std::vector<uint8_t>& bytes, int64_t utime);
   const std::string& path() const { return path_; }
@@ -47,19 +49,20 @@ class InputJournal {
   static int64_t read(const std::string& path,
                       const std::function<void(const std::string& channel, const lcm::ReceiveBuffer& rbuf)>& fn);
 
-  /// Decodes `rbuf` as the LCM type of `Plain` and converts it; false (counted
-  /// "<CHANNEL>:journal_bad_event" in `diag`) when it does not decode or convert.
-  template <class Plain>
-  static bool decode(const lcm::ReceiveBuffer& rbuf, const std::string& channel, Plain& out, Diagnostics& diag) {
-    typename LcmTypeOf<Plain>::type msg;
+  /// Decodes `rbuf`, an event of `channel`, as the channel's LCM type and converts it; false
+  /// (counted "<CHANNEL>:journal_bad_event" in `diag`) when it does not decode or convert.
+  template <class T>
+  static bool decode(const lcm::ReceiveBuffer& rbuf, channels::Channel<T> channel, std::type_identity_t<T>& out,
+                     Diagnostics& diag) {
+    WireType<T> msg;
     try {
       if (msg.decode(rbuf.data, 0, static_cast<int>(rbuf.data_size)) >= 0) {
-        out = fromLcm(msg);
+        out = fromWire<T>(msg);
         return true;
       }
     } catch (const std::exception&) {
     }
-    diag.count(channel + ":journal_bad_event");
+    diag.count(std::string(channel.name) + ":journal_bad_event");
     return false;
   }
 

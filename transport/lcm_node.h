@@ -1,6 +1,7 @@
 #pragma once
 /// @file lcm_node.h
-/// @brief The small runtime every process uses: one LCM instance, typed subscriptions that decode
+/// @brief The small runtime every process uses: one LCM instance, typed subscriptions (on the
+/// typed channels of transport/channels.h) that decode
 /// and validate messages themselves (a malformed message is reported with its channel, counted,
 /// and dropped: never a crash), a loop with a periodic heartbeat, and a clean stop on SIGINT /
 /// SIGTERM (StopSignal) or on request.
@@ -25,10 +26,12 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "common/diagnostics.h"
 #include "common/time.h"
+#include "transport/channels.h"
 #include "transport/convert.h"
 
 namespace meshnav::transport {
@@ -68,56 +71,36 @@ class LcmNode {
   using RawHandler = std::function<void(const lcm::ReceiveBuffer& rbuf, const std::string& channel)>;
   void subscribeRaw(const std::string& channel_regex, RawHandler fn);
 
-  /// Subscription to an LCM type: decoded here, decode failures reported and counted.
-  template <class Msg>
-  void subscribeLcm(const std::string& channel, std::function<void(const Msg&, const std::string& channel)> fn) {
-    subscribeRaw(channel, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
-      Msg msg;
+  /// Typed subscription to `channel`: each message decoded (decode failures reported and counted)
+  /// and, for a plain struct, converted with fromLcm (which validates: NaN, unknown codes →
+  /// "<CHANNEL>:invalid_message"). The handler takes the channel's type, nothing else: a
+  /// subscription with another type does not compile.
+  template <class T>
+  void subscribe(channels::Channel<T> channel, std::type_identity_t<std::function<void(const T&)>> fn) {
+    subscribeRaw(channel.name, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+      WireType<T> msg;
       if (!decode(rbuf, ch, msg)) return;
-      guarded(ch, [&] { fn(msg, ch); });
+      guarded(ch, [&] { fn(fromWire<T>(msg)); });
     });
   }
 
-  /// As subscribeLcm, with the wall time [µs] at which LCM received the message (taken by LCM's
+  /// As subscribe, with the wall time [µs] at which LCM received the message (taken by LCM's
   /// receive thread, so it does not include the time the message waited in the queue).
-  template <class Msg>
-  void subscribeLcmStamped(const std::string& channel,
-                           std::function<void(const Msg&, int64_t recv_utime)> fn) {
-    subscribeRaw(channel, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
-      Msg msg;
+  template <class T>
+  void subscribeStamped(channels::Channel<T> channel,
+                        std::type_identity_t<std::function<void(const T&, int64_t recv_utime)>> fn) {
+    subscribeRaw(channel.name, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+      WireType<T> msg;
       if (!decode(rbuf, ch, msg)) return;
-      guarded(ch, [&] { fn(msg, rbuf.recv_utime); });
+      guarded(ch, [&] { fn(fromWire<T>(msg), rbuf.recv_utime); });
     });
   }
 
-  /// Subscription delivering the plain struct (common/types.h, common/messages.h): decoded and
-  /// converted with fromLcm (which validates: NaN, unknown codes → "<CHANNEL>:invalid_message").
-  template <class Plain>
-  void subscribe(const std::string& channel, std::function<void(const Plain&)> fn) {
-    using Msg = typename LcmTypeOf<Plain>::type;
-    subscribeRaw(channel, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
-      Msg msg;
-      if (!decode(rbuf, ch, msg)) return;
-      guarded(ch, [&] { fn(fromLcm(msg)); });
-    });
-  }
-
-  template <class Msg>
-  bool publishLcm(const std::string& channel, const Msg& msg) {
-    if (const int64_t size = msg.getEncodedSize(); size < 0 || static_cast<size_t>(size) > kMaxMessageBytes) {
-      diag_.report(channel + ":oversized_publish", "publish on " + channel + ": " + std::to_string(size) +
-                                                       " bytes is above the limit of " +
-                                                       std::to_string(kMaxMessageBytes) + "; not sent");
-      return false;
-    }
-    const int rc = lcm_->publish(channel, &msg);
-    if (rc != 0) diag_.report("lcm:publish_error", "publish on " + channel + " failed");
-    return rc == 0;
-  }
-  /// Publishes a plain struct converted with toLcm.
-  template <class Plain>
-  bool publish(const std::string& channel, const Plain& value) {
-    return publishLcm(channel, toLcm(value));
+  /// Publishes `value` (of the channel's type only) on `channel`, converted with toLcm for a plain
+  /// struct. False when it is not sent (too large: "<CHANNEL>:oversized_publish"; LCM error).
+  template <class T>
+  bool publish(channels::Channel<T> channel, const std::type_identity_t<T>& value) {
+    return publishWire(channel.name, toWire(value));
   }
 
   /// Calls `fn` every `period` of wall time from spin() (the process heartbeat / status).
@@ -142,6 +125,19 @@ class LcmNode {
   int64_t received(const std::string& channel) const;
 
  private:
+  template <class Msg>
+  bool publishWire(const std::string& channel, const Msg& msg) {
+    if (const int64_t size = msg.getEncodedSize(); size < 0 || static_cast<size_t>(size) > kMaxMessageBytes) {
+      diag_.report(channel + ":oversized_publish", "publish on " + channel + ": " + std::to_string(size) +
+                                                       " bytes is above the limit of " +
+                                                       std::to_string(kMaxMessageBytes) + "; not sent");
+      return false;
+    }
+    const int rc = lcm_->publish(channel, &msg);
+    if (rc != 0) diag_.report("lcm:publish_error", "publish on " + channel + " failed");
+    return rc == 0;
+  }
+
   template <class Msg>
   bool decode(const lcm::ReceiveBuffer& rbuf, const std::string& ch, Msg& msg) {
     if (!sizeOk(rbuf, ch)) return false;

@@ -19,6 +19,7 @@
 #include <string>
 
 #include "common/cli.h"
+#include "transport/channels.h"
 #include "transport/lcm_node.h"
 #include "transport/replay/clock.h"
 
@@ -56,8 +57,8 @@ class ProcessMain {
   /// Publishes stamped(status()) on `channel` every `period_s` of wall time from spin() (first at
   /// once, so that others can wait for the process), then calls `after` with what was published.
   template <class Status>
-  void heartbeat(const std::string& channel, double period_s, std::function<Status()> status,
-                 std::function<void(const Status&)> after = {}) {
+  void heartbeat(channels::Channel<Status> channel, double period_s, std::type_identity_t<std::function<Status()>> status,
+                 std::type_identity_t<std::function<void(const Status&)>> after = {}) {
     lcm().setHeartbeat(Duration::fromSec(period_s), [this, channel, status, after] {
       const Status st = stamped(status());
       lcm().publish(channel, st);

@@ -32,6 +32,124 @@ std::string anchorStates(const CalibStatus& st) {
   return out;
 }
 
+/// The CalibratorNode wired to LCM: its inputs journaled before they reach it, its outputs
+/// published (except while the journal of a restart is replayed), the results file kept up to date.
+class CalibratorProcess {
+ public:
+  CalibratorProcess(transport::ProcessMain& process, const calib::CalibratorProcessConfig& config,
+                    const SystemSetup& setup)
+      : process_(process),
+        lcm_(process.lcm()),
+        config_(config),
+        node_(config.calibrator, setup, sinks(), config.node),
+        results_file_(config.out_yaml),
+        pose_period_(Duration::fromSec(config.pose_rate_hz > 0 ? 1.0 / config.pose_rate_hz : 0.0)) {}
+
+  /// With --state-dir: replays the inputs a previous run journaled, then journals the new ones.
+  void restoreFromJournal() {
+    if (config_.state_dir.empty()) return;
+    const std::string path = (std::filesystem::path(config_.state_dir) / "calibrator_inputs.lcmlog").string();
+    replaying_ = true;
+    Diagnostics& diag = lcm_.diagnostics();
+    const int64_t n = transport::InputJournal::read(path, [&](const std::string& ch, const lcm::ReceiveBuffer& rb) {
+      RangeSample r;
+      PoseEstimate p;
+      std::vector<AnchorEstimate> a;
+      CalibCommand c;
+      if (ch == channels::kRange.name && transport::InputJournal::decode(rb, channels::kRange, r, diag)) onRange(r);
+      if (ch == channels::kPose.name && transport::InputJournal::decode(rb, channels::kPose, p, diag)) onPose(p);
+      if (ch == channels::kAnchors.name && transport::InputJournal::decode(rb, channels::kAnchors, a, diag)) onAnchors(a);
+      if (ch == channels::kCalibCmd.name && transport::InputJournal::decode(rb, channels::kCalibCmd, c, diag)) onCommand(c);
+    });
+    replaying_ = false;
+    if (n > 0)
+      spdlog::warn("restart: {} inputs replayed from {} (data time {} s); anchors: {}", n, path,
+                   node_.dataTime() ? formatSeconds(*node_.dataTime()) : std::string("none"),
+                   anchorStates(node_.status()));
+    journal_ = std::make_unique<transport::InputJournal>(path);
+  }
+
+  /// Subscribes the inputs and starts the CALIB_STATUS heartbeat (with a progress line every 10 s).
+  void connect() {
+    lcm_.subscribe(channels::kRange, [this](const RangeSample& r) { onRange(r); });
+    lcm_.subscribe(channels::kPose, [this](const PoseEstimate& p) { onPose(p); });
+    lcm_.subscribe(channels::kAnchors, [this](const std::vector<AnchorEstimate>& a) { onAnchors(a); });
+    lcm_.subscribe(channels::kCalibCmd, [this](const CalibCommand& c) { onCommand(c); });
+    const int64_t progress_period_us = 10'000'000;  // a progress line every 10 s of wall time
+    next_progress_ = replay::wallUtimeNow() + progress_period_us;
+    process_.heartbeat(channels::kCalibStatus, config_.heartbeat_s, [this] { return node_.status(); },
+                       [this, progress_period_us](const CalibStatus& st) {
+                         if (st.wall_utime < next_progress_ || !node_.dataTime()) return;
+                         spdlog::info("t = {} s; anchors: {}", formatSeconds(st.t), anchorStates(st));
+                         next_progress_ = st.wall_utime + progress_period_us;
+                       });
+  }
+
+  /// After the loop: the last status, the results file, the counters.
+  void finish() {
+    const CalibStatus st = process_.stamped(node_.status());
+    lcm_.publish(channels::kCalibStatus, st);
+    if (results_file_.enabled()) writeResults(true);
+    spdlog::info("stopped at t = {} s; anchors: {}counters: {}", formatSeconds(st.t), anchorStates(st),
+                 transport::formatCounters(st.counters));
+  }
+
+ private:
+  calib::CalibratorSinks sinks() {
+    calib::CalibratorSinks s;
+    s.anchor_init = [this](const AnchorInit& a) {
+      logAnchorInit(a);
+      if (!replaying_) lcm_.publish(channels::kAnchorInit, a);
+    };
+    s.status = [this](const CalibStatus& st) {
+      if (!replaying_) lcm_.publish(channels::kCalibStatus, process_.stamped(st));
+    };
+    return s;
+  }
+  void writeResults(bool force) {
+    const int64_t attempts = node_.diagnostics().get("calibrations_ok") + node_.diagnostics().get("calibrations_refused");
+    if (results_file_.update(node_.results(), attempts, force))
+      spdlog::info("calibration results written to {}", results_file_.path());
+  }
+  /// What the node consumes goes to the journal first, so a kill -9 right after loses nothing.
+  template <class T>
+  void journaled(channels::Channel<T> channel, const T& value, Timestamp t) {
+    if (journal_ && !replaying_) journal_->write(channel, value, t.us);
+  }
+  void onRange(const RangeSample& r) {
+    journaled(channels::kRange, r, r.t);
+    node_.onRange(r);
+    writeResults(false);  // automatic mode calibrates on data
+  }
+  void onPose(const PoseEstimate& p) {
+    if (last_pose_ && p.t >= *last_pose_ && p.t - *last_pose_ < pose_period_) return;  // decimation
+    last_pose_ = p.t;
+    journaled(channels::kPose, p, p.t);
+    node_.onPose(p);
+    writeResults(false);
+  }
+  void onAnchors(const std::vector<AnchorEstimate>& a) {
+    journaled(channels::kAnchors, a, a.empty() ? Timestamp{} : a.front().t);
+    node_.onAnchors(a);
+  }
+  void onCommand(const CalibCommand& c) {
+    journaled(channels::kCalibCmd, c, c.t);
+    node_.onCommand(c);
+    writeResults(false);
+  }
+
+  transport::ProcessMain& process_;
+  transport::LcmNode& lcm_;
+  const calib::CalibratorProcessConfig& config_;
+  bool replaying_ = false;  ///< while the journal is replayed: the results are known to the others
+  calib::CalibratorNode node_;
+  calib::CalibrationYamlWriter results_file_;
+  std::unique_ptr<transport::InputJournal> journal_;
+  std::optional<Timestamp> last_pose_;
+  Duration pose_period_;
+  int64_t next_progress_ = 0;
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -53,98 +171,15 @@ int main(int argc, char** argv) {
       std::cout << config.toString();
       return 0;
     }
-    transport::LcmNode& lcm = process.lcm();
-    bool replaying = false;  // while the journal is replayed: the results are known to the others
-    calib::CalibratorSinks sinks;
-    sinks.anchor_init = [&](const AnchorInit& a) {
-      logAnchorInit(a);
-      if (!replaying) lcm.publish(channels::kAnchorInit, a);
-    };
-    sinks.status = [&](const CalibStatus& s) {
-      if (!replaying) lcm.publish(channels::kCalibStatus, process.stamped(s));
-    };
-    calib::CalibratorNode node(config.calibrator, setup, sinks, config.node);
+    CalibratorProcess calibrator(process, config, setup);
     spdlog::info("calibrator options:\n{}", config.toString());
-
-    calib::CalibrationYamlWriter results_file(config.out_yaml);
-    auto writeResults = [&](bool force) {
-      const int64_t attempts =
-          node.diagnostics().get("calibrations_ok") + node.diagnostics().get("calibrations_refused");
-      if (results_file.update(node.results(), attempts, force))
-        spdlog::info("calibration results written to {}", results_file.path());
-    };
-    std::optional<Timestamp> last_pose;
-    const Duration pose_period = Duration::fromSec(config.pose_rate_hz > 0 ? 1.0 / config.pose_rate_hz : 0.0);
-    // What the node consumed goes to the journal first, so a kill -9 right after loses nothing.
-    std::unique_ptr<transport::InputJournal> journal;
-    auto journaled = [&](const std::string& channel, const auto& value, Timestamp t) {
-      if (journal && !replaying) journal->write(channel, value, t.us);
-    };
-    auto onRange = [&](const RangeSample& r) {
-      journaled(channels::kRange, r, r.t);
-      node.onRange(r);
-      writeResults(false);  // automatic mode calibrates on data
-    };
-    auto onPose = [&](const PoseEstimate& p) {
-      if (last_pose && p.t >= *last_pose && p.t - *last_pose < pose_period) return;  // decimation
-      last_pose = p.t;
-      journaled(channels::kPose, p, p.t);
-      node.onPose(p);
-      writeResults(false);
-    };
-    auto onAnchors = [&](const std::vector<AnchorEstimate>& a) {
-      journaled(channels::kAnchors, a, a.empty() ? Timestamp{} : a.front().t);
-      node.onAnchors(a);
-    };
-    auto onCommand = [&](const CalibCommand& c) {
-      journaled(channels::kCalibCmd, c, c.t);
-      node.onCommand(c);
-      writeResults(false);
-    };
-    if (!config.state_dir.empty()) {
-      const std::string path = (std::filesystem::path(config.state_dir) / "calibrator_inputs.lcmlog").string();
-      replaying = true;
-      Diagnostics& diag = lcm.diagnostics();
-      const int64_t n = transport::InputJournal::read(path, [&](const std::string& ch, const lcm::ReceiveBuffer& rb) {
-        RangeSample r;
-        PoseEstimate p;
-        std::vector<AnchorEstimate> a;
-        CalibCommand c;
-        if (ch == channels::kRange && transport::InputJournal::decode(rb, ch, r, diag)) onRange(r);
-        if (ch == channels::kPose && transport::InputJournal::decode(rb, ch, p, diag)) onPose(p);
-        if (ch == channels::kAnchors && transport::InputJournal::decode(rb, ch, a, diag)) onAnchors(a);
-        if (ch == channels::kCalibCmd && transport::InputJournal::decode(rb, ch, c, diag)) onCommand(c);
-      });
-      replaying = false;
-      if (n > 0) {
-        const CalibStatus st = node.status();
-        spdlog::warn("restart: {} inputs replayed from {} (data time {} s); anchors: {}", n, path,
-                     node.dataTime() ? formatSeconds(*node.dataTime()) : std::string("none"), anchorStates(st));
-      }
-      journal = std::make_unique<transport::InputJournal>(path);
-    }
-    lcm.subscribe<RangeSample>(channels::kRange, onRange);
-    lcm.subscribe<PoseEstimate>(channels::kPose, onPose);
-    lcm.subscribe<std::vector<AnchorEstimate>>(channels::kAnchors, onAnchors);
-    lcm.subscribe<CalibCommand>(channels::kCalibCmd, onCommand);
-    const int64_t progress_period_us = 10'000'000;  // a progress line every 10 s of wall time
-    int64_t next_progress = replay::wallUtimeNow() + progress_period_us;
-    process.heartbeat<CalibStatus>(channels::kCalibStatus, config.heartbeat_s, [&] { return node.status(); },
-                                   [&](const CalibStatus& st) {
-                                     if (st.wall_utime < next_progress || !node.dataTime()) return;
-                                     spdlog::info("t = {} s; anchors: {}", formatSeconds(st.t), anchorStates(st));
-                                     next_progress = st.wall_utime + progress_period_us;
-                                   });
-    spdlog::info("LCM {}; {} tags, {} known anchors; {}", lcm.url(), setup.rel_tag_positions.size(),
+    calibrator.restoreFromJournal();
+    calibrator.connect();
+    spdlog::info("LCM {}; {} tags, {} known anchors; {}", process.lcm().url(), setup.rel_tag_positions.size(),
                  setup.abs_anchor_positions.size(),
                  config.node.auto_mode ? "automatic calibration" : "calibration on CALIB_CMD");
-    const int rc = lcm.spin();
-
-    const CalibStatus st = process.stamped(node.status());
-    lcm.publish(channels::kCalibStatus, st);
-    if (results_file.enabled()) writeResults(true);
-    spdlog::info("stopped at t = {} s; anchors: {}counters: {}", formatSeconds(st.t), anchorStates(st),
-                 transport::formatCounters(st.counters));
+    const int rc = process.lcm().spin();
+    calibrator.finish();
     return rc;
   });
 }

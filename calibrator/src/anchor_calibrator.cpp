@@ -40,6 +40,60 @@ std::vector<bool> classifyFinal(const CalibrationProblem& pb, const AnchorParams
   return in;
 }
 
+/// The final inliers `inl` (in the problem's order) mapped back to the caller's order: the problem
+/// sorted the observations by time (stable), so the same sort gives the map.
+std::vector<bool> inliersInCallerOrder(const std::vector<CalibObservation>& observations, const std::vector<bool>& inl) {
+  std::vector<size_t> order(observations.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return observations[a].t < observations[b].t; });
+  std::vector<bool> out(observations.size(), false);
+  for (size_t k = 0; k < order.size(); ++k) out[order[k]] = inl[k];
+  return out;
+}
+
+/// γ, β with their σ and the range statistics of each reference (slot) at the solution `x`.
+std::vector<ReferenceBiasEstimate> referenceEstimates(const CalibrationProblem& pb, const AnchorParams& x,
+                                                      const CovarianceEstimate& cov, const std::vector<bool>& inl,
+                                                      double default_sigma_range_m) {
+  std::vector<ReferenceBiasEstimate> out;
+  for (int s = 0; s < static_cast<int>(pb.slots().size()); ++s) {
+    const auto& slot = pb.slots()[static_cast<size_t>(s)];
+    ReferenceBiasEstimate r;
+    r.ref_id = slot.id;
+    r.moving = slot.moving;
+    r.beta_estimated = pb.betaIndex(s) >= 0;
+    r.gamma_m = x.gamma_m[static_cast<size_t>(s)];
+    r.sigma_gamma_m = std::sqrt(cov.P(pb.gammaIndex(s), pb.gammaIndex(s)));
+    r.beta = x.beta[static_cast<size_t>(s)];
+    r.sigma_beta = r.beta_estimated ? std::sqrt(cov.P(pb.betaIndex(s), pb.betaIndex(s))) : 0.0;
+    double sq = 0.0;
+    for (int i : slot.obs) {
+      if (inl[static_cast<size_t>(i)]) {
+        sq += std::pow(pb.observations()[static_cast<size_t>(i)].z_m - predictRange(pb, x, i), 2);
+        ++r.n_inliers;
+      } else {
+        ++r.n_outliers;
+      }
+    }
+    r.sigma_range_m = r.n_inliers > 0 ? std::sqrt(sq / r.n_inliers) : default_sigma_range_m;
+    out.push_back(r);
+  }
+  return out;
+}
+
+/// The [p, γ_0..γ_n-1] block of the stacked covariance, in the order of the references, symmetrized.
+Eigen::MatrixXd positionGammaCovariance(const CalibrationProblem& pb, const CovarianceEstimate& cov) {
+  const auto ns = static_cast<Eigen::Index>(pb.slots().size());
+  std::vector<Eigen::Index> idx = {0, 1, 2};
+  for (int s = 0; s < static_cast<int>(ns); ++s) idx.push_back(pb.gammaIndex(s));
+  Eigen::MatrixXd out(3 + ns, 3 + ns);
+  for (Eigen::Index r = 0; r < 3 + ns; ++r)
+    for (Eigen::Index c = 0; c < 3 + ns; ++c)
+      out(r, c) = 0.5 * (cov.P(idx[static_cast<size_t>(r)], idx[static_cast<size_t>(c)]) +
+                         cov.P(idx[static_cast<size_t>(c)], idx[static_cast<size_t>(r)]));
+  return out;
+}
+
 }  // namespace
 
 const char* toString(CalibrationStatus s) {
@@ -146,46 +200,13 @@ CalibrationResult AnchorCalibrator::calibrate(SensorId anchor_id, const std::vec
   res.p_AinG = x.p_AinG;
   res.cov_p_m2 = 0.5 * (Pp + Pp.transpose());
   res.residual_variance_factor = cov.s2;
-  // Map inliers back to the caller's order: the problem sorted by time (stable), so match by sort.
-  std::vector<size_t> order(observations.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return observations[a].t < observations[b].t; });
-  res.inliers.assign(observations.size(), false);
-  for (size_t k = 0; k < order.size(); ++k) res.inliers[order[k]] = inl[k];
-
-  for (int s = 0; s < static_cast<int>(pb.slots().size()); ++s) {
-    const auto& slot = pb.slots()[static_cast<size_t>(s)];
-    ReferenceBiasEstimate r;
-    r.ref_id = slot.id;
-    r.moving = slot.moving;
-    r.beta_estimated = pb.betaIndex(s) >= 0;
-    r.gamma_m = x.gamma_m[static_cast<size_t>(s)];
-    r.sigma_gamma_m = std::sqrt(cov.P(pb.gammaIndex(s), pb.gammaIndex(s)));
-    r.beta = x.beta[static_cast<size_t>(s)];
-    r.sigma_beta = r.beta_estimated ? std::sqrt(cov.P(pb.betaIndex(s), pb.betaIndex(s))) : 0.0;
-    double sq = 0.0;
-    for (int i : slot.obs) {
-      if (inl[static_cast<size_t>(i)]) {
-        sq += std::pow(pb.observations()[static_cast<size_t>(i)].z_m - predictRange(pb, x, i), 2);
-        ++r.n_inliers;
-      } else {
-        ++r.n_outliers;
-      }
-    }
-    r.sigma_range_m = r.n_inliers > 0 ? std::sqrt(sq / r.n_inliers) : options_.sigma_range_m;
+  res.inliers = inliersInCallerOrder(observations, inl);
+  res.references = referenceEstimates(pb, x, cov, inl, options_.sigma_range_m);
+  for (const ReferenceBiasEstimate& r : res.references) {
     res.n_inliers += r.n_inliers;
     res.n_outliers += r.n_outliers;
-    res.references.push_back(r);
   }
-  // [p, γ_0..γ_n-1] block of the stacked covariance, in references order.
-  const auto ns = static_cast<Eigen::Index>(pb.slots().size());
-  std::vector<Eigen::Index> idx = {0, 1, 2};
-  for (int s = 0; s < static_cast<int>(ns); ++s) idx.push_back(pb.gammaIndex(s));
-  res.cov_p_gamma_m2.resize(3 + ns, 3 + ns);
-  for (Eigen::Index r = 0; r < 3 + ns; ++r)
-    for (Eigen::Index c = 0; c < 3 + ns; ++c)
-      res.cov_p_gamma_m2(r, c) = 0.5 * (cov.P(idx[static_cast<size_t>(r)], idx[static_cast<size_t>(c)]) +
-                                        cov.P(idx[static_cast<size_t>(c)], idx[static_cast<size_t>(r)]));
+  res.cov_p_gamma_m2 = positionGammaCovariance(pb, cov);
   return res;
 }
 

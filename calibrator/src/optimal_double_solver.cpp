@@ -62,119 +62,162 @@ std::vector<std::pair<int, int>> OptimalDoubleSolver::selectPairs(const Calibrat
   return best;
 }
 
+namespace {
+
+/// The linear system of the optimal double method for one problem and subset of observations:
+/// unknowns [p (3), γ of each moving slot with ≥ 2 ranges], one row per pair of ranges of a slot.
+struct DoubleSystem {
+  const CalibrationProblem& pb;
+  std::vector<std::vector<int>> per_slot;            ///< observations per slot, time order
+  std::vector<int> lin_col;                          ///< column of the slot's γ (-1: not in the system)
+  int u = 3;                                         ///< number of unknowns
+  std::vector<std::vector<std::pair<int, int>>> pairs;  ///< the differenced pairs per slot
+
+  int nSlots() const { return static_cast<int>(per_slot.size()); }
+  const CalibObservation& obs(int i) const { return pb.observations()[static_cast<size_t>(i)]; }
+};
+
+/// σ² of a range with the reference's position uncertainty (before any estimate exists).
+double priorSigma2(const CalibObservation& o) {
+  return o.sigma_d_m * o.sigma_d_m + o.cov_p_RinG_m2.trace() / 3.0;
+}
+
+/// Observations per slot (time order = index order, the problem is time-sorted); `subset` empty:
+/// all of them.
+std::vector<std::vector<int>> observationsPerSlot(const CalibrationProblem& pb, const std::vector<int>& subset) {
+  const size_t n_slots = pb.slots().size();
+  std::vector<std::vector<int>> per_slot(n_slots);
+  if (subset.empty()) {
+    for (size_t s = 0; s < n_slots; ++s) per_slot[s] = pb.slots()[s].obs;
+    return per_slot;
+  }
+  std::vector<int> sorted = subset;
+  std::sort(sorted.begin(), sorted.end());
+  for (int i : sorted)
+    if (pb.slotOf(i) >= 0) per_slot[static_cast<size_t>(pb.slotOf(i))].push_back(i);
+  return per_slot;
+}
+
+/// Column layout: a γ column for each moving slot with ≥ 2 ranges; sets sys.u.
+void assignColumns(DoubleSystem& sys) {
+  sys.lin_col.assign(sys.per_slot.size(), -1);
+  sys.u = 3;
+  for (int s = 0; s < sys.nSlots(); ++s)
+    if (sys.pb.slots()[static_cast<size_t>(s)].moving && sys.per_slot[static_cast<size_t>(s)].size() >= 2)
+      sys.lin_col[static_cast<size_t>(s)] = sys.u++;
+}
+
+/// Pass 1 pairing and regressors (ρ = z).
+void choosePairs(DoubleSystem& sys) {
+  sys.pairs.assign(sys.per_slot.size(), {});
+  for (int s = 0; s < sys.nSlots(); ++s) {
+    if (sys.lin_col[static_cast<size_t>(s)] < 0) continue;
+    const auto& idx = sys.per_slot[static_cast<size_t>(s)];
+    std::vector<double> rho, var_half;
+    for (int i : idx) {
+      const double z = std::max(sys.obs(i).z_m, kMinRange);
+      rho.push_back(sys.obs(i).z_m);
+      var_half.push_back(4.0 * priorSigma2(sys.obs(i)) * z * z);
+    }
+    sys.pairs[static_cast<size_t>(s)] = OptimalDoubleSolver::selectPairs(sys.pb, idx, rho, var_half);
+  }
+}
+
+/// One weighted LS solve given the regressor ρ_i, the predicted range ẑ_i and σ²_i (for the
+/// weights). `rows` gets the number of difference rows. False when rank deficient.
+bool solveWeighted(const DoubleSystem& sys, const std::vector<double>& rho_all, const std::vector<double>& zhat_all,
+                   const std::vector<double>& s2_all, Eigen::VectorXd& x, int& rows) {
+  const int u = sys.u;
+  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(u, u);
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(u);
+  rows = 0;
+  for (int s = 0; s < sys.nSlots(); ++s) {
+    const int col = sys.lin_col[static_cast<size_t>(s)];
+    if (col < 0) continue;
+    for (auto [i, j] : sys.pairs[static_cast<size_t>(s)]) {
+      const auto& o1 = sys.obs(i);
+      const auto& o2 = sys.obs(j);
+      Eigen::Vector3d ap = 2.0 * (o1.p_RinG - o2.p_RinG);
+      const double ag = -2.0 * (rho_all[static_cast<size_t>(i)] - rho_all[static_cast<size_t>(j)]);
+      double b = o1.p_RinG.squaredNorm() - o2.p_RinG.squaredNorm() - (o1.z_m * o1.z_m - o2.z_m * o2.z_m);
+      b += o1.sigma_d_m * o1.sigma_d_m - o2.sigma_d_m * o2.sigma_d_m;
+      b -= o1.cov_p_RinG_m2.trace() - o2.cov_p_RinG_m2.trace();
+      const double z1 = std::max(zhat_all[static_cast<size_t>(i)], kMinRange);
+      const double z2 = std::max(zhat_all[static_cast<size_t>(j)], kMinRange);
+      const double w = 1.0 / (4.0 * (s2_all[static_cast<size_t>(i)] * z1 * z1 + s2_all[static_cast<size_t>(j)] * z2 * z2));
+      N.topLeftCorner<3, 3>().noalias() += w * ap * ap.transpose();
+      N.block(0, col, 3, 1) += w * ag * ap;
+      N.block(col, 0, 1, 3) += w * ag * ap.transpose();
+      N(col, col) += w * ag * ag;
+      r.head<3>() += w * b * ap;
+      r(col) += w * b * ag;
+      ++rows;
+    }
+  }
+  if (rows < u) return false;
+  // Scale-invariant rank test on the normalised normal matrix.
+  const Eigen::VectorXd dg = N.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+  const Eigen::MatrixXd Nn = dg.asDiagonal() * N * dg.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Nn, Eigen::EigenvaluesOnly);
+  if (!(es.eigenvalues()(0) > 1e-10 * es.eigenvalues()(u - 1))) return false;
+  x = N.ldlt().solve(r);
+  return x.allFinite();
+}
+
+/// The anchor parameters of a solution vector (γ of the slots outside the system: the prior).
+AnchorParams toParams(const DoubleSystem& sys, const Eigen::VectorXd& v) {
+  AnchorParams p = sys.pb.priorParams(v.head<3>());
+  for (int s = 0; s < sys.nSlots(); ++s)
+    if (sys.lin_col[static_cast<size_t>(s)] >= 0) p.gamma_m[static_cast<size_t>(s)] = v(sys.lin_col[static_cast<size_t>(s)]);
+  return p;
+}
+
+/// Stationary references (and moving ones without rows): γ from the mean residual.
+void gammaFromMeanResidual(const DoubleSystem& sys, AnchorParams& params) {
+  for (int s = 0; s < sys.nSlots(); ++s) {
+    if (sys.lin_col[static_cast<size_t>(s)] >= 0) continue;
+    const auto& idx = sys.per_slot[static_cast<size_t>(s)];
+    if (idx.empty()) continue;
+    double sum = 0.0;
+    const double beta = params.beta[static_cast<size_t>(s)];
+    for (int i : idx) sum += sys.obs(i).z_m - beta * (params.p_AinG - sys.obs(i).p_RinG).norm();
+    params.gamma_m[static_cast<size_t>(s)] = sum / static_cast<double>(idx.size());
+  }
+}
+
+}  // namespace
+
 LinearSolution OptimalDoubleSolver::solve(const CalibrationProblem& pb, const std::vector<int>& subset) const {
   LinearSolution sol;
-  const auto& obs = pb.observations();
-  const int n_slots = static_cast<int>(pb.slots().size());
-
-  // Observations per slot (time order = index order, the problem is time-sorted).
-  std::vector<std::vector<int>> per_slot(static_cast<size_t>(n_slots));
-  if (subset.empty()) {
-    for (int s = 0; s < n_slots; ++s) per_slot[static_cast<size_t>(s)] = pb.slots()[static_cast<size_t>(s)].obs;
-  } else {
-    std::vector<int> sorted = subset;
-    std::sort(sorted.begin(), sorted.end());
-    for (int i : sorted)
-      if (pb.slotOf(i) >= 0) per_slot[static_cast<size_t>(pb.slotOf(i))].push_back(i);
-  }
-
-  // Unknown layout of the linear system: [p (3), γ of each moving slot with ≥ 2 ranges].
-  std::vector<int> lin_col(static_cast<size_t>(n_slots), -1);
-  int u = 3;
-  for (int s = 0; s < n_slots; ++s)
-    if (pb.slots()[static_cast<size_t>(s)].moving && per_slot[static_cast<size_t>(s)].size() >= 2)
-      lin_col[static_cast<size_t>(s)] = u++;
-  if (u == 3) {
+  DoubleSystem sys{pb, observationsPerSlot(pb, subset), {}, 3, {}};
+  assignColumns(sys);
+  if (sys.u == 3) {
     sol.reason = "no moving reference with at least 2 ranges";
     return sol;
   }
+  choosePairs(sys);
 
-  auto sigma2 = [&](int i) {
-    const auto& o = obs[static_cast<size_t>(i)];
-    return o.sigma_d_m * o.sigma_d_m + o.cov_p_RinG_m2.trace() / 3.0;
-  };
-
-  // Pass 1 pairing and regressors (ρ = z).
-  std::vector<std::vector<std::pair<int, int>>> pairs(static_cast<size_t>(n_slots));
-  for (int s = 0; s < n_slots; ++s) {
-    if (lin_col[static_cast<size_t>(s)] < 0) continue;
-    const auto& idx = per_slot[static_cast<size_t>(s)];
-    std::vector<double> rho, var_half;
-    for (int i : idx) {
-      const double z = std::max(obs[static_cast<size_t>(i)].z_m, kMinRange);
-      rho.push_back(obs[static_cast<size_t>(i)].z_m);
-      var_half.push_back(4.0 * sigma2(i) * z * z);
-    }
-    pairs[static_cast<size_t>(s)] = selectPairs(pb, idx, rho, var_half);
-  }
-
-  // One weighted LS solve given the regressor ρ_i and the predicted range ẑ_i (for the weights).
-  auto solveOnce = [&](const std::vector<double>& rho_all, const std::vector<double>& zhat_all,
-                       const std::vector<double>& s2_all, Eigen::VectorXd& x) -> bool {
-    Eigen::MatrixXd N = Eigen::MatrixXd::Zero(u, u);
-    Eigen::VectorXd r = Eigen::VectorXd::Zero(u);
-    int rows = 0;
-    for (int s = 0; s < n_slots; ++s) {
-      const int col = lin_col[static_cast<size_t>(s)];
-      if (col < 0) continue;
-      for (auto [i, j] : pairs[static_cast<size_t>(s)]) {
-        const auto& o1 = obs[static_cast<size_t>(i)];
-        const auto& o2 = obs[static_cast<size_t>(j)];
-        Eigen::Vector3d ap = 2.0 * (o1.p_RinG - o2.p_RinG);
-        const double ag = -2.0 * (rho_all[static_cast<size_t>(i)] - rho_all[static_cast<size_t>(j)]);
-        double b = o1.p_RinG.squaredNorm() - o2.p_RinG.squaredNorm() - (o1.z_m * o1.z_m - o2.z_m * o2.z_m);
-        b += o1.sigma_d_m * o1.sigma_d_m - o2.sigma_d_m * o2.sigma_d_m;
-        b -= o1.cov_p_RinG_m2.trace() - o2.cov_p_RinG_m2.trace();
-        const double z1 = std::max(zhat_all[static_cast<size_t>(i)], kMinRange);
-        const double z2 = std::max(zhat_all[static_cast<size_t>(j)], kMinRange);
-        const double w = 1.0 / (4.0 * (s2_all[static_cast<size_t>(i)] * z1 * z1 + s2_all[static_cast<size_t>(j)] * z2 * z2));
-        N.topLeftCorner<3, 3>().noalias() += w * ap * ap.transpose();
-        N.block(0, col, 3, 1) += w * ag * ap;
-        N.block(col, 0, 1, 3) += w * ag * ap.transpose();
-        N(col, col) += w * ag * ag;
-        r.head<3>() += w * b * ap;
-        r(col) += w * b * ag;
-        ++rows;
-      }
-    }
-    sol.n_rows = rows;
-    if (rows < u) return false;
-    // Scale-invariant rank test on the normalised normal matrix.
-    const Eigen::VectorXd dg = N.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
-    const Eigen::MatrixXd Nn = dg.asDiagonal() * N * dg.asDiagonal();
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Nn, Eigen::EigenvaluesOnly);
-    if (!(es.eigenvalues()(0) > 1e-10 * es.eigenvalues()(u - 1))) return false;
-    x = N.ldlt().solve(r);
-    return x.allFinite();
-  };
-
+  const auto& obs = pb.observations();
   const size_t n_obs = obs.size();
   std::vector<double> rho(n_obs), zhat(n_obs), s2(n_obs);
   for (size_t i = 0; i < n_obs; ++i) {
     rho[i] = obs[i].z_m;
     zhat[i] = obs[i].z_m;
-    s2[i] = obs[i].sigma_d_m * obs[i].sigma_d_m + obs[i].cov_p_RinG_m2.trace() / 3.0;
+    s2[i] = priorSigma2(obs[i]);
   }
   Eigen::VectorXd x;
-  if (!solveOnce(rho, zhat, s2, x)) {
+  if (!solveWeighted(sys, rho, zhat, s2, x, sol.n_rows)) {
     sol.reason = "linear system rank deficient (" + std::to_string(sol.n_rows) + " difference rows for " +
-                 std::to_string(u) + " unknowns)";
+                 std::to_string(sys.u) + " unknowns)";
     return sol;
   }
-
-  auto toParams = [&](const Eigen::VectorXd& v) {
-    AnchorParams p = pb.priorParams(v.head<3>());
-    for (int s = 0; s < n_slots; ++s)
-      if (lin_col[static_cast<size_t>(s)] >= 0) p.gamma_m[static_cast<size_t>(s)] = v(lin_col[static_cast<size_t>(s)]);
-    return p;
-  };
-
   if (options_.linear_bias_correction) {
+    // Re-solve with the regressor ρ = d(p̂) and the weights of the current estimate.
     for (int pass = 0; pass < std::max(1, options_.linear_passes); ++pass) {
-      const AnchorParams cur = toParams(x);
-      for (int s = 0; s < n_slots; ++s) {
-        if (lin_col[static_cast<size_t>(s)] < 0) continue;
-        for (int i : per_slot[static_cast<size_t>(s)]) {
+      const AnchorParams cur = toParams(sys, x);
+      for (int s = 0; s < sys.nSlots(); ++s) {
+        if (sys.lin_col[static_cast<size_t>(s)] < 0) continue;
+        for (int i : sys.per_slot[static_cast<size_t>(s)]) {
           const double d = (cur.p_AinG - obs[static_cast<size_t>(i)].p_RinG).norm();
           rho[static_cast<size_t>(i)] = d;
           zhat[static_cast<size_t>(i)] = d + cur.gamma_m[static_cast<size_t>(s)];
@@ -183,23 +226,12 @@ LinearSolution OptimalDoubleSolver::solve(const CalibrationProblem& pb, const st
         }
       }
       Eigen::VectorXd x2;
-      if (!solveOnce(rho, zhat, s2, x2)) break;  // keep the previous pass
+      if (!solveWeighted(sys, rho, zhat, s2, x2, sol.n_rows)) break;  // keep the previous pass
       x = x2;
     }
   }
-
-  sol.params = toParams(x);
-  // Stationary references (and moving ones without rows): γ from the mean residual.
-  for (int s = 0; s < n_slots; ++s) {
-    if (lin_col[static_cast<size_t>(s)] >= 0) continue;
-    const auto& idx = per_slot[static_cast<size_t>(s)];
-    if (idx.empty()) continue;
-    double sum = 0.0;
-    const double beta = sol.params.beta[static_cast<size_t>(s)];
-    for (int i : idx)
-      sum += obs[static_cast<size_t>(i)].z_m - beta * (sol.params.p_AinG - obs[static_cast<size_t>(i)].p_RinG).norm();
-    sol.params.gamma_m[static_cast<size_t>(s)] = sum / static_cast<double>(idx.size());
-  }
+  sol.params = toParams(sys, x);
+  gammaFromMeanResidual(sys, sol.params);
   sol.ok = true;
   return sol;
 }

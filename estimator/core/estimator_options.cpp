@@ -11,10 +11,9 @@
 namespace meshnav::estimator {
 namespace {
 
-/// Visits every option as (dotted key, field, unit/comment). The single list used for loading,
-/// printing and the shipped YAML, so they cannot drift apart.
+/// forEachField, part: the top-level options and the IMU.
 template <typename Opt, typename Visitor>
-void forEachField(Opt& o, Visitor&& v) {
+void forEachGeneralField(Opt& o, Visitor& v) {
   v("strategy", o.strategy, "centralized | dp | dah");
   v("gravity_m_s2", o.gravity_m_s2, "|g| [m/s^2]");
   v("window_s", o.window_s, "out-of-sequence window [s]");
@@ -29,6 +28,11 @@ void forEachField(Opt& o, Visitor&& v) {
   v("imu.max_dt_s", o.imu.max_dt_s, "longer IMU gaps are counted as imu_gap and inflated [s]");
   v("imu.gap_sigma_acc_m_s2", o.imu.gap_sigma_acc_m_s2, "held-reading error during a gap [m/s^2/sqrt(s)]");
   v("imu.gap_sigma_gyro_rad_s", o.imu.gap_sigma_gyro_rad_s, "held-reading error during a gap [rad/s/sqrt(s)]");
+}
+
+/// forEachField, part: initialization (static, in motion, resume).
+template <typename Opt, typename Visitor>
+void forEachInitField(Opt& o, Visitor& v) {
   v("init.duration_s", o.init.duration_s, "landed data before initializing [s]");
   v("init.min_ranges", o.init.min_ranges, "tag-anchor ranges needed without initial_pose [-]");
   v("init.assume_landed_without_flight_state", o.init.assume_landed_without_flight_state,
@@ -55,6 +59,11 @@ void forEachField(Opt& o, Visitor&& v) {
   v("init.resume_max_outage_s", o.init.resume_max_outage_s, "longer restart outages re-initialize the pose (anchors kept) [s]");
   v("init.resume_max_acc_m_s2", o.init.resume_max_acc_m_s2, "largest acceleration during a restart's outage [m/s^2]");
   v("init.resume_max_rate_deg_s", o.init.resume_max_rate_deg_s, "largest rotation rate during a restart's outage [deg/s]");
+}
+
+/// forEachField, part: barometer and height sensor.
+template <typename Opt, typename Visitor>
+void forEachAltitudeField(Opt& o, Visitor& v) {
   v("baro.enabled", o.baro.enabled, "");
   v("baro.pressure_sigma_pa", o.baro.pressure_sigma_pa, "[Pa]");
   v("baro.bias_rw_m_per_sqrt_s", o.baro.bias_rw_m_per_sqrt_s, "height bias random walk [m/sqrt(s)]");
@@ -74,6 +83,11 @@ void forEachField(Opt& o, Visitor&& v) {
   v("carried_height.sigma_m", o.carried_height.sigma_m, "sigma of one reading (gait bob and sway) [m]");
   v("carried_height.bias_rw_m_per_sqrt_s", o.carried_height.bias_rw_m_per_sqrt_s,
     "random walk of the carrying height [m/sqrt(s)]");
+}
+
+/// forEachField, part: UWB ranges.
+template <typename Opt, typename Visitor>
+void forEachUwbField(Opt& o, Visitor& v) {
   v("uwb.enabled", o.uwb.enabled, "");
   v("uwb.sigma_range_m", o.uwb.sigma_range_m, "fallback range sigma [m]");
   v("uwb.gate_probability", o.uwb.gate_probability, "chi^2 gate, 0 = off [-]");
@@ -90,6 +104,11 @@ void forEachField(Opt& o, Visitor&& v) {
     "fuse ranges between two calibrated anchors (their correlated calibration errors are not known)");
   v("uwb.dah_fuse_estimated_anchor_pairs", o.uwb.dah_fuse_estimated_anchor_pairs,
     "dah only: fuse ranges between two estimated anchors (overconfident, see docs)");
+}
+
+/// forEachField, part: zero-velocity updates and the health monitor.
+template <typename Opt, typename Visitor>
+void forEachRestAndHealthField(Opt& o, Visitor& v) {
   v("zupt.enabled", o.zupt.enabled, "");
   v("zupt.rate_hz", o.zupt.rate_hz, "pseudo-measurement rate while landed [Hz]");
   v("zupt.sigma_acc_m_s2", o.zupt.sigma_acc_m_s2, "sigma of a = 0 [m/s^2]");
@@ -107,6 +126,11 @@ void forEachField(Opt& o, Visitor&& v) {
   v("health.lost_no_aiding_s", o.health.lost_no_aiding_s, "no accepted range for this long: lost [s]");
   v("health.lost_sigma_p_m", o.health.lost_sigma_p_m, "largest position sigma beyond which the pose is lost [m]");
   v("health.hold_s", o.health.hold_s, "a better health must hold this long [s]");
+}
+
+/// forEachField, part: process-noise adaptation, recovery and the time guard.
+template <typename Opt, typename Visitor>
+void forEachAdaptationField(Opt& o, Visitor& v) {
   v("process_noise.adapt", o.process_noise.enabled, "scale the IMU noise densities to the range innovations");
   v("process_noise.batch", o.process_noise.batch, "tag-anchor ranges per decision [-]");
   v("process_noise.upper_ratio", o.process_noise.upper_ratio, "median NIS ratio above which the scale grows [-]");
@@ -124,6 +148,18 @@ void forEachField(Opt& o, Visitor&& v) {
     "an input stamped farther than this from the current (newest) time is refused and counted [s]");
   v("time.rebase_after", o.time.rebase_after,
     "this many consecutive refused inputs agreeing among themselves move the clock (a real jump) [-]");
+}
+
+/// Visits every option as (dotted key, field, unit/comment). The single list used for loading,
+/// printing and the shipped YAML, so they cannot drift apart.
+template <typename Opt, typename Visitor>
+void forEachField(Opt& o, Visitor&& v) {
+  forEachGeneralField(o, v);
+  forEachInitField(o, v);
+  forEachAltitudeField(o, v);
+  forEachUwbField(o, v);
+  forEachRestAndHealthField(o, v);
+  forEachAdaptationField(o, v);
 }
 
 std::vector<std::string> splitKey(const std::string& key) {

@@ -88,6 +88,8 @@ class FactorizedCovariance {
   /// and baro update): the same steps as update() + writeBackDah() on stack storage, with the
   /// rank-one forms of the scalar update (see the .cpp). False: not applicable, use the general path.
   bool updateDahScalar(const Linearization& lin, double nis_gate, Timestamp t, Result* res);
+  /// Its steps on stack storage (factorized_covariance_dah_scalar.cpp).
+  friend class DahScalarUpdate;
 
   Mode mode_;
   bool joseph_;

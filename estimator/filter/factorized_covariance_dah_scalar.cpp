@@ -169,188 +169,245 @@ bool invertPending(const InstanceBelief& b, int max_lazy_steps, double max_condi
 
 }  // namespace
 
-bool FactorizedCovariance::updateDahScalar(const Linearization& lin, double nis_gate, Timestamp t, Result* res) {
-  if (lin.dim() != 1 || lin.R.rows() != 1 || lin.R.cols() != 1 || lin.blocks.empty() ||
-      lin.blocks.size() > static_cast<size_t>(kMaxParticipants))
-    return false;
-  // Participants P in layout order, their offsets in the stacked state.
+/// The steps of updateDahScalar on its stack storage: the participants, Σ_PP, the scalar EKF
+/// update, then the DAH write-back (private: one participant; joint: the rank-one correction of
+/// each L_i, their inverses and the new pair factors).
+class DahScalarUpdate {
+ public:
+  DahScalarUpdate(FactorizedCovariance& fc, const Linearization& lin) : fc_(fc), lin_(lin) {}
+
+  /// Participants P in layout order with their offsets in the stacked state; false when the
+  /// measurement is not for the fast path (not scalar, too many or too large participants).
+  bool selectParticipants() {
+    if (lin_.dim() != 1 || lin_.R.rows() != 1 || lin_.R.cols() != 1 || lin_.blocks.empty() ||
+        lin_.blocks.size() > static_cast<size_t>(kMaxParticipants))
+      return false;
+    std::array<int, kMaxParticipants> ks{};
+    int np = 0;
+    for (const JacobianBlock& jb : lin_.blocks) {
+      if (!fc_.has(jb.id)) throw std::logic_error("FactorizedCovariance::update: no instance " + std::to_string(jb.id));
+      ks[static_cast<size_t>(np++)] = fc_.index(jb.id);
+    }
+    std::sort(ks.begin(), ks.begin() + np);
+    np_ = static_cast<int>(std::unique(ks.begin(), ks.begin() + np) - ks.begin());
+    n_ = 0;
+    for (int a = 0; a < np_; ++a) {
+      const StateBlock& b = fc_.layout_.blocks()[static_cast<size_t>(ks[static_cast<size_t>(a)])];
+      if (b.dim > kMaxInstanceDim) return false;
+      pp_[static_cast<size_t>(a)] = Part{ks[static_cast<size_t>(a)], n_, b.dim, b.id};
+      n_ += b.dim;
+    }
+    if (n_ > kMaxStackedDim) return false;
+    for (const JacobianBlock& jb : lin_.blocks)
+      if (jb.H.rows() != 1 || jb.H.cols() != partOf(jb.id).dim)
+        throw std::logic_error("EKF update: Jacobian block of " + std::to_string(jb.id) + " has wrong size");
+    return true;
+  }
+
+  /// Stacks Σ_PP: blocks Σ_ii and Σ_ij = S_ij S_jiᵀ (identity factors are not multiplied).
+  void stackCovariance() {
+    P_.resize(n_, n_);
+    InstMat A, B;
+    for (int a = 0; a < np_; ++a) {
+      const Part& pa = pp_[static_cast<size_t>(a)];
+      const InstanceBelief& ba = *fc_.inst_[static_cast<size_t>(pa.k)];
+      P_.block(pa.off, pa.off, pa.dim, pa.dim) = ba.Sigma;
+      for (int c = a + 1; c < np_; ++c) {
+        const Part& pc = pp_[static_cast<size_t>(c)];
+        const InstanceBelief& bc = *fc_.inst_[static_cast<size_t>(pc.k)];
+        auto C = P_.block(pa.off, pc.off, pa.dim, pc.dim);
+        const FactorEntry* eac = ba.factors->find(bc.id);
+        if (!eac) {
+          C.setZero();
+        } else {
+          const FactorEntry* eca = bc.factors->find(ba.id);
+          if (!eca)
+            throw std::logic_error("FactorizedCovariance: factor of pair (" + std::to_string(ba.id) + ", " +
+                                   std::to_string(bc.id) + ") present on one side only");
+          const bool fa = trueFactorInto(ba, *eac, A), fc = trueFactorInto(bc, *eca, B);
+          if (fa && fc)
+            C.noalias() = A * B.transpose();
+          else if (fa)
+            C = A;
+          else if (fc)
+            C = B.transpose();
+          else
+            C.setIdentity();
+        }
+        P_.block(pc.off, pa.off, pc.dim, pa.dim) = C.transpose();
+      }
+    }
+  }
+
+  /// Scalar EKF update (the arithmetic of denseEkfUpdate with m = 1): u = Σ_PP hᵀ, s = h u + R,
+  /// NIS = r² / s, K = u / s, Joseph form P ← P − K uᵀ − u Kᵀ + K s Kᵀ (or P ← P − K uᵀ),
+  /// symmetrized. Fills `res`; false when the measurement is gated (or its NIS is not finite).
+  bool ekfUpdate(double nis_gate, bool joseph, FactorizedCovariance::Result* res) {
+    U_ = StackVec::Zero(n_);
+    for (const JacobianBlock& jb : lin_.blocks) {
+      const Part& p = partOf(jb.id);
+      U_.noalias() += P_.middleCols(p.off, p.dim) * jb.H.transpose();
+    }
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 1, 1> S = lin_.R;
+    for (const JacobianBlock& jb : lin_.blocks) {
+      const Part& p = partOf(jb.id);
+      S.noalias() += jb.H * U_.middleRows(p.off, p.dim);
+    }
+    s_ = S(0, 0);
+    invertible_ = std::abs(s_) > std::numeric_limits<double>::min();  // LDLT's pseudo-inverse
+    const double r = lin_.residual(0);
+    res->nis = r * (invertible_ ? r / s_ : 0.0);
+    if (!std::isfinite(res->nis) || (nis_gate > 0.0 && res->nis > nis_gate)) return false;
+    K_.resize(n_);
+    for (int i = 0; i < n_; ++i) K_(i) = invertible_ ? U_(i) / s_ : 0.0;
+    if (joseph) {
+      for (int j = 0; j < n_; ++j)
+        for (int i = 0; i < n_; ++i)
+          P_(i, j) = P_(i, j) + ((-(K_(i) * U_(j)) - K_(j) * U_(i)) + (K_(i) * s_) * K_(j));
+    } else {
+      for (int j = 0; j < n_; ++j)
+        for (int i = 0; i < n_; ++i) P_(i, j) -= K_(i) * U_(j);
+    }
+    for (int j = 0; j < n_; ++j)
+      for (int i = j + 1; i < n_; ++i) P_(i, j) = P_(j, i) = 0.5 * (P_(i, j) + P_(j, i));
+    res->accepted = true;
+    res->dx.resize(n_);
+    for (int i = 0; i < n_; ++i) res->dx(i) = K_(i) * r;
+    res->blocks.resize(static_cast<size_t>(np_));
+    for (int a = 0; a < np_; ++a) {
+      const Part& p = pp_[static_cast<size_t>(a)];
+      res->blocks[static_cast<size_t>(a)] =
+          StateBlock{p.id, fc_.layout_.blocks()[static_cast<size_t>(p.k)].kind, p.off, p.dim};
+    }
+    return true;
+  }
+
+  /// The DAH write-back of an accepted update.
+  void writeBack(Timestamp t) {
+    if (np_ == 1) {
+      writeBackPrivate(t);
+      return;
+    }
+    foldJointCorrections(t);
+    invertPendingFactors();
+    setPairFactors();
+  }
+
+ private:
   struct Part {
     int k = 0, off = 0, dim = 0;
     SensorId id = 0;
   };
-  std::array<int, kMaxParticipants> ks{};
-  int np = 0;
-  for (const JacobianBlock& jb : lin.blocks) {
-    if (!has(jb.id)) throw std::logic_error("FactorizedCovariance::update: no instance " + std::to_string(jb.id));
-    ks[static_cast<size_t>(np++)] = index(jb.id);
-  }
-  std::sort(ks.begin(), ks.begin() + np);
-  np = static_cast<int>(std::unique(ks.begin(), ks.begin() + np) - ks.begin());
-  std::array<Part, kMaxParticipants> pp;
-  int n = 0;
-  for (int a = 0; a < np; ++a) {
-    const StateBlock& b = layout_.blocks()[static_cast<size_t>(ks[static_cast<size_t>(a)])];
-    if (b.dim > kMaxInstanceDim) return false;
-    pp[static_cast<size_t>(a)] = Part{ks[static_cast<size_t>(a)], n, b.dim, b.id};
-    n += b.dim;
-  }
-  if (n > kMaxStackedDim) return false;
-  auto partOf = [&](SensorId id) -> const Part* {
-    for (int a = 0; a < np; ++a)
-      if (pp[static_cast<size_t>(a)].id == id) return &pp[static_cast<size_t>(a)];
-    return nullptr;
-  };
-  for (const JacobianBlock& jb : lin.blocks)
-    if (jb.H.rows() != 1 || jb.H.cols() != partOf(jb.id)->dim)
-      throw std::logic_error("EKF update: Jacobian block of " + std::to_string(jb.id) + " has wrong size");
-
-  // Stack Σ_PP: blocks Σ_ii and Σ_ij = S_ij S_jiᵀ (identity factors are not multiplied).
-  StackMat P(n, n);
-  InstMat A, B;
-  for (int a = 0; a < np; ++a) {
-    const Part& pa = pp[static_cast<size_t>(a)];
-    const InstanceBelief& ba = *inst_[static_cast<size_t>(pa.k)];
-    P.block(pa.off, pa.off, pa.dim, pa.dim) = ba.Sigma;
-    for (int c = a + 1; c < np; ++c) {
-      const Part& pc = pp[static_cast<size_t>(c)];
-      const InstanceBelief& bc = *inst_[static_cast<size_t>(pc.k)];
-      auto C = P.block(pa.off, pc.off, pa.dim, pc.dim);
-      const FactorEntry* eac = ba.factors->find(bc.id);
-      if (!eac) {
-        C.setZero();
-      } else {
-        const FactorEntry* eca = bc.factors->find(ba.id);
-        if (!eca)
-          throw std::logic_error("FactorizedCovariance: factor of pair (" + std::to_string(ba.id) + ", " +
-                                 std::to_string(bc.id) + ") present on one side only");
-        const bool fa = trueFactorInto(ba, *eac, A), fc = trueFactorInto(bc, *eca, B);
-        if (fa && fc)
-          C.noalias() = A * B.transpose();
-        else if (fa)
-          C = A;
-        else if (fc)
-          C = B.transpose();
-        else
-          C.setIdentity();
-      }
-      P.block(pc.off, pa.off, pc.dim, pa.dim) = C.transpose();
-    }
+  const Part& partOf(SensorId id) const {
+    for (int a = 0; a < np_; ++a)
+      if (pp_[static_cast<size_t>(a)].id == id) return pp_[static_cast<size_t>(a)];
+    throw std::logic_error("DahScalarUpdate: no participant " + std::to_string(id));
   }
 
-  // Scalar EKF update (the arithmetic of denseEkfUpdate with m = 1): u = Σ_PP hᵀ, s = h u + R,
-  // NIS = r² / s, K = u / s, Joseph form P ← P − K uᵀ − u Kᵀ + K s Kᵀ (or P ← P − K uᵀ), symmetrized.
-  StackVec U = StackVec::Zero(n);
-  for (const JacobianBlock& jb : lin.blocks) {
-    const Part& p = *partOf(jb.id);
-    U.noalias() += P.middleCols(p.off, p.dim) * jb.H.transpose();
-  }
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 1, 1> S = lin.R;
-  for (const JacobianBlock& jb : lin.blocks) {
-    const Part& p = *partOf(jb.id);
-    S.noalias() += jb.H * U.middleRows(p.off, p.dim);
-  }
-  const double s = S(0, 0);
-  const bool invertible = std::abs(s) > std::numeric_limits<double>::min();  // LDLT's pseudo-inverse
-  const double r = lin.residual(0);
-  res->nis = r * (invertible ? r / s : 0.0);
-  if (!std::isfinite(res->nis) || (nis_gate > 0.0 && res->nis > nis_gate)) return true;
-  StackVec K(n);
-  for (int i = 0; i < n; ++i) K(i) = invertible ? U(i) / s : 0.0;
-  if (joseph_) {
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        P(i, j) = P(i, j) + ((-(K(i) * U(j)) - K(j) * U(i)) + (K(i) * s) * K(j));
-  } else {
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) P(i, j) -= K(i) * U(j);
-  }
-  for (int j = 0; j < n; ++j)
-    for (int i = j + 1; i < n; ++i) P(i, j) = P(j, i) = 0.5 * (P(i, j) + P(j, i));
-  res->accepted = true;
-  res->dx.resize(n);
-  for (int i = 0; i < n; ++i) res->dx(i) = K(i) * r;
-  res->blocks.resize(static_cast<size_t>(np));
-  for (int a = 0; a < np; ++a) {
-    const Part& p = pp[static_cast<size_t>(a)];
-    res->blocks[static_cast<size_t>(a)] = StateBlock{p.id, layout_.blocks()[static_cast<size_t>(p.k)].kind, p.off, p.dim};
-  }
-
-  // 1. Σ_ii' and the pending factors.
-  if (np == 1) {
-    // Private update: Σ_ik' = (I − K h_i) Σ_ik exactly: L_i ← (I − K h_i) L_i = L_i − K (h_i L_i).
-    const Part& p = pp[0];
-    const JacobianBlock& jb = *lin.find(p.id);
-    InstanceBelief& b = mut(p.k);
+  /// Private update: Σ_ik' = (I − K h_i) Σ_ik exactly: L_i ← (I − K h_i) L_i = L_i − K (h_i L_i).
+  void writeBackPrivate(Timestamp t) {
+    const Part& p = pp_[0];
+    const JacobianBlock& jb = *lin_.find(p.id);
+    InstanceBelief& b = fc_.mut(p.k);
     if (!b.L.size()) {
       b.L.resize(p.dim, p.dim);
       for (int j = 0; j < p.dim; ++j)
-        for (int i = 0; i < p.dim; ++i) b.L(i, j) = (i == j ? 1.0 : 0.0) - K(i) * jb.H(0, j);
+        for (int i = 0; i < p.dim; ++i) b.L(i, j) = (i == j ? 1.0 : 0.0) - K_(i) * jb.H(0, j);
     } else if (p.dim == ImuErr::kDim) {
       using M15 = Eigen::Matrix<double, ImuErr::kDim, ImuErr::kDim>;
       Eigen::Map<M15> L(b.L.data());
-      const Eigen::Matrix<double, 1, ImuErr::kDim> hL = Eigen::Map<const Eigen::Matrix<double, 1, ImuErr::kDim>>(jb.H.data()) * L;
-      L.noalias() -= Eigen::Map<const Eigen::Matrix<double, ImuErr::kDim, 1>>(K.data()) * hL;
+      const Eigen::Matrix<double, 1, ImuErr::kDim> hL =
+          Eigen::Map<const Eigen::Matrix<double, 1, ImuErr::kDim>>(jb.H.data()) * L;
+      L.noalias() -= Eigen::Map<const Eigen::Matrix<double, ImuErr::kDim, 1>>(K_.data()) * hL;
     } else {
       const Eigen::RowVectorXd hL = jb.H * b.L;
-      b.L.noalias() -= K.head(p.dim) * hL;
+      b.L.noalias() -= K_.head(p.dim) * hL;
     }
-    b.Sigma = P;
+    b.Sigma = P_;
     b.t = t;
-    if (++b.lazy_steps > kMaxLazySteps) renormalize(p.id);
-    return true;
+    if (++b.lazy_steps > FactorizedCovariance::kMaxLazySteps) fc_.renormalize(p.id);
   }
-  for (int a = 0; a < np; ++a) {
-    const Part& p = pp[static_cast<size_t>(a)];
-    InstanceBelief& b = mut(p.k);
-    if (invertible) {  // else K = 0: nothing changed
-      const auto u = U.segment(p.off, p.dim);
-      if (p.dim == ImuErr::kDim)
-        foldDahCorrection<ImuErr::kDim>(b, u, s);
-      else if (p.dim == 3)
-        foldDahCorrection<3>(b, u, s);
-      else
-        foldDahCorrection<Eigen::Dynamic>(b, u, s);
-    }
-    b.Sigma = P.block(p.off, p.off, p.dim, p.dim);
-    b.t = t;
-    ++b.lazy_steps;
-  }
-  // 2. L_i'⁻¹ of the participants (re-normalize when L_i' is badly conditioned or old).
-  std::array<InstMat, kMaxParticipants> Linv;
-  std::array<bool, kMaxParticipants> has_inv{};
-  for (int a = 0; a < np; ++a) {
-    const Part& p = pp[static_cast<size_t>(a)];
-    const InstanceBelief& b = *inst_[static_cast<size_t>(p.k)];
-    if (b.L.size() == 0) continue;
-    const bool ok = p.dim == ImuErr::kDim ? invertPending<ImuErr::kDim>(b, kMaxLazySteps, kMaxLazyCondition, Linv[a])
-                    : p.dim == 3          ? invertPending<3>(b, kMaxLazySteps, kMaxLazyCondition, Linv[a])
-                                          : invertPending<Eigen::Dynamic>(b, kMaxLazySteps, kMaxLazyCondition, Linv[a]);
-    if (ok)
-      has_inv[static_cast<size_t>(a)] = true;
-    else
-      renormalize(p.id);
-  }
-  // 3. Pair factors within P: smaller id S̄_ij = L_i'⁻¹ Σ_ij', larger id S̄_ji = L_j'⁻¹ (S_ji = I).
-  for (int a = 0; a < np; ++a) {
-    for (int c = a + 1; c < np; ++c) {
-      const bool a_small = pp[static_cast<size_t>(a)].id < pp[static_cast<size_t>(c)].id;
-      const size_t si = static_cast<size_t>(a_small ? a : c), li = static_cast<size_t>(a_small ? c : a);
-      const Part &ps = pp[si], &pl = pp[li];
-      const auto C = P.block(ps.off, pl.off, ps.dim, pl.dim);
-      MatrixXd S_bar(ps.dim, pl.dim);
-      if (!has_inv[si]) {
-        S_bar = C;
-      } else if (ps.dim == ImuErr::kDim && pl.dim == 3) {
-        using M15 = Eigen::Matrix<double, ImuErr::kDim, ImuErr::kDim>;
-        using M15x3 = Eigen::Matrix<double, ImuErr::kDim, 3>;
-        Eigen::Map<M15x3>(S_bar.data()).noalias() = Eigen::Map<const M15>(Linv[si].data()).lazyProduct(M15x3(C));
-      } else {
-        S_bar.noalias() = Linv[si] * C;
+
+  /// 1. Σ_ii' and the pending factors of a joint update (foldDahCorrection).
+  void foldJointCorrections(Timestamp t) {
+    for (int a = 0; a < np_; ++a) {
+      const Part& p = pp_[static_cast<size_t>(a)];
+      InstanceBelief& b = fc_.mut(p.k);
+      if (invertible_) {  // else K = 0: nothing changed
+        const auto u = U_.segment(p.off, p.dim);
+        if (p.dim == ImuErr::kDim)
+          foldDahCorrection<ImuErr::kDim>(b, u, s_);
+        else if (p.dim == 3)
+          foldDahCorrection<3>(b, u, s_);
+        else
+          foldDahCorrection<Eigen::Dynamic>(b, u, s_);
       }
-      mutDict(mut(ps.k)).set(pl.id, shared(std::move(S_bar)));
-      mutDict(mut(pl.k)).set(ps.id, has_inv[li] ? shared(MatrixXd(Linv[li])) : nullptr);
+      b.Sigma = P_.block(p.off, p.off, p.dim, p.dim);
+      b.t = t;
+      ++b.lazy_steps;
     }
   }
+
+  /// 2. L_i'⁻¹ of the participants (re-normalize when L_i' is badly conditioned or old).
+  void invertPendingFactors() {
+    constexpr int kSteps = FactorizedCovariance::kMaxLazySteps;
+    constexpr double kCond = FactorizedCovariance::kMaxLazyCondition;
+    for (int a = 0; a < np_; ++a) {
+      const Part& p = pp_[static_cast<size_t>(a)];
+      const InstanceBelief& b = *fc_.inst_[static_cast<size_t>(p.k)];
+      if (b.L.size() == 0) continue;
+      const bool ok = p.dim == ImuErr::kDim ? invertPending<ImuErr::kDim>(b, kSteps, kCond, Linv_[a])
+                      : p.dim == 3          ? invertPending<3>(b, kSteps, kCond, Linv_[a])
+                                            : invertPending<Eigen::Dynamic>(b, kSteps, kCond, Linv_[a]);
+      if (ok)
+        has_inv_[static_cast<size_t>(a)] = true;
+      else
+        fc_.renormalize(p.id);
+    }
+  }
+
+  /// 3. Pair factors within P: smaller id S̄_ij = L_i'⁻¹ Σ_ij', larger id S̄_ji = L_j'⁻¹ (S_ji = I).
+  void setPairFactors() {
+    for (int a = 0; a < np_; ++a) {
+      for (int c = a + 1; c < np_; ++c) {
+        const bool a_small = pp_[static_cast<size_t>(a)].id < pp_[static_cast<size_t>(c)].id;
+        const size_t si = static_cast<size_t>(a_small ? a : c), li = static_cast<size_t>(a_small ? c : a);
+        const Part &ps = pp_[si], &pl = pp_[li];
+        const auto C = P_.block(ps.off, pl.off, ps.dim, pl.dim);
+        MatrixXd S_bar(ps.dim, pl.dim);
+        if (!has_inv_[si]) {
+          S_bar = C;
+        } else if (ps.dim == ImuErr::kDim && pl.dim == 3) {
+          using M15 = Eigen::Matrix<double, ImuErr::kDim, ImuErr::kDim>;
+          using M15x3 = Eigen::Matrix<double, ImuErr::kDim, 3>;
+          Eigen::Map<M15x3>(S_bar.data()).noalias() = Eigen::Map<const M15>(Linv_[si].data()).lazyProduct(M15x3(C));
+        } else {
+          S_bar.noalias() = Linv_[si] * C;
+        }
+        FactorizedCovariance::mutDict(fc_.mut(ps.k)).set(pl.id, shared(std::move(S_bar)));
+        FactorizedCovariance::mutDict(fc_.mut(pl.k)).set(ps.id, has_inv_[li] ? shared(MatrixXd(Linv_[li])) : nullptr);
+      }
+    }
+  }
+
+  FactorizedCovariance& fc_;
+  const Linearization& lin_;
+  std::array<Part, kMaxParticipants> pp_;
+  int np_ = 0;  ///< participants
+  int n_ = 0;   ///< stacked dimension
+  StackMat P_;  ///< Σ_PP, updated in place
+  StackVec U_, K_;
+  double s_ = 0.0;
+  bool invertible_ = false;
+  std::array<InstMat, kMaxParticipants> Linv_;
+  std::array<bool, kMaxParticipants> has_inv_{};
+};
+
+bool FactorizedCovariance::updateDahScalar(const Linearization& lin, double nis_gate, Timestamp t, Result* res) {
+  DahScalarUpdate u(*this, lin);
+  if (!u.selectParticipants()) return false;
+  u.stackCovariance();
+  if (u.ekfUpdate(nis_gate, joseph_, res)) u.writeBack(t);
   return true;
 }
 

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <iterator>
 #include <tuple>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -20,7 +21,20 @@ namespace meshnav::estimator {
 using EstimatorInput =
     std::variant<FlightStateSample, ImuSample, BaroSample, RangeSample, AnchorInit, EstimatorCommand, HeightSample>;
 
-/// Sort key of an input (time, kind = variant index, ids).
+/// The canonical order of the kinds at equal time (`rank`) and each kind's channel name (counter
+/// prefix: "RANGE:duplicate", "IMU:time_ahead"). An explicit table, not the variant's index: adding
+/// or moving an alternative of EstimatorInput changes no order (test_estimator_input.cpp).
+template <class T>
+struct InputKind;
+template <> struct InputKind<FlightStateSample> { static constexpr int rank = 0; static constexpr const char* name = "FLIGHT_STATE"; };
+template <> struct InputKind<ImuSample> { static constexpr int rank = 1; static constexpr const char* name = "IMU"; };
+template <> struct InputKind<BaroSample> { static constexpr int rank = 2; static constexpr const char* name = "BARO"; };
+template <> struct InputKind<RangeSample> { static constexpr int rank = 3; static constexpr const char* name = "RANGE"; };
+template <> struct InputKind<AnchorInit> { static constexpr int rank = 4; static constexpr const char* name = "ANCHOR_INIT"; };
+template <> struct InputKind<EstimatorCommand> { static constexpr int rank = 5; static constexpr const char* name = "ESTIMATOR_CMD"; };
+template <> struct InputKind<HeightSample> { static constexpr int rank = 6; static constexpr const char* name = "HEIGHT"; };
+
+/// Sort key of an input (time, kind = InputKind rank, ids).
 struct InputOrder {
   int64_t t_us = 0;
   int kind = 0;
@@ -33,17 +47,20 @@ inline Timestamp inputTime(const EstimatorInput& in) {
   return std::visit([](const auto& m) { return m.t; }, in);
 }
 
-/// Kind of an input as its channel name (counter prefix: "RANGE:duplicate", "IMU:time_ahead").
+/// Kind of an input as its channel name (InputKind::name).
 inline const char* inputKindName(const EstimatorInput& in) {
-  static const char* const kNames[] = {"FLIGHT_STATE", "IMU", "BARO", "RANGE", "ANCHOR_INIT", "ESTIMATOR_CMD", "HEIGHT"};
-  static_assert(std::variant_size_v<EstimatorInput> == std::size(kNames));
-  return kNames[in.index()];
+  return std::visit([](const auto& m) { return InputKind<std::decay_t<decltype(m)>>::name; }, in);
+}
+
+/// Rank of an input's kind in the canonical order (InputKind::rank).
+inline int inputKindRank(const EstimatorInput& in) {
+  return std::visit([](const auto& m) { return InputKind<std::decay_t<decltype(m)>>::rank; }, in);
 }
 
 inline InputOrder inputOrder(const EstimatorInput& in) {
   InputOrder o;
   o.t_us = inputTime(in).us;
-  o.kind = static_cast<int>(in.index());
+  o.kind = inputKindRank(in);
   if (const auto* r = std::get_if<RangeSample>(&in)) {
     o.a = r->id_initiator;
     o.b = r->id_responder;

@@ -28,6 +28,30 @@ constexpr double kDeg = M_PI / 180.0;
 
 Eigen::Matrix3d rotZ(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
 
+/// Two end states are different answers: > 0.5 m apart or > 15° apart in yaw.
+bool distinctPoses(const ImuState& a, const ImuState& b) {
+  const double dyaw = std::remainder(so3::yawOf(a.q_ItoG) - so3::yawOf(b.q_ItoG), 2 * M_PI);
+  return (a.p_IinG - b.p_IinG).norm() > 0.5 || std::abs(dyaw) > 15.0 * kDeg;
+}
+
+/// The order in which the rivals of the best candidate (cands[0], sorted by cost) are refitted:
+/// first the best of those elsewhere (> 0.5 m from `p_best`: a mirror image across nearly coplanar
+/// anchors), then by first-pass cost. The first-pass order includes the outliers, so the closest
+/// rival need not come first, and a handful of heading variants at the same place must not crowd
+/// out the mirror image (a walk under three anchors was initialized 1.15 m below the truth that way).
+template <class Candidate>
+std::vector<size_t> rivalOrder(const std::vector<Candidate>& cands, const Eigen::Vector3d& p_best) {
+  std::vector<size_t> order;
+  for (size_t k = 1; k < cands.size(); ++k)
+    if ((cands[k].end.p_IinG - p_best).norm() > 0.5) {
+      order.push_back(k);
+      break;
+    }
+  for (size_t k = 1; k < cands.size(); ++k)
+    if (order.empty() || order.front() != k) order.push_back(k);
+  return order;
+}
+
 }  // namespace
 
 double MotionAligner::fit(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights, Unknowns& x,
@@ -206,55 +230,34 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
     return std::nullopt;
   }
   std::sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
-  auto distinct = [&](const ImuState& a, const ImuState& b) {
-    const double dyaw = std::remainder(so3::yawOf(a.q_ItoG) - so3::yawOf(b.q_ItoG), 2 * M_PI);
-    return (a.p_IinG - b.p_IinG).norm() > 0.5 || std::abs(dyaw) > 15.0 * kDeg;
-  };
   // Outliers by the best candidate, then refit the best and the best distinct rival on the inliers.
   Unknowns best = cands.front().x;
-  int n_used = 0;
-  for (Obs& o : obs) {
-    o.use = std::abs(residual(o, best)) <= std::max(options_.outlier_m, 4.0 * o.r.sigma_m);
-    n_used += o.use;
-  }
+  for (Obs& o : obs) o.use = std::abs(residual(o, best)) <= std::max(options_.outlier_m, 4.0 * o.r.sigma_m);
   for (HeightObs& o : heights) o.use = std::abs(residual(o, best)) <= std::max(0.3, 4.0 * o.h.sigma_m);
   MatU info;
   const double best_cost = fit(obs, heights, best, &info);
   const ImuState best_end = endState(best, end, bias_gyro_rad_s);
-  // Distinct rivals are refitted on the same inliers: first the best of those elsewhere (> 0.5 m
-  // away: a mirror image across nearly coplanar anchors), then by first-pass cost, up to 6 in all.
-  // The first-pass order includes the outliers, so the closest rival need not come first, and a
-  // handful of heading variants at the same place must not crowd out the mirror image (a walk
-  // under three anchors was initialized 1.15 m below the truth that way).
+  // Distinct rivals are refitted on the same inliers, in rivalOrder, up to 6 in all.
   // Costs are compared in units of the residuals' own scatter: ranges that fit worse than their σ
   // (unmodelled drift over the window, heavier noise) make a cost difference mean less.
   const double margin = options_.ambiguity_chi2 * robustVarianceFactor(obs, best);
-  std::vector<size_t> order;
-  for (size_t k = 1; k < cands.size(); ++k)
-    if ((cands[k].end.p_IinG - best_end.p_IinG).norm() > 0.5) {
-      order.push_back(k);
-      break;
-    }
-  for (size_t k = 1; k < cands.size(); ++k)
-    if (order.empty() || order.front() != k) order.push_back(k);
   std::vector<ImuState> checked;
-  for (const size_t k : order) {
+  for (const size_t k : rivalOrder(cands, best_end.p_IinG)) {
     if (checked.size() >= 6) break;
-    if (!distinct(cands[k].end, best_end)) continue;
-    if (std::any_of(checked.begin(), checked.end(), [&](const ImuState& c) { return !distinct(cands[k].end, c); }))
+    if (!distinctPoses(cands[k].end, best_end)) continue;
+    if (std::any_of(checked.begin(), checked.end(), [&](const ImuState& c) { return !distinctPoses(cands[k].end, c); }))
       continue;
     checked.push_back(cands[k].end);
     Unknowns rival = cands[k].x;
     const double c = fit(obs, heights, rival, nullptr);
     const ImuState rival_end = endState(rival, end, bias_gyro_rad_s);
-    if (c - best_cost < margin && distinct(rival_end, best_end)) {
+    if (c - best_cost < margin && distinctPoses(rival_end, best_end)) {
       reason_ = "motion alignment: ambiguous (two poses " + std::to_string((rival_end.p_IinG - best_end.p_IinG).norm()) +
                 " m apart fit the ranges within " + std::to_string(c - best_cost) +
                 "): anchor geometry or motion cannot fix the pose yet";
       return std::nullopt;
     }
   }
-  (void)n_used;
   return finish(obs, heights, best, info, end, bias_gyro_rad_s);
 }
 

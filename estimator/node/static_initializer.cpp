@@ -15,6 +15,28 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 
 Eigen::Matrix3d rotZ(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+
+/// A local minimum of the static range fit from one start.
+struct FitMinimum {
+  double cost;
+  Eigen::Vector3d p;
+  double yaw;
+};
+
+/// Why the fit is ambiguous ("" when it is not): a second minimum within `chi2` of the best cost
+/// elsewhere (nearly coplanar anchors mirror the position) or at another heading (lever arms too
+/// short for the range noise). Refused rather than one picked.
+std::string ambiguityOf(const std::vector<FitMinimum>& minima, const FitMinimum& best, double chi2) {
+  for (const FitMinimum& m : minima) {
+    if (m.cost - best.cost >= chi2) continue;
+    if ((m.p - best.p).norm() > 0.5)
+      return "motion: two positions " + std::to_string((m.p - best.p).norm()) +
+             " m apart fit the landed ranges alike (known anchors nearly coplanar?)";
+    const double dyaw = std::abs(std::remainder(m.yaw - best.yaw, 2.0 * M_PI));
+    if (dyaw > 30.0 * kDeg) return "motion: two headings " + std::to_string(dyaw / kDeg) + " deg apart fit the ranges alike";
+  }
+  return "";
+}
 }  // namespace
 
 StaticInitializer::StaticInitializer(const EstimatorOptions& options, const SystemSetup& setup)
@@ -240,78 +262,53 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
   centroid /= static_cast<double>(anchors.size());
 
   std::vector<bool> use(ranges_.size(), true);
-  auto solve = [&](Eigen::Vector3d& p, double& yaw, Eigen::Matrix4d* cov) {
-    return solveFit(R_rp, use, p, yaw, cov);
-  };
-
-  double best_cost = std::numeric_limits<double>::infinity();
-  Eigen::Vector3d best_p = centroid;
-  double best_yaw = 0.0;
-  struct Minimum {
-    double cost;
-    Eigen::Vector3d p;
-    double yaw;
-  };
-  std::vector<Minimum> minima;
   // Starts near the floor (a landed pad) and 1.5 m below and above the anchors' mean height (a
   // body at rest in the air): anchors in a narrow height band mirror the height, and only a start
-  // on each side lets the ambiguity check below see both (a start at the mean height itself may
-  // slide to either side: a body above three anchors at one height was fitted at its mirror image
-  // without refusal, StaticInitializer.CoplanarAnchors…).
+  // on each side lets the ambiguity check see both (a start at the mean height itself may slide to
+  // either side: a body above three anchors at one height was fitted at its mirror image without
+  // refusal, StaticInitializer.CoplanarAnchors…).
   std::vector<double> z_starts{0.5, centroid.z() - 1.5, centroid.z() + 1.5};
   if (height_prior_) z_starts.push_back(height_prior_->z_m);
+  std::vector<FitMinimum> minima;
   for (const double z0 : z_starts)
-  for (int sx = -1; sx <= 1; ++sx)
-    for (int sy = -1; sy <= 1; ++sy)
-      for (int k = 0; k < 4; ++k) {
-        Eigen::Vector3d p = centroid + Eigen::Vector3d(2.0 * sx, 2.0 * sy, 0.0);
-        p.z() = z0;
-        double yaw = k * 0.5 * M_PI;
-        const double c = solve(p, yaw, nullptr);
-        if (!std::isfinite(c)) continue;
-        minima.push_back({c, p, yaw});
-        if (c < best_cost) {
-          best_cost = c;
-          best_p = p;
-          best_yaw = yaw;
+    for (int sx = -1; sx <= 1; ++sx)
+      for (int sy = -1; sy <= 1; ++sy)
+        for (int k = 0; k < 4; ++k) {
+          Eigen::Vector3d p = centroid + Eigen::Vector3d(2.0 * sx, 2.0 * sy, 0.0);
+          p.z() = z0;
+          double yaw = k * 0.5 * M_PI;
+          const double c = solveFit(R_rp, use, p, yaw, nullptr);
+          if (std::isfinite(c)) minima.push_back({c, p, yaw});
         }
-      }
-  if (!std::isfinite(best_cost)) return false;
-  // A second minimum elsewhere that fits about as well: the anchors cannot fix the position
-  // (nearly coplanar anchors mirror it). Refuse rather than pick one.
-  for (const Minimum& m : minima) {
-    if (m.cost - best_cost >= options_.init.ambiguity_chi2) continue;
-    if ((m.p - best_p).norm() > 0.5) {
-      waiting_for_ = "motion: two positions " + std::to_string((m.p - best_p).norm()) +
-                     " m apart fit the landed ranges alike (known anchors nearly coplanar?)";
-      return false;
-    }
-    const double dyaw = std::abs(std::remainder(m.yaw - best_yaw, 2.0 * M_PI));
-    if (dyaw > 30.0 * kDeg) {  // tags' lever arms too short for the range noise
-      waiting_for_ = "motion: two headings " + std::to_string(dyaw / kDeg) + " deg apart fit the ranges alike";
-      return false;
-    }
-  }
+  if (minima.empty()) return false;
+  const FitMinimum best = *std::min_element(minima.begin(), minima.end(),
+                                            [](const FitMinimum& x, const FitMinimum& y) { return x.cost < y.cost; });
+  waiting_for_ = ambiguityOf(minima, best, options_.init.ambiguity_chi2);
+  if (!waiting_for_.empty()) return false;
+  Eigen::Vector3d best_p = best.p;
+  double best_yaw = best.yaw;
+  // Range residual of range i at pose (R, p).
+  auto residual = [&](size_t i, const Eigen::Matrix3d& R, const Eigen::Vector3d& p) {
+    const InitRange& r = ranges_[i];
+    return r.d_m - (setup_.abs_anchor_positions.at(r.anchor) - p - R * setup_.rel_tag_positions.at(r.tag)).norm();
+  };
   // Drop outliers and refine.
   const Eigen::Matrix3d R = rotZ(best_yaw) * R_rp;
   n_used = 0;
   for (size_t i = 0; i < ranges_.size(); ++i) {
-    const InitRange& r = ranges_[i];
-    const double d = (setup_.abs_anchor_positions.at(r.anchor) - best_p - R * setup_.rel_tag_positions.at(r.tag)).norm();
-    use[i] = std::abs(r.d_m - d) <= options_.init.range_init_outlier_m;
+    use[i] = std::abs(residual(i, R, best_p)) <= options_.init.range_init_outlier_m;
     n_used += use[i] ? 1 : 0;
   }
   if (n_used < 4) return false;
-  solve(best_p, best_yaw, &cov_out);
+  solveFit(R_rp, use, best_p, best_yaw, &cov_out);
   double sq = 0.0;
   std::vector<double> abs_e;
   const Eigen::Matrix3d R2 = rotZ(best_yaw) * R_rp;
   for (size_t i = 0; i < ranges_.size(); ++i) {
     if (!use[i]) continue;
-    const InitRange& r = ranges_[i];
-    const double d = (setup_.abs_anchor_positions.at(r.anchor) - best_p - R2 * setup_.rel_tag_positions.at(r.tag)).norm();
-    sq += (r.d_m - d) * (r.d_m - d);
-    abs_e.push_back(std::abs(r.d_m - d) / r.sigma_m);
+    const double e = residual(i, R2, best_p);
+    sq += e * e;
+    abs_e.push_back(std::abs(e) / ranges_[i].sigma_m);
   }
   cov_out *= huber::varianceFactor(std::move(abs_e));  // ranges noisier than their σ
   rms_out = std::sqrt(sq / n_used);

@@ -15,102 +15,150 @@
 #include "transport/process_main.h"
 #include "transport/time_sync.h"
 
+namespace {
+
+using namespace meshnav;
+
+/// The process's own options (--lcm-url, --log-level come from transport::ProcessMain).
+struct EstimatorProcessOptions {
+  std::string setup_path, config_path, strategy, state_dir;
+  double heartbeat_s = 1.0, state_period_s = 0.5;
+  bool print_config = false;
+};
+
+void declareOptions(Cli& cli, EstimatorProcessOptions& o) {
+  cli.optional("setup", o.setup_path, "system setup (setup.yaml: tags, known anchors, pair biases, baro); required")
+      ->type_name("FILE");
+  cli.optional("config", o.config_path, "estimator options YAML (default: built-in = config/estimator.yaml)")
+      ->type_name("FILE");
+  cli.optional("strategy", o.strategy, "override the fusion strategy of --config")
+      ->check(cli::oneOf(estimator::strategyImplemented, "centralized|dp|dah"));
+  cli.option("heartbeat", o.heartbeat_s, "wall seconds between heartbeat statuses")->type_name("S")->check(cli::positive());
+  cli.flag("print-config", o.print_config, "print the estimator options and exit");
+  cli.optional("state-dir", o.state_dir, "folder of the restart checkpoint: written while running, resumed from at start")
+      ->type_name("DIR");
+  cli.option("state-period", o.state_period_s, "data seconds between two checkpoints")->type_name("S")->check(cli::positive());
+}
+
+/// The EstimatorNode wired to LCM, with its checkpoint in --state-dir.
+class EstimatorProcess {
+ public:
+  EstimatorProcess(transport::ProcessMain& process, const EstimatorProcessOptions& o,
+                   const estimator::EstimatorOptions& options, const SystemSetup& setup)
+      : process_(process), lcm_(process.lcm()), o_(o), node_(options, setup, sinks()) {
+    ready_ = true;
+  }
+
+  /// With --state-dir: resumes from the checkpoint found there (a bad one is reported, not used).
+  void resumeFromCheckpoint() {
+    if (o_.state_dir.empty()) return;
+    try {
+      if (auto c = estimator::readCheckpoint(o_.state_dir)) {
+        spdlog::warn("restart: checkpoint of t = {} s with {} anchors in {}", formatSeconds(c->t), c->anchors.size(),
+                     o_.state_dir);
+        node_.resumeFrom(std::move(*c));
+      }
+    } catch (const std::exception& ex) {
+      spdlog::error("checkpoint in {} not used: {}", o_.state_dir, ex.what());
+    }
+  }
+
+  /// Subscribes the inputs, serves the time reference and starts the ESTIMATOR_STATUS heartbeat.
+  void connect() {
+    estimator::EstimatorNode& node = node_;
+    lcm_.subscribe(channels::kImu, [&node](const ImuSample& s) { node.onImu(s); });
+    lcm_.subscribe(channels::kBaro, [&node](const BaroSample& s) { node.onBaro(s); });
+    lcm_.subscribe(channels::kHeight, [&node](const HeightSample& s) { node.onHeight(s); });
+    lcm_.subscribe(channels::kRange, [&node](const RangeSample& s) { node.onRange(s); });
+    lcm_.subscribe(channels::kFlightState, [&node](const FlightStateSample& s) { node.onFlightState(s); });
+    lcm_.subscribe(channels::kAnchorInit, [&node](const AnchorInit& a) { node.onAnchorInit(a); });
+    lcm_.subscribe(channels::kEstimatorCmd, [&node](const EstimatorCommand& c) { node.onCommand(c); });
+    // This host's clock is the reference of every stamp the estimator fuses: bridges on other
+    // hosts estimate their offset to it (transport/time_sync.h, docs/deployment.md).
+    transport::serveTimeSync(lcm_);
+    process_.heartbeat(channels::kEstimatorStatus, o_.heartbeat_s, [&node] { return node.status(); },
+                       [this](const EstimatorStatus& st) {
+                         if (!st.initialized || was_initialized_) return;
+                         was_initialized_ = true;
+                         spdlog::info("initialized at t = {} s", formatSeconds(st.t));
+                       });
+  }
+
+  /// After the loop: the final anchors and status, for the recorder.
+  void finish() {
+    if (node_.initialized()) lcm_.publish(channels::kAnchors, node_.anchors());
+    const EstimatorStatus st = process_.stamped(node_.status());
+    lcm_.publish(channels::kEstimatorStatus, st);
+    spdlog::info("stopped at t = {} s ({}); counters: {}", formatSeconds(st.t),
+                 st.initialized ? "initialized" : "never initialized", transport::formatCounters(st.counters));
+  }
+
+  const estimator::EstimatorNode& node() const { return node_; }
+
+ private:
+  estimator::EstimatorSinks sinks() {
+    estimator::EstimatorSinks s;
+    s.pose = [this](const PoseEstimate& e) {
+      lcm_.publish(channels::kPose, e);
+      checkpoint(e.t);
+    };
+    s.anchors = [this](const std::vector<AnchorEstimate>& a) { lcm_.publish(channels::kAnchors, a); };
+    s.status = [this](const EstimatorStatus& st) { lcm_.publish(channels::kEstimatorStatus, process_.stamped(st)); };
+    return s;
+  }
+  /// Writes the checkpoint every --state-period of data time (with --state-dir).
+  void checkpoint(Timestamp t) {
+    if (o_.state_dir.empty() || !ready_ || (last_checkpoint_ && (t - *last_checkpoint_).sec() < o_.state_period_s))
+      return;
+    last_checkpoint_ = t;
+    try {
+      estimator::writeCheckpoint(node_.checkpoint(), o_.state_dir);
+    } catch (const std::exception& ex) {
+      spdlog::error("checkpoint not written: {}", ex.what());
+    }
+  }
+
+  transport::ProcessMain& process_;
+  transport::LcmNode& lcm_;
+  const EstimatorProcessOptions& o_;
+  std::optional<Timestamp> last_checkpoint_;
+  bool was_initialized_ = false;
+  bool ready_ = false;  ///< false while node_ is constructed: no checkpoint from inside its constructor
+  estimator::EstimatorNode node_;
+};
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  using namespace meshnav;
   transport::ProcessMain process(
       "estimator",
       "Subscribes IMU, BARO, RANGE, FLIGHT_STATE, ANCHOR_INIT, ESTIMATOR_CMD; publishes POSE, ANCHORS and "
       "ESTIMATOR_STATUS (also a wall-clock heartbeat). Messages may arrive out of order: the node re-processes "
       "within its window. Malformed messages are counted per channel (\"<CHANNEL>:decode_error\" / "
       "\":invalid_message\") and reported in ESTIMATOR_STATUS.");
-  std::string setup_path, config_path, strategy, state_dir;
-  double heartbeat_s = 1.0, state_period_s = 0.5;
-  bool print_config = false;
-  Cli& cli = process.cli();
-  cli.optional("setup", setup_path, "system setup (setup.yaml: tags, known anchors, pair biases, baro); required")
-      ->type_name("FILE");
-  cli.optional("config", config_path, "estimator options YAML (default: built-in = config/estimator.yaml)")
-      ->type_name("FILE");
-  cli.optional("strategy", strategy, "override the fusion strategy of --config")
-      ->check(cli::oneOf(estimator::strategyImplemented, "centralized|dp|dah"));
-  cli.option("heartbeat", heartbeat_s, "wall seconds between heartbeat statuses")->type_name("S")->check(cli::positive());
-  cli.flag("print-config", print_config, "print the estimator options and exit");
-  cli.optional("state-dir", state_dir, "folder of the restart checkpoint: written while running, resumed from at start")
-      ->type_name("DIR");
-  cli.option("state-period", state_period_s, "data seconds between two checkpoints")->type_name("S")->check(cli::positive());
-
+  EstimatorProcessOptions o;
+  declareOptions(process.cli(), o);
   return process.run(argc, argv, [&] {
     estimator::EstimatorOptions options;
-    if (!config_path.empty()) options = estimator::EstimatorOptions::fromYaml(config_path);
-    if (!strategy.empty()) options.strategy = strategy;
-    if (print_config) {
+    if (!o.config_path.empty()) options = estimator::EstimatorOptions::fromYaml(o.config_path);
+    if (!o.strategy.empty()) options.strategy = o.strategy;
+    if (o.print_config) {
       std::cout << options.toString();
       return 0;
     }
-    if (setup_path.empty()) {
+    if (o.setup_path.empty()) {
       spdlog::error("--setup is required (see --help)");
       return 2;
     }
-    const SystemSetup setup = loadSetup(setup_path);
-    transport::LcmNode& lcm = process.lcm();
-    estimator::EstimatorSinks sinks;
-    estimator::EstimatorNode* node_ptr = nullptr;
-    std::optional<Timestamp> last_checkpoint;
-    sinks.pose = [&](const PoseEstimate& e) {
-      lcm.publish(channels::kPose, e);
-      if (state_dir.empty() || !node_ptr || (last_checkpoint && (e.t - *last_checkpoint).sec() < state_period_s)) return;
-      last_checkpoint = e.t;
-      try {
-        estimator::writeCheckpoint(node_ptr->checkpoint(), state_dir);
-      } catch (const std::exception& ex) {
-        spdlog::error("checkpoint not written: {}", ex.what());
-      }
-    };
-    sinks.anchors = [&](const std::vector<AnchorEstimate>& a) { lcm.publish(channels::kAnchors, a); };
-    sinks.status = [&](const EstimatorStatus& s) { lcm.publish(channels::kEstimatorStatus, process.stamped(s)); };
-    estimator::EstimatorNode node(options, setup, sinks);
-    node_ptr = &node;
-    if (!state_dir.empty()) {
-      try {
-        if (auto c = estimator::readCheckpoint(state_dir)) {
-          spdlog::warn("restart: checkpoint of t = {} s with {} anchors in {}", formatSeconds(c->t), c->anchors.size(),
-                       state_dir);
-          node.resumeFrom(std::move(*c));
-        }
-      } catch (const std::exception& ex) {
-        spdlog::error("checkpoint in {} not used: {}", state_dir, ex.what());
-      }
-    }
-    spdlog::info("estimator options:\n{}", node.options().toString());
-
-    lcm.subscribe<ImuSample>(channels::kImu, [&](const ImuSample& s) { node.onImu(s); });
-    lcm.subscribe<BaroSample>(channels::kBaro, [&](const BaroSample& s) { node.onBaro(s); });
-    lcm.subscribe<HeightSample>(channels::kHeight, [&](const HeightSample& s) { node.onHeight(s); });
-    lcm.subscribe<RangeSample>(channels::kRange, [&](const RangeSample& s) { node.onRange(s); });
-    lcm.subscribe<FlightStateSample>(channels::kFlightState, [&](const FlightStateSample& s) { node.onFlightState(s); });
-    lcm.subscribe<AnchorInit>(channels::kAnchorInit, [&](const AnchorInit& a) { node.onAnchorInit(a); });
-    lcm.subscribe<EstimatorCommand>(channels::kEstimatorCmd, [&](const EstimatorCommand& c) { node.onCommand(c); });
-    // This host's clock is the reference of every stamp the estimator fuses: bridges on other
-    // hosts estimate their offset to it (transport/time_sync.h, docs/deployment.md).
-    transport::serveTimeSync(lcm);
-
-    bool was_initialized = false;
-    process.heartbeat<EstimatorStatus>(channels::kEstimatorStatus, heartbeat_s, [&] { return node.status(); },
-                                       [&](const EstimatorStatus& st) {
-                                         if (!st.initialized || was_initialized) return;
-                                         was_initialized = true;
-                                         spdlog::info("initialized at t = {} s", formatSeconds(st.t));
-                                       });
-    spdlog::info("LCM {}; strategy {}; {} tags, {} known anchors", lcm.url(), options.strategy,
+    const SystemSetup setup = loadSetup(o.setup_path);
+    EstimatorProcess estimator(process, o, options, setup);
+    estimator.resumeFromCheckpoint();
+    spdlog::info("estimator options:\n{}", estimator.node().options().toString());
+    estimator.connect();
+    spdlog::info("LCM {}; strategy {}; {} tags, {} known anchors", process.lcm().url(), options.strategy,
                  setup.rel_tag_positions.size(), setup.abs_anchor_positions.size());
-    const int rc = lcm.spin();
-
-    // Final state for the recorder.
-    if (node.initialized()) lcm.publish(channels::kAnchors, node.anchors());
-    const EstimatorStatus st = process.stamped(node.status());
-    lcm.publish(channels::kEstimatorStatus, st);
-    spdlog::info("stopped at t = {} s ({}); counters: {}", formatSeconds(st.t),
-                 st.initialized ? "initialized" : "never initialized", transport::formatCounters(st.counters));
+    const int rc = process.lcm().spin();
+    estimator.finish();
     return rc;
   });
 }

@@ -31,6 +31,72 @@ std::unique_ptr<lcm::LogFile> openLcmLog(const std::string& path, bool append, D
   return log;
 }
 
+/// The process's own options (--lcm-url, --log-level come from transport::ProcessMain).
+struct LoggingOptions {
+  std::string out, lcmlog_path, channel_regex = ".*", run_id;
+  double flush_period_s = 0.5, idle_s = 0.0;
+};
+
+void declareOptions(Cli& cli, LoggingOptions& o) {
+  cli.optional("out", o.out, "output folder (created); required")->type_name("DIR");
+  cli.optional("lcmlog", o.lcmlog_path, "also write every message of --channels into an LCM log (lcm-logplayer)")
+      ->type_name("FILE");
+  cli.option("channels", o.channel_regex, "channels recorded into --lcmlog and counted")->type_name("REGEX");
+  cli.option("flush-period", o.flush_period_s, "seconds between flushes of the CSV files and the --lcmlog")
+      ->type_name("S")
+      ->check(cli::positive());
+  cli.optional("exit-when-idle", o.idle_s,
+               "exit once nothing arrived for S seconds after the first message (e.g. after an lcm-logplayer replay; "
+               "default: run until stopped)")
+      ->type_name("S")
+      ->check(cli::nonNegative());
+  cli.optional("run-id", o.run_id,
+               "id of the run (launch files: ${T0_UTIME}); kept in OUT/.logging_run_id: a logger restarted with the "
+               "id already there continues the files of its run instead of starting them anew")
+      ->type_name("ID");
+  cli.optionsFile("these options as a YAML map (`flush_period: 1`); the command line wins");
+}
+
+/// Whether this is a restart within the same run (the supervisor respawned us): --run-id equals the
+/// id kept in `id_file`; then the files are continued.
+bool continuesRun(const std::filesystem::path& id_file, const std::string& run_id, const std::string& out) {
+  if (run_id.empty()) return false;
+  std::string previous;
+  if (std::ifstream in(id_file); in) std::getline(in, previous);
+  const bool append = previous == run_id;
+  if (append) spdlog::warn("restart within run {}: continuing the files in {}", run_id, out);
+  return append;
+}
+
+/// The typed channels the run files are made of.
+void subscribeRunFiles(transport::LcmNode& node, logging::RunRecorder& recorder) {
+  node.subscribe(channels::kPose, [&](const PoseEstimate& e) { recorder.onPose(e); });
+  node.subscribe(channels::kAnchors, [&](const std::vector<AnchorEstimate>& a) { recorder.onAnchors(a); });
+  node.subscribe(channels::kAnchorInit, [&](const AnchorInit& a) { recorder.onAnchorInit(a); });
+  node.subscribe(channels::kGroundTruth, [&](const PoseSample& p) { recorder.onGroundTruth(p); });
+  node.subscribe(channels::kEstimatorStatus, [&](const EstimatorStatus& s) { recorder.onEstimatorStatus(s); });
+  node.subscribe(channels::kCalibStatus, [&](const CalibStatus& s) { recorder.onCalibStatus(s); });
+  node.subscribe(channels::kMissionStatus, [&](const MissionStatus& s) { recorder.onMissionStatus(s); });
+}
+
+/// Flushes the files every `period_s` of wall time (a kill -9 loses at most one period), with a
+/// progress line every 10 s.
+void flushPeriodically(transport::LcmNode& node, logging::RunRecorder& recorder, lcm::LogFile* lcmlog, double period_s) {
+  const int64_t progress_period_us = 10'000'000;
+  node.setHeartbeat(Duration::fromSec(period_s),
+                    [&recorder, lcmlog, progress_period_us, next_progress = replay::wallUtimeNow() + progress_period_us]() mutable {
+                      recorder.flush();
+                      if (lcmlog) std::fflush(lcmlog->getFilePtr());
+                      const int64_t now = replay::wallUtimeNow();
+                      if (now < next_progress) return;
+                      int64_t total = 0;
+                      for (const auto& [ch, c] : recorder.channels()) total += c.messages;
+                      spdlog::info("{} messages, {} poses, {} anchor rows so far", total, recorder.posesWritten(),
+                                   recorder.anchorRowsWritten());
+                      next_progress = now + progress_period_us;
+                    });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -42,47 +108,22 @@ int main(int argc, char** argv) {
       "--flush-period of wall time and on SIGINT/SIGTERM: a stop loses nothing received, a kill -9 at most the last "
       "period. A logger restarted with the same --run-id cuts the half-written last row or event a kill left, then "
       "continues the files.");
-  std::string out, lcmlog_path, channel_regex = ".*", run_id;
-  double flush_period_s = 0.5, idle_s = 0.0;
-  Cli& cli = process.cli();
-  cli.optional("out", out, "output folder (created); required")->type_name("DIR");
-  cli.optional("lcmlog", lcmlog_path, "also write every message of --channels into an LCM log (lcm-logplayer)")
-      ->type_name("FILE");
-  cli.option("channels", channel_regex, "channels recorded into --lcmlog and counted")->type_name("REGEX");
-  cli.option("flush-period", flush_period_s, "seconds between flushes of the CSV files and the --lcmlog")
-      ->type_name("S")
-      ->check(cli::positive());
-  cli.optional("exit-when-idle", idle_s,
-               "exit once nothing arrived for S seconds after the first message (e.g. after an lcm-logplayer replay; "
-               "default: run until stopped)")
-      ->type_name("S")
-      ->check(cli::nonNegative());
-  cli.optional("run-id", run_id,
-               "id of the run (launch files: ${T0_UTIME}); kept in OUT/.logging_run_id: a logger restarted with the "
-               "id already there continues the files of its run instead of starting them anew")
-      ->type_name("ID");
-  cli.optionsFile("these options as a YAML map (`flush_period: 1`); the command line wins");
-
+  LoggingOptions o;
+  declareOptions(process.cli(), o);
   return process.run(argc, argv, [&] {
-    if (out.empty()) {
+    if (o.out.empty()) {
       spdlog::error("--out is required (see --help)");
       return 2;
     }
-    // A restart within the same run (the supervisor respawned us): continue the files.
-    bool append = false;
-    const std::filesystem::path id_file = std::filesystem::path(out) / ".logging_run_id";
-    if (!run_id.empty()) {
-      std::string previous;
-      if (std::ifstream in(id_file); in) std::getline(in, previous);
-      append = previous == run_id;
-      if (append) spdlog::warn("restart within run {}: continuing the files in {}", run_id, out);
-    }
-    logging::RunRecorder recorder(out, append);
-    if (!run_id.empty()) std::ofstream(id_file) << run_id << "\n";
+    const std::filesystem::path id_file = std::filesystem::path(o.out) / ".logging_run_id";
+    const bool append = continuesRun(id_file, o.run_id, o.out);
+    logging::RunRecorder recorder(o.out, append);
+    if (!o.run_id.empty()) std::ofstream(id_file) << o.run_id << "\n";
     transport::LcmNode& node = process.lcm();
-    std::unique_ptr<lcm::LogFile> lcmlog = lcmlog_path.empty() ? nullptr : openLcmLog(lcmlog_path, append, node.diagnostics());
+    std::unique_ptr<lcm::LogFile> lcmlog =
+        o.lcmlog_path.empty() ? nullptr : openLcmLog(o.lcmlog_path, append, node.diagnostics());
     int64_t last_msg_wall = 0;
-    node.subscribeRaw(channel_regex, [&](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+    node.subscribeRaw(o.channel_regex, [&](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
       if (ch == "LCM_SELF_TEST") return;  // udpm's own start-up probe
       recorder.countMessage(ch, rbuf.data_size, rbuf.recv_utime);
       last_msg_wall = replay::wallUtimeNow();
@@ -90,32 +131,11 @@ int main(int argc, char** argv) {
       lcm::LogEvent ev{0, rbuf.recv_utime, ch, static_cast<int32_t>(rbuf.data_size), rbuf.data};
       if (lcmlog->writeEvent(&ev) != 0) node.diagnostics().report("lcmlog:write_error", "lcmlog write failed");
     });
-    node.subscribe<PoseEstimate>(channels::kPose, [&](const PoseEstimate& e) { recorder.onPose(e); });
-    node.subscribe<std::vector<AnchorEstimate>>(channels::kAnchors,
-                                                [&](const std::vector<AnchorEstimate>& a) { recorder.onAnchors(a); });
-    node.subscribe<AnchorInit>(channels::kAnchorInit, [&](const AnchorInit& a) { recorder.onAnchorInit(a); });
-    node.subscribe<PoseSample>(channels::kGroundTruth, [&](const PoseSample& p) { recorder.onGroundTruth(p); });
-    node.subscribe<EstimatorStatus>(channels::kEstimatorStatus,
-                                    [&](const EstimatorStatus& s) { recorder.onEstimatorStatus(s); });
-    node.subscribe<CalibStatus>(channels::kCalibStatus, [&](const CalibStatus& s) { recorder.onCalibStatus(s); });
-    node.subscribe<MissionStatus>(channels::kMissionStatus, [&](const MissionStatus& s) { recorder.onMissionStatus(s); });
-
-    const int64_t progress_period_us = 10'000'000;
-    int64_t next_progress = replay::wallUtimeNow() + progress_period_us;
-    node.setHeartbeat(Duration::fromSec(flush_period_s), [&] {
-      recorder.flush();
-      if (lcmlog) std::fflush(lcmlog->getFilePtr());  // a kill -9 loses at most one flush period
-      const int64_t now = replay::wallUtimeNow();
-      if (now < next_progress) return;
-      int64_t total = 0;
-      for (const auto& [ch, c] : recorder.channels()) total += c.messages;
-      spdlog::info("{} messages, {} poses, {} anchor rows so far", total, recorder.posesWritten(),
-                   recorder.anchorRowsWritten());
-      next_progress = now + progress_period_us;
-    });
-    spdlog::info("LCM {}; recording into {}{}", node.url(), out, lcmlog ? " and " + lcmlog_path : std::string());
+    subscribeRunFiles(node, recorder);
+    flushPeriodically(node, recorder, lcmlog.get(), o.flush_period_s);
+    spdlog::info("LCM {}; recording into {}{}", node.url(), o.out, lcmlog ? " and " + o.lcmlog_path : std::string());
     const int rc = node.spin([&] {
-      return idle_s > 0 && last_msg_wall > 0 && replay::wallUtimeNow() - last_msg_wall > idle_s * 1e6;
+      return o.idle_s > 0 && last_msg_wall > 0 && replay::wallUtimeNow() - last_msg_wall > o.idle_s * 1e6;
     });
     recorder.finish(node.diagnostics());
     lcmlog.reset();

@@ -14,18 +14,20 @@ namespace {
 
 using namespace meshnav;
 
-/// Subscribes the channels whose message time advances the mission clock (besides POSE).
+/// Subscribes the channels named in `names` (--time-channels) whose message time advances the
+/// mission clock (besides POSE); each name is matched against the typed channel constants.
 void subscribeTimeChannels(transport::LcmNode& lcm, const std::vector<std::string>& names,
                            const std::function<void(Timestamp)>& onDataTime) {
+  auto timeOf = [&](auto channel) { lcm.subscribe(channel, [onDataTime](const auto& m) { onDataTime(m.t); }); };
   for (const auto& ch : names) {
-    if (ch == channels::kRange)
-      lcm.subscribe<RangeSample>(ch, [onDataTime](const RangeSample& m) { onDataTime(m.t); });
-    else if (ch == channels::kImu)
-      lcm.subscribe<ImuSample>(ch, [onDataTime](const ImuSample& m) { onDataTime(m.t); });
-    else if (ch == channels::kBaro)
-      lcm.subscribe<BaroSample>(ch, [onDataTime](const BaroSample& m) { onDataTime(m.t); });
-    else if (ch == channels::kFlightState)
-      lcm.subscribe<FlightStateSample>(ch, [onDataTime](const FlightStateSample& m) { onDataTime(m.t); });
+    if (ch == channels::kRange.name)
+      timeOf(channels::kRange);
+    else if (ch == channels::kImu.name)
+      timeOf(channels::kImu);
+    else if (ch == channels::kBaro.name)
+      timeOf(channels::kBaro);
+    else if (ch == channels::kFlightState.name)
+      timeOf(channels::kFlightState);
   }
 }
 
@@ -66,13 +68,13 @@ int main(int argc, char** argv) {
                      config.stay ? " (staying: --stay)" : "; waiting for the calibrator's answer");
       }
     };
-    lcm.subscribe<PoseEstimate>(channels::kPose, [&](const PoseEstimate& p) { onDataTime(p.t); });
+    lcm.subscribe(channels::kPose, [&](const PoseEstimate& p) { onDataTime(p.t); });
     subscribeTimeChannels(lcm, config.time_channels, onDataTime);
-    lcm.subscribe<CalibStatus>(channels::kCalibStatus, [&](const CalibStatus& s) {
+    lcm.subscribe(channels::kCalibStatus, [&](const CalibStatus& s) {
       node.onCalibStatus(s);
       completion.onCalibStatus(s);
     });
-    lcm.subscribe<EstimatorStatus>(channels::kEstimatorStatus,
+    lcm.subscribe(channels::kEstimatorStatus,
                                    [&](const EstimatorStatus& s) { node.onEstimatorStatus(s); });
     process.heartbeat<MissionStatus>(channels::kMissionStatus, config.heartbeat_s, [&] { return node.status(); });
     spdlog::info("LCM {}; waiting for data", lcm.url());

@@ -20,15 +20,15 @@ int main(int argc, char** argv) {
   Diagnostics diag;
   const int64_t n = transport::InputJournal::read(path, [&](const std::string& ch, const lcm::ReceiveBuffer& rbuf) {
     std::string t;
-    if (ch == channels::kPose) {
+    if (ch == channels::kPose.name) {
       PoseEstimate e;
-      if (transport::InputJournal::decode(rbuf, ch, e, diag)) t = formatSeconds(e.t);
-    } else if (ch == channels::kAnchors) {
+      if (transport::InputJournal::decode(rbuf, channels::kPose, e, diag)) t = formatSeconds(e.t);
+    } else if (ch == channels::kAnchors.name) {
       std::vector<AnchorEstimate> a;
-      if (transport::InputJournal::decode(rbuf, ch, a, diag) && !a.empty()) t = formatSeconds(a.front().t);
-    } else if (ch == channels::kAnchorInit) {
+      if (transport::InputJournal::decode(rbuf, channels::kAnchors, a, diag) && !a.empty()) t = formatSeconds(a.front().t);
+    } else if (ch == channels::kAnchorInit.name) {
       AnchorInit a;
-      if (transport::InputJournal::decode(rbuf, ch, a, diag)) t = formatSeconds(a.t);
+      if (transport::InputJournal::decode(rbuf, channels::kAnchorInit, a, diag)) t = formatSeconds(a.t);
     }
     std::printf("%s,%lld,%s\n", ch.c_str(), static_cast<long long>(rbuf.recv_utime), t.c_str());
   });

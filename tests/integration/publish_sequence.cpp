@@ -72,9 +72,9 @@ int main(int argc, char** argv) {
     a.biases = {PairBias{100, a.id, 0.1, 1.0, 0.1, 0.02, 0.0}};
     a.n_inliers = 50;
     const auto msg = transport::toLcm(a);
-    lines.push_back(std::string(channels::kAnchorInit) + "," + std::to_string(id) + "," +
+    lines.push_back(std::string(channels::kAnchorInit.name) + "," + std::to_string(id) + "," +
                     std::to_string(wallUtime()));
-    lcm.publish(channels::kAnchorInit, &msg);
+    lcm.publish(channels::kAnchorInit.name, &msg);
   }
   const auto start = std::chrono::steady_clock::now();
   for (int64_t k = 0; k < count; ++k) {
@@ -86,9 +86,9 @@ int main(int argc, char** argv) {
     e.cov_p_m2 = Eigen::Matrix3d::Identity() * 0.04;
     e.cov_theta_rad2 = Eigen::Matrix3d::Identity() * 1e-4;
     const auto pose = transport::toLcm(e);
-    lines.push_back(std::string(channels::kPose) + "," + std::to_string(i) + "," +
+    lines.push_back(std::string(channels::kPose.name) + "," + std::to_string(i) + "," +
                     std::to_string(wallUtime()));
-    lcm.publish(channels::kPose, &pose);
+    lcm.publish(channels::kPose.name, &pose);
     if (i % anchors_every != 0) continue;
     std::vector<AnchorEstimate> anchors(2);
     for (int j = 0; j < 2; ++j) {
@@ -98,9 +98,9 @@ int main(int argc, char** argv) {
       anchors[j].cov_p_m2 = Eigen::Matrix3d::Identity() * 0.01;
     }
     const auto msg = transport::toLcm(e.t, anchors);
-    lines.push_back(std::string(channels::kAnchors) + "," + std::to_string(i) + "," +
+    lines.push_back(std::string(channels::kAnchors.name) + "," + std::to_string(i) + "," +
                     std::to_string(wallUtime()));
-    lcm.publish(channels::kAnchors, &msg);
+    lcm.publish(channels::kAnchors.name, &msg);
   }
   for (const auto& l : lines) record << l << '\n';
   std::printf("published %lld POSE from %lld at %.0f Hz and %zu ANCHOR_INIT\n", static_cast<long long>(count),

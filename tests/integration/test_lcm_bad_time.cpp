@@ -21,10 +21,10 @@ synthetic::SyntheticOptions scenario() { return test::shortNoisyFlight(9); }
 template <class Inject>
 std::unique_ptr<EstimatorNode> runOverLcm(const Dataset& ds, transport::LcmNode& lcm, Inject inject) {
   auto node = std::make_unique<EstimatorNode>(EstimatorOptions{}, ds.setup);
-  lcm.subscribe<ImuSample>(channels::kImu, [&n = *node](const ImuSample& s) { n.onImu(s); });
-  lcm.subscribe<BaroSample>(channels::kBaro, [&n = *node](const BaroSample& s) { n.onBaro(s); });
-  lcm.subscribe<RangeSample>(channels::kRange, [&n = *node](const RangeSample& s) { n.onRange(s); });
-  lcm.subscribe<FlightStateSample>(channels::kFlightState,
+  lcm.subscribe(channels::kImu, [&n = *node](const ImuSample& s) { n.onImu(s); });
+  lcm.subscribe(channels::kBaro, [&n = *node](const BaroSample& s) { n.onBaro(s); });
+  lcm.subscribe(channels::kRange, [&n = *node](const RangeSample& s) { n.onRange(s); });
+  lcm.subscribe(channels::kFlightState,
                                    [&n = *node](const FlightStateSample& s) { n.onFlightState(s); });
   auto drain = [&] {
     while (lcm.spinOnce(0) > 0) {
@@ -70,7 +70,7 @@ TEST(LcmBadTime, FutureRangeAndRandomImuBytesChangeNothing) {
     }
     if (rng() % 20 == 0) {
       for (size_t i = 8; i < bytes.size(); ++i) bytes[i] = static_cast<uint8_t>(rng());  // keep the fingerprint
-      l.lcm().publish(channels::kImu, bytes.data(), static_cast<unsigned>(bytes.size()));
+      l.lcm().publish(channels::kImu.name, bytes.data(), static_cast<unsigned>(bytes.size()));
       ++random_sent;
     }
   });

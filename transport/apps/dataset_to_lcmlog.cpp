@@ -15,20 +15,35 @@
 
 namespace {
 
-template <class Msg>
-bool writeEvent(lcm::LogFile& log, const std::string& channel, int64_t utime, const Msg& msg,
+template <class T>
+bool writeEvent(lcm::LogFile& log, meshnav::channels::Channel<T> channel, int64_t utime, const std::type_identity_t<T>& value,
                 std::vector<uint8_t>& buf) {
+  const auto msg = meshnav::transport::toWire(value);
   const int n = msg.getEncodedSize();
   buf.resize(static_cast<size_t>(n));
   if (msg.encode(buf.data(), 0, n) != n) return false;
   lcm::LogEvent ev;
   ev.eventnum = 0;
   ev.timestamp = utime;
-  ev.channel = channel;
+  ev.channel = channel.name;
   ev.datalen = n;
   ev.data = buf.data();
   return log.writeEvent(&ev) == 0;
 }
+
+/// The streams of the log, numbered in their order at equal times: the estimator's canonical
+/// order (estimator/node/estimator_input.h: flight state, IMU, baro, range, then height), so a
+/// replay of the log causes no rewinds; the ground truth after the inputs of its instant. An
+/// explicit table (test_dataset_to_lcmlog.cpp checks the order in a written log).
+enum Stream : int {
+  kFlightStateStream = 0,
+  kImuStream = 1,
+  kBaroStream = 2,
+  kRangeStream = 3,
+  kGroundTruthStream = 4,
+  kHeightStream = 5,
+  kStreamCount = 6
+};
 
 }  // namespace
 
@@ -50,12 +65,14 @@ int main(int argc, char** argv) {
     Diagnostics diag;
     const Dataset ds = readDataset(dataset, diag);
     const bool with_gt = !no_ground_truth;
-    // Streams in this order: equal times keep it — the estimator's canonical order (flight state,
-    // IMU, baro, range), so a replay of the log causes no rewinds; inputs before the truth.
-    const std::vector<std::vector<Timestamp>> times = {
-        replay::timesOf(ds.flight_states), replay::timesOf(ds.imu), replay::timesOf(ds.baro),
-        replay::timesOf(ds.ranges), with_gt ? replay::timesOf(ds.ground_truth) : std::vector<Timestamp>{},
-        replay::timesOf(ds.heights)};
+    // Equal times keep the order of the streams (Stream).
+    std::vector<std::vector<Timestamp>> times(kStreamCount);
+    times[kFlightStateStream] = replay::timesOf(ds.flight_states);
+    times[kImuStream] = replay::timesOf(ds.imu);
+    times[kBaroStream] = replay::timesOf(ds.baro);
+    times[kRangeStream] = replay::timesOf(ds.ranges);
+    if (with_gt) times[kGroundTruthStream] = replay::timesOf(ds.ground_truth);
+    times[kHeightStream] = replay::timesOf(ds.heights);
     const auto events = replay::mergeTimeline(times);
 
     const std::filesystem::path outp(out);
@@ -70,12 +87,12 @@ int main(int argc, char** argv) {
     for (const auto& ev : events) {
       bool ok = false;
       switch (ev.stream) {
-        case 0: ok = writeEvent(log, channels::kFlightState, ev.t.us, transport::toLcm(ds.flight_states[ev.index]), buf); break;
-        case 1: ok = writeEvent(log, channels::kImu, ev.t.us, transport::toLcm(ds.imu[ev.index]), buf); break;
-        case 2: ok = writeEvent(log, channels::kBaro, ev.t.us, transport::toLcm(ds.baro[ev.index]), buf); break;
-        case 3: ok = writeEvent(log, channels::kRange, ev.t.us, transport::toLcm(ds.ranges[ev.index]), buf); break;
-        case 4: ok = writeEvent(log, channels::kGroundTruth, ev.t.us, transport::toLcm(ds.ground_truth[ev.index]), buf); break;
-        case 5: ok = writeEvent(log, channels::kHeight, ev.t.us, transport::toLcm(ds.heights[ev.index]), buf); break;
+        case kFlightStateStream: ok = writeEvent(log, channels::kFlightState, ev.t.us, ds.flight_states[ev.index], buf); break;
+        case kImuStream: ok = writeEvent(log, channels::kImu, ev.t.us, ds.imu[ev.index], buf); break;
+        case kBaroStream: ok = writeEvent(log, channels::kBaro, ev.t.us, ds.baro[ev.index], buf); break;
+        case kRangeStream: ok = writeEvent(log, channels::kRange, ev.t.us, ds.ranges[ev.index], buf); break;
+        case kGroundTruthStream: ok = writeEvent(log, channels::kGroundTruth, ev.t.us, ds.ground_truth[ev.index], buf); break;
+        case kHeightStream: ok = writeEvent(log, channels::kHeight, ev.t.us, ds.heights[ev.index], buf); break;
         default: break;
       }
       if (!ok) {

@@ -20,6 +20,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <queue>
 #include <string>
 #include <vector>
@@ -82,6 +83,123 @@ int openPort(Port& p, const std::string& group, int udp_port) {
   return fd;
 }
 
+/// The interfaces of a comma-separated list ("veth0,veth1").
+std::vector<Port> parsePorts(const std::string& list) {
+  std::vector<Port> ports;
+  size_t start = 0;
+  while (start <= list.size()) {
+    size_t end = list.find(',', start);
+    if (end == std::string::npos) end = list.size();
+    if (end > start) ports.push_back({list.substr(start, end - start)});
+    start = end + 1;
+  }
+  return ports;
+}
+
+/// The switch: every datagram received on a port goes to every other port through that port's
+/// link emulator, queued until its delivery time.
+class Switch {
+ public:
+  /// Opens the ports (throws naming the interface when one cannot be opened).
+  Switch(std::vector<Port> ports, const netem::LinkFaults& faults, uint64_t seed, const std::string& group, int udp_port)
+      : ports_(std::move(ports)), faults_(faults) {
+    for (size_t i = 0; i < ports_.size(); ++i) {
+      fds_.push_back({openPort(ports_[i], group, udp_port), POLLIN, 0});
+      links_.emplace_back(faults, seed * 1000003 + i);
+    }
+    dest_.sin_family = AF_INET;
+    dest_.sin_port = htons(static_cast<uint16_t>(udp_port));
+    inet_pton(AF_INET, group.c_str(), &dest_.sin_addr);
+  }
+  ~Switch() {
+    for (auto& p : ports_) close(p.fd);
+  }
+  Switch(const Switch&) = delete;
+  Switch& operator=(const Switch&) = delete;
+
+  size_t size() const { return ports_.size(); }
+
+  /// Forwards until SIGINT/SIGTERM. Returns 0, or 1 after a poll error.
+  int run() {
+    while (!transport::StopSignal::requested()) {
+      const int64_t now = replay::wallUtimeNow();
+      sendDue(now);
+      int timeout_ms = 100;
+      if (!queue_.empty())
+        timeout_ms = static_cast<int>(std::clamp<int64_t>((queue_.top().due_us - now + 999) / 1000, 0, 100));
+      const int n = poll(fds_.data(), fds_.size(), timeout_ms);
+      if (n < 0 && errno != EINTR) {
+        std::cerr << "meshnav_netem_switch: poll: " << strerror(errno) << "\n";
+        return 1;
+      }
+      if (n <= 0) continue;
+      const int64_t received_at = replay::wallUtimeNow();
+      for (size_t i = 0; i < fds_.size(); ++i)
+        if (fds_[i].revents & POLLIN) receiveFrom(i, received_at);
+    }
+    return 0;
+  }
+
+  /// The counters per channel as YAML (--summary).
+  std::string summary() const {
+    std::ostringstream out;
+    out << "# meshnav_netem_switch: datagrams per LCM channel. received = sent by a host; lost, duplicated,\n"
+           "# delivered count the copies towards the other "
+        << ports_.size() - 1 << " hosts each.\nfaults: \"" << faults_.toString() << "\"\nports: " << ports_.size()
+        << "\nchannels:\n";
+    for (const auto& [ch, c] : counts_)
+      out << "  " << ch << ": {received: " << c.received << ", lost: " << c.lost << ", duplicated: " << c.duplicated
+          << ", delivered: " << c.delivered << "}\n";
+    for (const auto& [k, v] : port_errors_) out << "# " << k << ": " << v << "\n";
+    return out.str();
+  }
+
+ private:
+  /// Sends every queued copy whose delivery time has come.
+  void sendDue(int64_t now) {
+    while (!queue_.empty() && queue_.top().due_us <= now) {
+      const Pending& p = queue_.top();
+      if (sendto(ports_[p.port].fd, p.data->data(), p.data->size(), 0, reinterpret_cast<sockaddr*>(&dest_),
+                 sizeof dest_) < 0)
+        ++port_errors_[ports_[p.port].name + ":send_error"];
+      queue_.pop();
+    }
+  }
+  /// Reads every waiting datagram of port `i` and queues its copies towards the other ports.
+  void receiveFrom(size_t i, int64_t now) {
+    while (true) {
+      const ssize_t got = recv(fds_[i].fd, buf_.data(), buf_.size(), MSG_DONTWAIT);
+      if (got < 0) break;
+      std::string ch = netem::lcmChannelOf(buf_.data(), static_cast<size_t>(got));
+      if (ch.empty()) ch = "(fragments)";
+      ChannelCount& c = counts_[ch];
+      ++c.received;
+      auto data = std::make_shared<std::vector<uint8_t>>(buf_.begin(), buf_.begin() + got);
+      for (size_t j = 0; j < ports_.size(); ++j) {
+        if (j == i) continue;
+        const auto d = links_[j].deliveries();
+        if (d.empty()) ++c.lost;
+        if (d.size() > 1) ++c.duplicated;
+        for (int64_t delay : d) {
+          ++c.delivered;
+          queue_.push({now + delay, order_++, j, data});
+        }
+      }
+    }
+  }
+
+  std::vector<Port> ports_;
+  netem::LinkFaults faults_;
+  std::vector<netem::LinkEmulator> links_;  ///< towards each port
+  std::vector<pollfd> fds_;
+  std::priority_queue<Pending, std::vector<Pending>, std::greater<>> queue_;
+  std::map<std::string, ChannelCount> counts_;
+  std::map<std::string, int64_t> port_errors_;
+  uint64_t order_ = 0;
+  std::vector<uint8_t> buf_ = std::vector<uint8_t>(70000);
+  sockaddr_in dest_{};
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -109,89 +227,18 @@ int main(int argc, char** argv) {
     return 2;
   }
   transport::StopSignal::install();
-  std::vector<Port> ports;
-  std::vector<netem::LinkEmulator> links;  // towards each port
-  std::vector<pollfd> fds;
+  std::unique_ptr<Switch> sw;
   try {
-    size_t start = 0;
-    while (start <= ports_list.size()) {
-      size_t end = ports_list.find(',', start);
-      if (end == std::string::npos) end = ports_list.size();
-      if (end > start) ports.push_back({ports_list.substr(start, end - start)});
-      start = end + 1;
-    }
-    for (size_t i = 0; i < ports.size(); ++i) {
-      fds.push_back({openPort(ports[i], group, udp_port), POLLIN, 0});
-      links.emplace_back(faults, seed * 1000003 + i);
-    }
+    sw = std::make_unique<Switch>(parsePorts(ports_list), faults, seed, group, udp_port);
   } catch (const std::exception& e) {
     std::cerr << "meshnav_netem_switch: " << e.what() << "\n";
     return 1;
   }
-  std::cout << "meshnav_netem_switch: " << ports.size() << " ports, group " << group << ":" << udp_port
+  std::cout << "meshnav_netem_switch: " << sw->size() << " ports, group " << group << ":" << udp_port
             << ", faults: " << (faults.none() ? "none" : faults.toString()) << std::endl;
-
-  std::priority_queue<Pending, std::vector<Pending>, std::greater<>> queue;
-  std::map<std::string, ChannelCount> counts;
-  std::map<std::string, int64_t> port_errors;
-  uint64_t order = 0;
-  std::vector<uint8_t> buf(70000);
-  sockaddr_in dest{};
-  dest.sin_family = AF_INET;
-  dest.sin_port = htons(static_cast<uint16_t>(udp_port));
-  inet_pton(AF_INET, group.c_str(), &dest.sin_addr);
-  while (!transport::StopSignal::requested()) {
-    int64_t now = replay::wallUtimeNow();
-    while (!queue.empty() && queue.top().due_us <= now) {
-      const Pending& p = queue.top();
-      if (sendto(ports[p.port].fd, p.data->data(), p.data->size(), 0, reinterpret_cast<sockaddr*>(&dest),
-                 sizeof dest) < 0)
-        ++port_errors[ports[p.port].name + ":send_error"];
-      queue.pop();
-    }
-    int timeout_ms = 100;
-    if (!queue.empty()) timeout_ms = static_cast<int>(std::clamp<int64_t>((queue.top().due_us - now + 999) / 1000, 0, 100));
-    const int n = poll(fds.data(), fds.size(), timeout_ms);
-    if (n < 0 && errno != EINTR) {
-      std::cerr << "meshnav_netem_switch: poll: " << strerror(errno) << "\n";
-      return 1;
-    }
-    if (n <= 0) continue;
-    now = replay::wallUtimeNow();
-    for (size_t i = 0; i < fds.size(); ++i) {
-      if (!(fds[i].revents & POLLIN)) continue;
-      while (true) {
-        const ssize_t got = recv(fds[i].fd, buf.data(), buf.size(), MSG_DONTWAIT);
-        if (got < 0) break;
-        std::string ch = netem::lcmChannelOf(buf.data(), static_cast<size_t>(got));
-        if (ch.empty()) ch = "(fragments)";
-        ChannelCount& c = counts[ch];
-        ++c.received;
-        auto data = std::make_shared<std::vector<uint8_t>>(buf.begin(), buf.begin() + got);
-        for (size_t j = 0; j < ports.size(); ++j) {
-          if (j == i) continue;
-          const auto d = links[j].deliveries();
-          if (d.empty()) ++c.lost;
-          if (d.size() > 1) ++c.duplicated;
-          for (int64_t delay : d) {
-            ++c.delivered;
-            queue.push({now + delay, order++, j, data});
-          }
-        }
-      }
-    }
-  }
-  std::ostringstream out;
-  out << "# meshnav_netem_switch: datagrams per LCM channel. received = sent by a host; lost, duplicated,\n"
-         "# delivered count the copies towards the other "
-      << ports.size() - 1 << " hosts each.\nfaults: \"" << faults.toString() << "\"\nports: " << ports.size()
-      << "\nchannels:\n";
-  for (const auto& [ch, c] : counts)
-    out << "  " << ch << ": {received: " << c.received << ", lost: " << c.lost << ", duplicated: " << c.duplicated
-        << ", delivered: " << c.delivered << "}\n";
-  for (const auto& [k, v] : port_errors) out << "# " << k << ": " << v << "\n";
-  std::cout << out.str() << std::flush;
-  if (!summary.empty()) std::ofstream(summary) << out.str();
-  for (auto& p : ports) close(p.fd);
+  if (const int rc = sw->run(); rc != 0) return rc;
+  const std::string text = sw->summary();
+  std::cout << text << std::flush;
+  if (!summary.empty()) std::ofstream(summary) << text;
   return 0;
 }

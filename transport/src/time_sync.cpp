@@ -9,19 +9,19 @@
 namespace meshnav::transport {
 
 void serveTimeSync(LcmNode& node) {
-  node.subscribeLcmStamped<meshnav::time_sync_t>(
+  node.subscribeStamped(
       channels::kTimeSyncRequest, [&node](const meshnav::time_sync_t& req, int64_t recv_utime) {
         meshnav::time_sync_t reply = req;
         reply.t_receive = recv_utime;
         reply.t_reply = replay::wallUtimeNow();
-        node.publishLcm(channels::kTimeSync, reply);
+        node.publish(channels::kTimeSync, reply);
       });
 }
 
 TimeSyncClient::TimeSyncClient(LcmNode& node, std::string client, Duration injected_offset,
                                ClockOffsetOptions options)
     : node_(node), client_(std::move(client)), injected_(injected_offset), estimator_(options) {
-  node_.subscribeLcmStamped<meshnav::time_sync_t>(
+  node_.subscribeStamped(
       channels::kTimeSync, [this](const meshnav::time_sync_t& r, int64_t recv_utime) {
         if (r.client != client_) return;  // another client's reply
         if (r.seq < 1 || r.seq > seq_) {
@@ -45,7 +45,7 @@ void TimeSyncClient::request() {
   req.client = client_;
   req.seq = ++seq_;
   last_request_wall_ = replay::wallUtimeNow();
-  node_.publishLcm(channels::kTimeSyncRequest, req);
+  node_.publish(channels::kTimeSyncRequest, req);
 }
 
 void TimeSyncClient::poll(Duration period) {

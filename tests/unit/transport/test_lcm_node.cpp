@@ -32,7 +32,7 @@ void drain(LcmNode& node) {
 TEST(LcmNode, TypedRoundTrip) {
   LcmNode node("test", "memq://");
   std::vector<RangeSample> got;
-  node.subscribe<RangeSample>(channels::kRange, [&](const RangeSample& r) { got.push_back(r); });
+  node.subscribe(channels::kRange, [&](const RangeSample& r) { got.push_back(r); });
   RangeSample r;
   r.t = Timestamp{42};
   r.id_initiator = 100;
@@ -43,29 +43,29 @@ TEST(LcmNode, TypedRoundTrip) {
   ASSERT_EQ(got.size(), 1u);
   EXPECT_EQ(got[0].t, r.t);
   EXPECT_EQ(got[0].range_m, 3.5);
-  EXPECT_EQ(node.received(channels::kRange), 1);
+  EXPECT_EQ(node.received(channels::kRange.name), 1);
   EXPECT_EQ(node.diagnostics().total(), 0);
 }
 
 TEST(LcmNode, GarbageBytesAreCountedNotFatal) {
   LcmNode node("test", "memq://");
   int imu_count = 0;
-  node.subscribe<ImuSample>(channels::kImu, [&](const ImuSample&) { ++imu_count; });
-  publishBytes(node, channels::kImu, {0xde, 0xad, 0xbe, 0xef});
-  publishBytes(node, channels::kImu, {});
+  node.subscribe(channels::kImu, [&](const ImuSample&) { ++imu_count; });
+  publishBytes(node, channels::kImu.name, {0xde, 0xad, 0xbe, 0xef});
+  publishBytes(node, channels::kImu.name, {});
   std::vector<uint8_t> junk(300);
   for (size_t i = 0; i < junk.size(); ++i) junk[i] = static_cast<uint8_t>(i * 37 + 11);
-  publishBytes(node, channels::kImu, junk);
+  publishBytes(node, channels::kImu.name, junk);
   // A valid message of another type on the IMU channel is malformed for IMU too.
   const auto baro = toLcm(BaroSample{Timestamp{1}, 101325.0});
   std::vector<uint8_t> bb(static_cast<size_t>(baro.getEncodedSize()));
   baro.encode(bb.data(), 0, static_cast<int>(bb.size()));
-  publishBytes(node, channels::kImu, bb);
+  publishBytes(node, channels::kImu.name, bb);
   ASSERT_TRUE(node.publish(channels::kImu, ImuSample{}));  // a good one still gets through
   drain(node);
   EXPECT_EQ(imu_count, 1);
   EXPECT_EQ(node.diagnostics().get("IMU:decode_error"), 4);
-  EXPECT_EQ(node.received(channels::kImu), 1);
+  EXPECT_EQ(node.received(channels::kImu.name), 1);
 }
 
 TEST(LcmNode, OlderAnchorInitVersionIsRefusedByName) {
@@ -73,7 +73,7 @@ TEST(LcmNode, OlderAnchorInitVersionIsRefusedByName) {
   // version, as in an older log, must be refused and named, never misread as the new layout.
   LcmNode node("test", "memq://");
   int n = 0;
-  node.subscribe<AnchorInit>(channels::kAnchorInit, [&](const AnchorInit&) { ++n; });
+  node.subscribe(channels::kAnchorInit, [&](const AnchorInit&) { ++n; });
   AnchorInit a;
   a.id = 106;
   a.biases.push_back(PairBias{100, 106, 0.1, 1.0, 0.1, 0.02, 0.0});
@@ -84,8 +84,8 @@ TEST(LcmNode, OlderAnchorInitVersionIsRefusedByName) {
   const uint64_t v1 = 0xa4a10701fd07c42dULL;  // anchor_init_t before issue 10
   for (int i = 0; i < 8; ++i) old[static_cast<size_t>(i)] = static_cast<uint8_t>(v1 >> (56 - 8 * i));
   old.resize(old.size() - 2);  // version 1 had no num_gamma_cov
-  publishBytes(node, channels::kAnchorInit, old);
-  publishBytes(node, channels::kAnchorInit, buf);
+  publishBytes(node, channels::kAnchorInit.name, old);
+  publishBytes(node, channels::kAnchorInit.name, buf);
   drain(node);
   EXPECT_EQ(n, 1);
   EXPECT_EQ(node.diagnostics().get("ANCHOR_INIT:decode_error"), 1);
@@ -114,11 +114,11 @@ TEST(LcmNode, OversizedMessagesAreCounted) {
   // counted and dropped before decoding; one of ours is not sent, and counted at the sender.
   LcmNode node("test", "memq://");
   int imu_count = 0;
-  node.subscribe<ImuSample>(channels::kImu, [&](const ImuSample&) { ++imu_count; });
+  node.subscribe(channels::kImu, [&](const ImuSample&) { ++imu_count; });
   const auto imu = toLcm(ImuSample{});
   std::vector<uint8_t> big(1 << 20);
   imu.encode(big.data(), 0, imu.getEncodedSize());  // a valid imu_t followed by 1 MB of padding
-  publishBytes(node, channels::kImu, big);
+  publishBytes(node, channels::kImu.name, big);
   ASSERT_TRUE(node.publish(channels::kImu, ImuSample{}));
   drain(node);
   EXPECT_EQ(imu_count, 1);
@@ -137,7 +137,7 @@ TEST(LcmNode, CorruptedArrayCountIsCaught) {
   // the buffer: decode must fail cleanly (no huge allocation, no crash).
   LcmNode node("test", "memq://");
   int n = 0;
-  node.subscribe<std::vector<AnchorEstimate>>(channels::kAnchors, [&](const std::vector<AnchorEstimate>&) { ++n; });
+  node.subscribe(channels::kAnchors, [&](const std::vector<AnchorEstimate>&) { ++n; });
   std::vector<AnchorEstimate> v(2);
   const auto msg = toLcm(Timestamp{5}, v);
   std::vector<uint8_t> buf(static_cast<size_t>(msg.getEncodedSize()));
@@ -148,14 +148,14 @@ TEST(LcmNode, CorruptedArrayCountIsCaught) {
   auto negative = buf;
   negative[count_pos] = 0xff;
   negative[count_pos + 1] = 0xff;
-  publishBytes(node, channels::kAnchors, negative);
+  publishBytes(node, channels::kAnchors.name, negative);
   auto too_many = buf;
   too_many[count_pos] = 0x7f;
-  publishBytes(node, channels::kAnchors, too_many);
+  publishBytes(node, channels::kAnchors.name, too_many);
   auto truncated = buf;
   truncated.resize(buf.size() - 3);
-  publishBytes(node, channels::kAnchors, truncated);
-  publishBytes(node, channels::kAnchors, buf);
+  publishBytes(node, channels::kAnchors.name, truncated);
+  publishBytes(node, channels::kAnchors.name, buf);
   drain(node);
   EXPECT_EQ(n, 1);
   EXPECT_EQ(node.diagnostics().get("ANCHORS:decode_error"), 3);
@@ -164,7 +164,7 @@ TEST(LcmNode, CorruptedArrayCountIsCaught) {
 TEST(LcmNode, CorruptedStringLengthIsCaught) {
   LcmNode node("test", "memq://");
   int n = 0;
-  node.subscribe<MissionStatus>(channels::kMissionStatus, [&](const MissionStatus&) { ++n; });
+  node.subscribe(channels::kMissionStatus, [&](const MissionStatus&) { ++n; });
   MissionStatus s;
   s.text = "hello";
   const auto msg = toLcm(s);
@@ -177,7 +177,7 @@ TEST(LcmNode, CorruptedStringLengthIsCaught) {
     bad[len_pos + 1] = b0;
     bad[len_pos + 2] = b0;
     bad[len_pos + 3] = 0;  // length 0 or negative or huge
-    publishBytes(node, channels::kMissionStatus, bad);
+    publishBytes(node, channels::kMissionStatus.name, bad);
   }
   drain(node);
   EXPECT_EQ(n, 0);
@@ -187,7 +187,7 @@ TEST(LcmNode, CorruptedStringLengthIsCaught) {
 TEST(LcmNode, InvalidContentAndThrowingHandlers) {
   LcmNode node("test", "memq://");
   int ok = 0;
-  node.subscribe<RangeSample>(channels::kRange, [&](const RangeSample& r) {
+  node.subscribe(channels::kRange, [&](const RangeSample& r) {
     if (r.id_initiator == 666) throw std::runtime_error("boom");
     ++ok;
   });
@@ -196,7 +196,7 @@ TEST(LcmNode, InvalidContentAndThrowingHandlers) {
   node.publish(channels::kRange, nan_range);
   auto bad_type = toLcm(RangeSample{});
   bad_type.type_initiator = 'Z';
-  node.publishLcm(channels::kRange, bad_type);
+  node.lcm().publish(channels::kRange.name, &bad_type);
   RangeSample throws;
   throws.id_initiator = 666;
   node.publish(channels::kRange, throws);
@@ -225,7 +225,7 @@ TEST(LcmNode, BurstIsNotDropped) {
   // integration.lcm_pipeline checks over udpm that the logger receives every published message.
   LcmNode node("test", "memq://");
   int typed = 0, raw = 0;
-  node.subscribe<ImuSample>(channels::kImu, [&](const ImuSample&) { ++typed; });
+  node.subscribe(channels::kImu, [&](const ImuSample&) { ++typed; });
   node.subscribeRaw(".*", [&](const lcm::ReceiveBuffer&, const std::string&) { ++raw; });
   for (int i = 0; i < 500; ++i) node.publish(channels::kImu, ImuSample{Timestamp{i}, {}, {}});
   // Wait on the condition (a handle with timeout 0 may find memq's notification not yet readable
@@ -250,8 +250,8 @@ TEST(LcmNode, WaitForMessage) {
   EstimatorStatus st;
   st.strategy = "dah";
   node.setHeartbeat(Duration::fromMs(5), [&] { node.publish(channels::kEstimatorStatus, st); });
-  EXPECT_TRUE(node.waitForMessage(channels::kEstimatorStatus, Duration::fromSec(10)));
-  EXPECT_FALSE(node.waitForMessage(channels::kCalibStatus, Duration::fromMs(20)));
+  EXPECT_TRUE(node.waitForMessage(channels::kEstimatorStatus.name, Duration::fromSec(10)));
+  EXPECT_FALSE(node.waitForMessage(channels::kCalibStatus.name, Duration::fromMs(20)));
 }
 
 TEST(LcmNode, StopSignalEndsSpin) {
