@@ -41,18 +41,8 @@ void EstimatorNode::feedInitializer(const EstimatorInput& in) {
   if (!initializer_->isStatic() || initializer_->waitingFor().rfind("motion", 0) == 0) tryMotionInitialization(inputTime(in));
 }
 
-void EstimatorNode::initialize(const InitialBelief& b) {
-  auto filter = makeStrategy(options_);
-  filter->reset(setup_.imu_id, b.imu, b.cov, b.t);
-  if (options_.baro.enabled && b.baro_reference_pa) {
-    baro_reference_pa_ = b.baro_reference_pa;
-    filter->addBaro(setup_.baro_id, b.baro_bias_m, b.baro_bias_var_m2);
-  } else if (options_.baro.enabled && resume_baro_) {  // a restart in flight: the predecessor's reference
-    baro_reference_pa_ = resume_baro_->baro_reference_pa;
-    filter->addBaro(setup_.baro_id, resume_baro_->baro_bias_m, resume_baro_->baro_bias_var_m2);
-  }
-  resume_baro_.reset();
-  pending_height_bias_ = b.height_bias;  // the height instance is added at the first usable height
+/// Known-but-uncertain setup anchors (abs_anchor_sigmas) as estimated anchor instances.
+void EstimatorNode::addSetupAnchorStates(FusionStrategy& f) const {
   for (const auto& [id, p] : setup_.abs_anchor_positions) {
     auto sig = setup_.abs_anchor_sigmas_m.find(id);
     if (sig == setup_.abs_anchor_sigmas_m.end()) continue;
@@ -73,8 +63,11 @@ void EstimatorNode::initialize(const InitialBelief& b) {
     biases.gamma_m = Eigen::Map<const Eigen::VectorXd>(gamma.data(), static_cast<Eigen::Index>(gamma.size()));
     Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(var.data(), static_cast<Eigen::Index>(var.size()));
     v.head<3>() *= sig->second * sig->second;
-    filter->addAnchor(id, p, v.asDiagonal().toDenseMatrix(), biases);
+    f.addAnchor(id, p, v.asDiagonal().toDenseMatrix(), biases);
   }
+}
+
+void EstimatorNode::addTagBiasStates(FusionStrategy& f) const {
   if (options_.uwb.estimate_tag_biases) {
     // Tag instances with state: γ towards the setup's anchors (exact or known-but-uncertain) whose
     // a-priori bias is uncertain. Constant per pair, so a state rather than white noise.
@@ -89,17 +82,13 @@ void EstimatorNode::initialize(const InitialBelief& b) {
         var.push_back(pb->sigma_gamma_m * pb->sigma_gamma_m);
       }
       if (!peers.empty())
-        filter->addTagBiases(tag, peers, Eigen::Map<Eigen::VectorXd>(gamma.data(), static_cast<long>(gamma.size())),
+        f.addTagBiases(tag, peers, Eigen::Map<Eigen::VectorXd>(gamma.data(), static_cast<long>(gamma.size())),
                              Eigen::Map<Eigen::VectorXd>(var.data(), static_cast<long>(var.size())));
     }
   }
-  cur_.filter = std::move(filter);
-  cur_.last_imu = b.last_imu;
-  cur_.landed = b.landed;
-  cur_.last_zupt = b.t;
-  init_time_ = b.t;
-  health_.reset(b.t);
-  newest_ = newest_ ? std::max(*newest_, b.t) : b.t;
+}
+
+void EstimatorNode::logInitialization(const InitialBelief& b) const {
   const double yaw_deg = so3::yawOf(b.imu.q_ItoG) * 180.0 / M_PI;
   const double sigma_yaw_deg =
       std::sqrt(so3::yawVariance(b.imu.q_ItoG, b.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta))) * 180.0 / M_PI;
@@ -115,6 +104,30 @@ void EstimatorNode::initialize(const InitialBelief& b) {
                  b.height_bias->first, std::sqrt(b.height_bias->second));
   if (!baro_reference_pa_ && options_.baro.enabled)
     spdlog::warn("estimator: no baro reference pressure (none in setup, no landed baro data): baro unused");
+}
+
+void EstimatorNode::initialize(const InitialBelief& b) {
+  auto filter = makeStrategy(options_);
+  filter->reset(setup_.imu_id, b.imu, b.cov, b.t);
+  if (options_.baro.enabled && b.baro_reference_pa) {
+    baro_reference_pa_ = b.baro_reference_pa;
+    filter->addBaro(setup_.baro_id, b.baro_bias_m, b.baro_bias_var_m2);
+  } else if (options_.baro.enabled && resume_baro_) {  // a restart in flight: the predecessor's reference
+    baro_reference_pa_ = resume_baro_->baro_reference_pa;
+    filter->addBaro(setup_.baro_id, resume_baro_->baro_bias_m, resume_baro_->baro_bias_var_m2);
+  }
+  resume_baro_.reset();
+  pending_height_bias_ = b.height_bias;  // the height instance is added at the first usable height
+  addSetupAnchorStates(*filter);
+  addTagBiasStates(*filter);
+  cur_.filter = std::move(filter);
+  cur_.last_imu = b.last_imu;
+  cur_.landed = b.landed;
+  cur_.last_zupt = b.t;
+  init_time_ = b.t;
+  health_.reset(b.t);
+  newest_ = newest_ ? std::max(*newest_, b.t) : b.t;
+  logInitialization(b);
   const auto pending = std::move(pending_anchor_inits_);
   pending_anchor_inits_.clear();
   for (auto a : pending) {

@@ -63,6 +63,7 @@ void StaticInitializer::restart() {
   n_baro_ = 0;
   sum_pressure_ = 0.0;
   ranges_.clear();
+  last_fit_t_.reset();
 }
 
 void StaticInitializer::addFlightState(const FlightStateSample& s) {
@@ -100,6 +101,9 @@ void StaticInitializer::addRange(const RangeSample& s) {
   r.d_m = (z - pb.gamma_m) / pb.beta;
   r.sigma_m = network_.rangeSigma(tag, anchor, s.R_m2);
   ranges_.push_back(r);
+  // The newest ones only: a body that rests long (a hover the ranges cannot fix) must not make
+  // every retry slower (90 s of ranges took 30 min of fits).
+  if (ranges_.size() > kMaxRanges) ranges_.erase(ranges_.begin(), ranges_.begin() + (ranges_.size() - kMaxRanges));
 }
 
 std::optional<InitialBelief> StaticInitializer::tryInitialize() {
@@ -143,6 +147,9 @@ std::optional<InitialBelief> StaticInitializer::build(const Eigen::Matrix3d& R_r
           std::to_string(options_.init.min_ranges) + ")";
       return std::nullopt;
     }
+    // Retried at most every kRetryS of data time (tryInitialize runs at every input).
+    if (last_fit_t_ && b.t >= *last_fit_t_ && (b.t - *last_fit_t_).sec() < kRetryS) return std::nullopt;
+    last_fit_t_ = b.t;
     Eigen::Matrix4d cov;
     if (!fitPoseToRanges(R_rp, p, yaw, cov, b.range_fit_rms_m, b.n_ranges_used)) {
       if (waiting_for_.empty()) waiting_for_ = "a converging range fit";

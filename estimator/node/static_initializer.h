@@ -109,6 +109,9 @@ class StaticInitializer {
   double sum_pressure_ = 0.0;
   std::vector<InitRange> ranges_;
   std::optional<HeightPrior> height_prior_;  ///< of the fit in progress (fitPoseToRanges)
+  static constexpr size_t kMaxRanges = 600;   ///< newest ranges kept for the fit (≈ 10 s at 60 Hz)
+  static constexpr double kRetryS = 0.5;      ///< a refused range fit is retried after this much data time [s]
+  std::optional<Timestamp> last_fit_t_;       ///< data time of the last range fit
   std::string waiting_for_ = "landed IMU data";
 };
 
