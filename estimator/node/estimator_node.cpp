@@ -85,6 +85,8 @@ void EstimatorNode::resetAll() {
   initializer_ = std::make_unique<StaticInitializer>(options_, setup_);
   aligner_.clear();
   last_align_try_.reset();
+  gravity_check_at_.reset();
+  gravity_checked_ = false;
   last_recovery_try_.reset();
   cur_ = Snapshot{};
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);
@@ -189,6 +191,7 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     publishPeriodic();
     return;
   }
+  if (gravity_check_at_ && t >= *gravity_check_at_ && std::holds_alternative<ImuSample>(in)) checkGravityDirection(t);
   if (t < init_time_) {
     diag_.count("before_init");
     return;

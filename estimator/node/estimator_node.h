@@ -162,6 +162,10 @@ class EstimatorNode {
   /// Feeds the aligner (and stillness) with an input in arrival order.
   void feedAligner(const EstimatorInput& in);
   void tryMotionInitialization(Timestamp t);
+  /// Once per node, a full alignment window after the first initialization: does gravity point
+  /// along −z of G as assumed? Logs the aligner's GravityCheck; an anchor frame that fits
+  /// decisively better upside down is a warning and the counter `anchor_frame_z_down`.
+  void checkGravityDirection(Timestamp t);
   InitialBelief beliefFromAlignment(const AlignmentResult& r) const;
   void updateHealth(Timestamp t);
   void tryRecover(Timestamp t);
@@ -204,6 +208,8 @@ class EstimatorNode {
   std::optional<double> last_pressure_pa_;
   HealthMonitor health_;
   std::optional<Timestamp> last_align_try_, last_recovery_try_, last_health_eval_;
+  std::optional<Timestamp> gravity_check_at_;  ///< when checkGravityDirection runs (once)
+  bool gravity_checked_ = false;
 
   Snapshot cur_;
   std::deque<Entry> history_;

@@ -41,6 +41,7 @@ void EstimatorNode::feedInitializer(const EstimatorInput& in) {
 }
 
 void EstimatorNode::initialize(const InitialBelief& b) {
+  if (!gravity_checked_ && !gravity_check_at_) gravity_check_at_ = b.t + Duration::fromSec(options_.init.motion_window_s);
   auto filter = makeStrategy(options_);
   filter->reset(setup_.imu_id, b.imu, b.cov, b.t);
   if (options_.baro.enabled && b.baro_reference_pa) {
@@ -189,6 +190,29 @@ void EstimatorNode::tryMotionInitialization(Timestamp t) {
     return;
   }
   initialize(beliefFromAlignment(*r));
+}
+
+void EstimatorNode::checkGravityDirection(Timestamp t) {
+  gravity_check_at_.reset();
+  gravity_checked_ = true;
+  const auto c = cur_.filter ? aligner_.checkGravityDirection(cur_.filter->state().imu.bias_gyro_rad_s)
+                             : aligner_.checkGravityDirection(Eigen::Vector3d::Zero());
+  if (!c) {
+    spdlog::info("estimator: gravity direction not checked at t={}: {}", formatSeconds(t), aligner_.reason());
+    return;
+  }
+  const std::string costs = fmt::format("cost {:.1f} with gravity along -z, {:.1f} along +z, margin {:.1f}, {} ranges",
+                                        c->cost_z_up, c->cost_z_down, c->margin, c->n_ranges);
+  if (c->zDown()) {
+    diag_.count("anchor_frame_z_down");
+    spdlog::warn(
+        "estimator: at t={} the anchors' frame G fits the IMU upside down ({}): its z axis seems to point down, "
+        "but the estimator assumes gravity along -z of G; expect poor estimates (docs/real_data.md)",
+        formatSeconds(t), costs);
+  } else {
+    spdlog::info("estimator: gravity direction at t={}: {} ({})", formatSeconds(t),
+                 c->zUp() ? "along -z of G as assumed" : "undecided", costs);
+  }
 }
 
 InitialBelief EstimatorNode::beliefFromAlignment(const AlignmentResult& r) const {
