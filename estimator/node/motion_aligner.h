@@ -125,6 +125,8 @@ class MotionAligner {
   /// Compares both directions on the current window; nullopt (see `reason()`) with too little
   /// data, with heights (their floor model assumes z up) or when a fit fails.
   std::optional<GravityCheck> checkGravityDirection(const Eigen::Vector3d& bias_gyro_rad_s);
+  /// From now on `solve` fits gravity along +z of G (true) or −z (false, the default).
+  void setGravityAlongPlusZ(bool plus_z) { gravity_z_sign_ = assumed_gravity_z_sign_ = plus_z ? 1.0 : -1.0; }
   /// Why the last `solve` refused.
   const std::string& reason() const { return reason_; }
   /// Data span currently held [s].
@@ -188,11 +190,11 @@ class MotionAligner {
                                         const Unknowns& x, const Info& info, const Increments& end,
                                         const Eigen::Vector3d& bias_gyro);
 
-  /// g = (0, 0, sign·|g|) in G: −1 everywhere but inside `checkGravityDirection`.
+  /// g = (0, 0, sign·|g|) in G: the assumed sign everywhere but inside `checkGravityDirection`.
   Eigen::Vector3d gravityG() const { return {0.0, 0.0, gravity_z_sign_ * options_.gravity_m_s2}; }
 
   MotionAlignerOptions options_;
-  double gravity_z_sign_ = -1.0;
+  double gravity_z_sign_ = -1.0, assumed_gravity_z_sign_ = -1.0;
   std::map<SensorId, Eigen::Vector3d> tags_p_TinI_;
   std::deque<ImuSample> imu_;
   std::deque<AlignRange> ranges_;

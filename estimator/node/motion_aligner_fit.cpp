@@ -292,7 +292,7 @@ std::optional<MotionAligner::GravityCheck> MotionAligner::checkGravityDirection(
     }
     (sign < 0.0 ? check.cost_z_up : check.cost_z_down) = best;
   }
-  gravity_z_sign_ = -1.0;
+  gravity_z_sign_ = assumed_gravity_z_sign_;
   if (!std::isfinite(check.cost_z_up) || !std::isfinite(check.cost_z_down)) {
     reason_ = "gravity check: no fit converged";
     return std::nullopt;

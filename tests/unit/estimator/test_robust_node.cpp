@@ -326,3 +326,35 @@ TEST(RobustNode, MalformedCheckpointIsRefusedNamingFileAndKey) {
   }
   EXPECT_FALSE(readCheckpoint(dir + "/absent").has_value());
 }
+
+// The hand-held walk with its anchors given in a frame whose z axis points down (half a turn about
+// x, as ISAS-Walk1's RTLS frame): a window after initializing, the node finds gravity along +z of
+// that frame, re-initializes with it and then tracks the walk as in the true frame. In the true
+// frame nothing is flipped. Without baro (a baro measures along −z and keeps the convention).
+TEST(RobustNode, UpsideDownAnchorFrameIsDetectedAndTakenAsItIs) {
+  sim::SimulationOptions so;
+  so.seed = 11;
+  so.trajectory_kind = sim::TrajectoryKind::Walk;
+  so.hall_size_m = Eigen::Vector3d(10, 8, 3);
+  so.anchor_layout = sim::AnchorLayoutKind::Walls;
+  so.n_known_anchors = 4;
+  so.n_unknown_anchors = 0;
+  so.duration_s = 60.0;
+  auto r = sim::ScenarioSimulator(so).run();
+  r.dataset.baro.clear();
+  const Eigen::Matrix3d R_flip = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+  for (const bool upside_down : {false, true}) {
+    Dataset ds = r.dataset;
+    if (upside_down) {
+      for (auto& [id, p] : ds.setup.abs_anchor_positions) p = R_flip * p;
+      for (PoseSample& g : ds.ground_truth) g.p_IinG = R_flip * g.p_IinG;
+    }
+    EstimatorNode node(EstimatorOptions{}, ds.setup);
+    const RunResult res = run(node, ds, 35.0, [](EstimatorNode&, Timestamp) {});
+    ASSERT_TRUE(node.initialized()) << node.waitingFor();
+    EXPECT_EQ(node.diagnostics().get("anchor_frame_z_down"), upside_down ? 1 : 0);
+    EXPECT_EQ(node.diagnostics().get("gravity_flip"), upside_down ? 1 : 0);
+    EXPECT_LT(res.max_error_after_m, 0.6) << (upside_down ? "upside down" : "true frame");
+    EXPECT_NE(res.final_health, Health::Lost);
+  }
+}
