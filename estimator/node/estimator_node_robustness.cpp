@@ -41,7 +41,8 @@ void EstimatorNode::feedInitializer(const EstimatorInput& in) {
 }
 
 void EstimatorNode::initialize(const InitialBelief& b) {
-  if (gravity_checks_ == 0 && !gravity_check_at_) gravity_check_at_ = b.t + Duration::fromSec(options_.init.motion_window_s);
+  if (gravity_checks_ == 0 && !gravity_check_at_)
+    gravity_check_at_ = b.t + Duration::fromSec(options_.init.motion_window_s);
   auto filter = makeStrategy(options_, gravity_z_sign_);
   filter->reset(setup_.imu_id, b.imu, b.cov, b.t);
   if (options_.baro.enabled && b.baro_reference_pa) {
@@ -206,7 +207,10 @@ void EstimatorNode::checkGravityDirection(Timestamp t) {
                                         c->cost_z_up, c->cost_z_down, c->margin, c->n_ranges);
   if (c->zDown()) {
     diag_.count("anchor_frame_z_down");
-    if (last_pressure_pa_ || last_align_height_) {
+    const bool vertical_sensor = last_pressure_pa_ || last_align_height_ ||
+                                 (cur_.filter && (!cur_.filter->state().baro_bias_m.empty() ||
+                                                  !cur_.filter->state().height_bias_m.empty()));
+    if (vertical_sensor) {
       spdlog::warn(
           "estimator: at t={} the anchors' frame G fits the IMU upside down ({}), but baro or heights measure along "
           "-z: kept gravity along -z of G; expect poor estimates (docs/real_data.md)",

@@ -163,8 +163,9 @@ std::vector<MotionAligner::Unknowns> MotionAligner::starts(const std::vector<Obs
       (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
           .toRotationMatrix();
   // Gravity along +z of G: the specific force at rest points along −z, half a turn about x.
-  const Eigen::Matrix3d R_up = gravity_z_sign_ > 0.0 ? Eigen::Matrix3d(Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal())
-                                                     : Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d R_up = gravity_z_sign_ > 0.0
+                                   ? Eigen::Matrix3d(Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal())
+                                   : Eigen::Matrix3d::Identity();
   std::vector<Unknowns> out;
   for (const Eigen::Vector3d& p : positions)
     for (int k = 0; k < options_.yaw_starts; ++k) {

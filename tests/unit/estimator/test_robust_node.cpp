@@ -25,6 +25,19 @@ sim::SimulationResult simulate(uint64_t seed, double duration_s = 80.0) {
   return sim::ScenarioSimulator(so).run();
 }
 
+/// A 60 s hand-held walk (one tag) in a 10 × 8 × 3 m hall with four known anchors on the walls.
+sim::SimulationResult handheldWalk() {
+  sim::SimulationOptions so;
+  so.seed = 11;
+  so.trajectory_kind = sim::TrajectoryKind::Walk;
+  so.hall_size_m = Eigen::Vector3d(10, 8, 3);
+  so.anchor_layout = sim::AnchorLayoutKind::Walls;
+  so.n_known_anchors = 4;
+  so.n_unknown_anchors = 0;
+  so.duration_s = 60.0;
+  return sim::ScenarioSimulator(so).run();
+}
+
 /// Runs `ds` through a node; `hook(node, t)` after every input. Returns the position error at
 /// the end and records the largest error after `t_check`.
 struct RunResult {
@@ -130,15 +143,7 @@ TEST(RobustNode, OneTagWithoutPadPriorWaitsForMotionThenStaysConsistent) {
 }
 
 TEST(RobustNode, HandheldWalkInitializesWithoutALandedPhase) {
-  sim::SimulationOptions so;
-  so.seed = 11;
-  so.trajectory_kind = sim::TrajectoryKind::Walk;
-  so.hall_size_m = Eigen::Vector3d(10, 8, 3);
-  so.anchor_layout = sim::AnchorLayoutKind::Walls;
-  so.n_known_anchors = 4;
-  so.n_unknown_anchors = 0;
-  so.duration_s = 60.0;
-  const auto r = sim::ScenarioSimulator(so).run();
+  const auto r = handheldWalk();
   ASSERT_TRUE(r.dataset.flight_states.empty());
   ASSERT_FALSE(r.dataset.setup.initial_pose);
   EstimatorNode node(EstimatorOptions{}, r.dataset.setup);
@@ -332,15 +337,7 @@ TEST(RobustNode, MalformedCheckpointIsRefusedNamingFileAndKey) {
 // that frame, re-initializes with it and then tracks the walk as in the true frame. In the true
 // frame nothing is flipped. Without baro (a baro measures along −z and keeps the convention).
 TEST(RobustNode, UpsideDownAnchorFrameIsDetectedAndTakenAsItIs) {
-  sim::SimulationOptions so;
-  so.seed = 11;
-  so.trajectory_kind = sim::TrajectoryKind::Walk;
-  so.hall_size_m = Eigen::Vector3d(10, 8, 3);
-  so.anchor_layout = sim::AnchorLayoutKind::Walls;
-  so.n_known_anchors = 4;
-  so.n_unknown_anchors = 0;
-  so.duration_s = 60.0;
-  auto r = sim::ScenarioSimulator(so).run();
+  auto r = handheldWalk();
   r.dataset.baro.clear();
   const Eigen::Matrix3d R_flip = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
   for (const bool upside_down : {false, true}) {
