@@ -226,7 +226,7 @@ TEST(LcmNode, BurstIsNotDropped) {
   int typed = 0, raw = 0;
   node.subscribe<ImuSample>(channels::kImu, [&](const ImuSample&) { ++typed; });
   node.subscribeRaw(".*", [&](const lcm::ReceiveBuffer&, const std::string&) { ++raw; });
-  for (int i = 0; i < 500; ++i) node.publish(channels::kImu, ImuSample{Timestamp{i}, {}, {}});
+  for (int i = 0; i < 500; ++i) node.publish(channels::kImu, ImuSample{Timestamp{i}});  // explicit {} would leave Eigen uninitialized
   drain(node);
   EXPECT_EQ(typed, 500);
   EXPECT_EQ(raw, 500);
