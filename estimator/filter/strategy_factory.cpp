@@ -9,14 +9,14 @@ namespace meshnav::estimator {
 
 bool strategyImplemented(const std::string& name) { return name == "centralized" || name == "dp" || name == "dah"; }
 
-std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& o) {
+std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& o, double gravity_z_sign) {
   if (o.strategy == "centralized")
-    return std::make_unique<CentralizedEkf>(ImuPropagator(o.gravity_m_s2, o.imu), o.baro.bias_rw_m_per_sqrt_s,
-                                            o.joseph_form, o.height.bias_rw_m_per_sqrt_s);
+    return std::make_unique<CentralizedEkf>(ImuPropagator(o.gravity_m_s2, o.imu, gravity_z_sign),
+                                            o.baro.bias_rw_m_per_sqrt_s, o.joseph_form, o.height.bias_rw_m_per_sqrt_s);
   if (o.strategy == "dp" || o.strategy == "dah")
     return std::make_unique<ModularFilter>(o.strategy == "dp" ? ModularFilter::Mode::DP : ModularFilter::Mode::DAH,
-                                           ImuPropagator(o.gravity_m_s2, o.imu), o.baro.bias_rw_m_per_sqrt_s,
-                                           o.joseph_form, o.height.bias_rw_m_per_sqrt_s);
+                                           ImuPropagator(o.gravity_m_s2, o.imu, gravity_z_sign),
+                                           o.baro.bias_rw_m_per_sqrt_s, o.joseph_form, o.height.bias_rw_m_per_sqrt_s);
   throw std::invalid_argument("unknown strategy '" + o.strategy + "'");
 }
 

@@ -11,7 +11,7 @@ namespace meshnav::estimator {
 
 /// True for strategies this build implements ("centralized", "dp", "dah").
 bool strategyImplemented(const std::string& name);
-/// Throws std::invalid_argument for unknown strategies.
-std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& options);
+/// Throws std::invalid_argument for unknown strategies. `gravity_z_sign`: see ImuPropagator.
+std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& options, double gravity_z_sign = -1.0);
 
 }  // namespace meshnav::estimator

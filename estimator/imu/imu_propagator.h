@@ -18,18 +18,22 @@ namespace meshnav::estimator {
 
 class ImuPropagator {
  public:
-  ImuPropagator(double gravity_m_s2, const ImuNoiseOptions& noise) : gravity_m_s2_(gravity_m_s2), noise_(noise) {}
+  /// `gravity_z_sign` −1: gravity along −z of G (z up, the convention); +1: an anchor frame whose z
+  /// axis points down (EstimatorNode::checkGravityDirection).
+  ImuPropagator(double gravity_m_s2, const ImuNoiseOptions& noise, double gravity_z_sign = -1.0)
+      : gravity_m_s2_(gravity_m_s2), gravity_z_sign_(gravity_z_sign), noise_(noise) {}
 
   /// Propagates `x` over `dt_s` with constant readings; fills Φ and Q when non-null.
   void propagate(ImuState& x, const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, double dt_s,
                  ImuMatrix* Phi, ImuMatrix* Q) const;
 
   /// Gravity in G [m/s²].
-  Eigen::Vector3d gravity_G() const { return {0.0, 0.0, -gravity_m_s2_}; }
+  Eigen::Vector3d gravity_G() const { return {0.0, 0.0, gravity_z_sign_ * gravity_m_s2_}; }
   const ImuNoiseOptions& noise() const { return noise_; }
 
  private:
   double gravity_m_s2_;
+  double gravity_z_sign_;
   ImuNoiseOptions noise_;
 };
 

@@ -125,6 +125,13 @@ void EstimatorNode::resetAll() {
   initializer_ = std::make_unique<StaticInitializer>(options_, setup_);
   aligner_.clear();
   last_align_try_.reset();
+  gravity_check_at_.reset();
+  gravity_checks_ = 0;
+  gravity_z_sign_ = -1.0;
+  gravity_flip_pending_ = false;
+  last_flip_try_.reset();
+  aligner_.setGravityAlongPlusZ(false);
+  zupt_model_ = ZuptModel(Eigen::Vector3d(0.0, 0.0, -options_.gravity_m_s2));
   last_recovery_try_.reset();
   cur_ = Snapshot{};
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);
@@ -228,6 +235,10 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     feedInitializer(in);
     publishPeriodic();
     return;
+  }
+  if (std::holds_alternative<ImuSample>(in)) {
+    if (gravity_check_at_ && t >= *gravity_check_at_) checkGravityDirection(t);
+    if (gravity_flip_pending_ && (!last_flip_try_ || (t - *last_flip_try_).sec() >= 0.5)) adoptGravityAlongPlusZ(t);
   }
   if (t < init_time_) {
     diag_.count("before_init");

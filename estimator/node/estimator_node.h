@@ -174,6 +174,17 @@ class EstimatorNode {
   /// Feeds the aligner (and stillness) with an input in arrival order.
   void feedAligner(const EstimatorInput& in);
   void tryMotionInitialization(Timestamp t);
+  /// A full alignment window after the first initialization (not earlier: a window that still
+  /// held the rest before a hand-held start chose the wrong side on ISAS-Walk1), and again a
+  /// window later while undecided (at most kMaxGravityChecks times): does gravity point along −z
+  /// of G as assumed? Logs the aligner's GravityCheck. An anchor frame that fits decisively
+  /// better upside down (counter `anchor_frame_z_down`) is taken as it is: without baro and
+  /// heights (which measure along −z), the filter is re-initialized by the aligner with gravity
+  /// along +z of G and propagates with it from then on (`adoptGravityAlongPlusZ`).
+  void checkGravityDirection(Timestamp t);
+  /// Re-initializes the pose with gravity along +z (anchors and biases kept, as a recovery);
+  /// retried every 0.5 s while the aligner refuses.
+  void adoptGravityAlongPlusZ(Timestamp t);
   InitialBelief beliefFromAlignment(const AlignmentResult& r) const;
   void updateHealth(Timestamp t);
   void tryRecover(Timestamp t);
@@ -220,6 +231,12 @@ class EstimatorNode {
   std::optional<double> last_pressure_pa_;
   HealthMonitor health_;
   std::optional<Timestamp> last_align_try_, last_recovery_try_, last_health_eval_;
+  std::optional<Timestamp> gravity_check_at_;  ///< when checkGravityDirection runs (once)
+  int gravity_checks_ = 0;
+  static constexpr int kMaxGravityChecks = 3;
+  double gravity_z_sign_ = -1.0;  ///< gravity along −z of G (−1, the convention) or +z (+1)
+  bool gravity_flip_pending_ = false;
+  std::optional<Timestamp> last_flip_try_;
 
   Snapshot cur_;
   std::deque<Entry> history_;

@@ -107,7 +107,9 @@ void EstimatorNode::logInitialization(const InitialBelief& b) const {
 }
 
 void EstimatorNode::initialize(const InitialBelief& b) {
-  auto filter = makeStrategy(options_);
+  if (gravity_checks_ == 0 && !gravity_check_at_)
+    gravity_check_at_ = b.t + Duration::fromSec(options_.init.motion_window_s);
+  auto filter = makeStrategy(options_, gravity_z_sign_);
   filter->reset(setup_.imu_id, b.imu, b.cov, b.t);
   if (options_.baro.enabled && b.baro_reference_pa) {
     baro_reference_pa_ = b.baro_reference_pa;
@@ -220,6 +222,62 @@ void EstimatorNode::tryMotionInitialization(Timestamp t) {
     return;
   }
   initialize(beliefFromAlignment(*r));
+}
+
+void EstimatorNode::checkGravityDirection(Timestamp t) {
+  gravity_check_at_.reset();
+  ++gravity_checks_;
+  const auto c = cur_.filter ? aligner_.checkGravityDirection(cur_.filter->state().imu.bias_gyro_rad_s)
+                             : aligner_.checkGravityDirection(Eigen::Vector3d::Zero());
+  if (!c) {
+    spdlog::info("estimator: gravity direction not checked at t={}: {}", formatSeconds(t), aligner_.reason());
+    if (gravity_checks_ < kMaxGravityChecks) gravity_check_at_ = t + Duration::fromSec(options_.init.motion_window_s);
+    return;
+  }
+  const std::string costs = fmt::format("cost {:.1f} with gravity along -z, {:.1f} along +z, margin {:.1f}, {} ranges",
+                                        c->cost_z_up, c->cost_z_down, c->margin, c->n_ranges);
+  if (c->zDown()) {
+    diag_.count("anchor_frame_z_down");
+    const bool vertical_sensor = last_pressure_pa_ || last_align_height_ ||
+                                 (cur_.filter && (!cur_.filter->state().baro_bias_m.empty() ||
+                                                  !cur_.filter->state().height_bias_m.empty()));
+    if (vertical_sensor) {
+      spdlog::warn(
+          "estimator: at t={} the anchors' frame G fits the IMU upside down ({}), but baro or heights measure along "
+          "-z: kept gravity along -z of G; expect poor estimates (docs/real_data.md)",
+          formatSeconds(t), costs);
+      return;
+    }
+    spdlog::warn("estimator: at t={} the anchors' frame G fits the IMU upside down ({}): its z axis points down; "
+                 "gravity is taken along +z of G from now on (docs/real_data.md)",
+                 formatSeconds(t), costs);
+    gravity_z_sign_ = 1.0;
+    aligner_.setGravityAlongPlusZ(true);
+    zupt_model_ = ZuptModel(Eigen::Vector3d(0.0, 0.0, options_.gravity_m_s2));
+    gravity_flip_pending_ = true;
+    adoptGravityAlongPlusZ(t);
+  } else {
+    spdlog::info("estimator: gravity direction at t={}: {} ({})", formatSeconds(t),
+                 c->zUp() ? "along -z of G as assumed" : "undecided", costs);
+    // Undecided (little motion in the window): again a window later, at most kMaxGravityChecks times.
+    if (!c->zUp() && gravity_checks_ < kMaxGravityChecks)
+      gravity_check_at_ = t + Duration::fromSec(options_.init.motion_window_s);
+  }
+}
+
+void EstimatorNode::adoptGravityAlongPlusZ(Timestamp t) {
+  last_flip_try_ = t;
+  const auto r = aligner_.solve(cur_.filter->state().imu.bias_gyro_rad_s);
+  if (!r) {
+    diag_.count("gravity_flip_refused");
+    return;
+  }
+  gravity_flip_pending_ = false;
+  replaceImu(r->imu, r->cov, r->t, r->last_imu);
+  diag_.count("gravity_flip");
+  spdlog::warn("estimator: re-initialized at t={} with gravity along +z of G from {} ranges (σ_p {:.2f} m, σ_yaw "
+               "{:.1f} deg); anchors and bias states kept",
+               formatSeconds(r->t), r->n_ranges, r->sigma_p_m, r->sigma_yaw_deg);
 }
 
 InitialBelief EstimatorNode::beliefFromAlignment(const AlignmentResult& r) const {
@@ -337,7 +395,7 @@ void EstimatorNode::tryRecover(Timestamp t) {
 void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu) {
   const FusionStrategy& old = *cur_.filter;
   const NominalState& s = old.state();
-  auto f = makeStrategy(options_);
+  auto f = makeStrategy(options_, gravity_z_sign_);
   f->reset(setup_.imu_id, x, P, t);
   // The baro bias may have absorbed the runaway: keep its mean, widen it to the init σ.
   for (const auto& [id, b] : s.baro_bias_m)

@@ -152,7 +152,7 @@ std::vector<MotionAligner::Obs> MotionAligner::buildObservations(const Eigen::Ve
 }
 
 double MotionAligner::residual(const Obs& o, const Unknowns& x) const {
-  const Eigen::Vector3d g(0.0, 0.0, -options_.gravity_m_s2);
+  const Eigen::Vector3d g = gravityG();
   const double tau = o.inc.tau_s;
   const Eigen::Vector3d p_TinG =
       x.p0 + x.v0 * tau + 0.5 * g * tau * tau + x.R0 * bodyTerm(o.inc, x, tags_p_TinI_.at(o.r.tag));
@@ -163,7 +163,7 @@ Eigen::Matrix<double, 1, 16> MotionAligner::jacobian(const Obs& o, const Unknown
   // r = d − ‖p_A − p_T‖: ∂r/∂p_T = uᵀ with u the unit vector from the tag to the anchor;
   // ∂p_T/∂[p₀, v₀, δθ, b_a, δb_ω] = [I, τ I, −R₀[w]×, −R₀ M, R₀ (J_S − C[p_TinI]× J_C)],
   // w = S − M b_a + C p_TinI (the J_C term to first order around the current δb_ω).
-  const Eigen::Vector3d g(0.0, 0.0, -options_.gravity_m_s2);
+  const Eigen::Vector3d g = gravityG();
   const double tau = o.inc.tau_s;
   const Eigen::Vector3d& lever = tags_p_TinI_.at(o.r.tag);
   const Eigen::Vector3d w = bodyTerm(o.inc, x, lever);
@@ -181,7 +181,7 @@ Eigen::Matrix<double, 1, 16> MotionAligner::jacobian(const Obs& o, const Unknown
 }
 
 double MotionAligner::residual(const HeightObs& o, const Unknowns& x) const {
-  const Eigen::Vector3d g(0.0, 0.0, -options_.gravity_m_s2);
+  const Eigen::Vector3d g = gravityG();
   const double tau = o.inc.tau_s;
   const Eigen::Vector3d s = x.p0 + x.v0 * tau + 0.5 * g * tau * tau + x.R0 * bodyTerm(o.inc, x, options_.p_IH);
   const double c = options_.height_tilt_correction ? (x.R0 * o.inc.C * so3::expMap(o.inc.JC * x.dbg))(2, 2) : 1.0;
@@ -192,7 +192,7 @@ Eigen::Matrix<double, 1, 16> MotionAligner::jacobian(const HeightObs& o, const U
   // ĥ = s_z / c + b_H with s = p₀ + v₀τ + ½gτ² + R₀ w (w as for a tag, lever p_IH), c = e_zᵀ R₀ C e_z:
   // ∂s_z = e_zᵀ [I, τ I, −R₀[w]×, −R₀ M, R₀ (J_S − C[p_IH]× J_C)],
   // ∂c/∂δθ = −e_zᵀ R₀ [C e_z]×, ∂c/∂δb_ω = −e_zᵀ R₀ C [e_z]× J_C; r = h − ĥ, so J = −∂ĥ.
-  const Eigen::Vector3d g(0.0, 0.0, -options_.gravity_m_s2);
+  const Eigen::Vector3d g = gravityG();
   const double tau = o.inc.tau_s;
   const Eigen::Vector3d& lever = options_.p_IH;
   const Eigen::Vector3d w = bodyTerm(o.inc, x, lever);

@@ -107,6 +107,26 @@ class MotionAligner {
   void clear();
   /// Fits the current window; nullopt (see `reason()`) while the pose is not determined.
   std::optional<AlignmentResult> solve(const Eigen::Vector3d& bias_gyro_rad_s);
+  /// Which way gravity points in G, by the data. The estimator assumes −z (z up); an anchor
+  /// frame whose z axis points down (ISAS-Walk1's RTLS frame, docs/real_data.md) fits the ranges
+  /// and accelerations of a window better with gravity along +z. Both are fitted from the same
+  /// starts on every range of the window; costs in units of the residuals' own scatter as for
+  /// the ambiguity check (margin = `ambiguity_chi2` × the robust variance factor of the z-up fit).
+  struct GravityCheck {
+    double cost_z_up = 0.0;    ///< best cost with gravity along −z of G [-]
+    double cost_z_down = 0.0;  ///< best cost with gravity along +z of G [-]
+    double margin = 0.0;       ///< a difference beyond this is decisive [-]
+    int n_ranges = 0;
+    /// +z fits decisively better: the anchors' frame has its z axis pointing down.
+    bool zDown() const { return cost_z_up - cost_z_down > margin; }
+    /// −z fits decisively better (the estimator's convention holds).
+    bool zUp() const { return cost_z_down - cost_z_up > margin; }
+  };
+  /// Compares both directions on the current window; nullopt (see `reason()`) with too little
+  /// data, with heights (their floor model assumes z up) or when a fit fails.
+  std::optional<GravityCheck> checkGravityDirection(const Eigen::Vector3d& bias_gyro_rad_s);
+  /// From now on `solve` fits gravity along +z of G (true) or −z (false, the default).
+  void setGravityAlongPlusZ(bool plus_z) { gravity_z_sign_ = assumed_gravity_z_sign_ = plus_z ? 1.0 : -1.0; }
   /// Why the last `solve` refused.
   const std::string& reason() const { return reason_; }
   /// Data span currently held [s].
@@ -170,7 +190,11 @@ class MotionAligner {
                                         const Unknowns& x, const Info& info, const Increments& end,
                                         const Eigen::Vector3d& bias_gyro);
 
+  /// g = (0, 0, sign·|g|) in G: the assumed sign everywhere but inside `checkGravityDirection`.
+  Eigen::Vector3d gravityG() const { return {0.0, 0.0, gravity_z_sign_ * options_.gravity_m_s2}; }
+
   MotionAlignerOptions options_;
+  double gravity_z_sign_ = -1.0, assumed_gravity_z_sign_ = -1.0;
   std::map<SensorId, Eigen::Vector3d> tags_p_TinI_;
   std::deque<ImuSample> imu_;
   std::deque<AlignRange> ranges_;

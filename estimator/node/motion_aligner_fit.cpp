@@ -120,7 +120,7 @@ double MotionAligner::fit(const std::vector<Obs>& obs, const std::vector<HeightO
 }
 
 ImuState MotionAligner::endState(const Unknowns& x, const Increments& end, const Eigen::Vector3d& bias_gyro) const {
-  const Eigen::Vector3d g(0.0, 0.0, -options_.gravity_m_s2);
+  const Eigen::Vector3d g = gravityG();
   const double T = end.tau_s;
   ImuState s;
   s.p_IinG = x.p0 + x.v0 * T + 0.5 * g * T * T + x.R0 * (end.S + end.JS * x.dbg - end.M * x.ba);
@@ -186,12 +186,16 @@ std::vector<MotionAligner::Unknowns> MotionAligner::starts(const std::vector<Obs
   const Eigen::Matrix3d R_rp =
       (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
           .toRotationMatrix();
+  // Gravity along +z of G: the specific force at rest points along −z, half a turn about x.
+  const Eigen::Matrix3d R_up = gravity_z_sign_ > 0.0
+                                   ? Eigen::Matrix3d(Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal())
+                                   : Eigen::Matrix3d::Identity();
   std::vector<Unknowns> out;
   for (const Eigen::Vector3d& p : positions)
     for (int k = 0; k < options_.yaw_starts; ++k) {
       Unknowns x;
       x.p0 = p;
-      x.R0 = rotZ(2.0 * M_PI * k / options_.yaw_starts) * R_rp;
+      x.R0 = rotZ(2.0 * M_PI * k / options_.yaw_starts) * R_up * R_rp;
       out.push_back(x);
     }
   return out;
@@ -259,6 +263,46 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
     }
   }
   return finish(obs, heights, best, info, end, bias_gyro_rad_s);
+}
+
+std::optional<MotionAligner::GravityCheck> MotionAligner::checkGravityDirection(const Eigen::Vector3d& bias_gyro_rad_s) {
+  if (spanSeconds() < options_.min_span_s) {
+    reason_ = "gravity check: too short a window";
+    return std::nullopt;
+  }
+  Increments end;
+  std::vector<HeightObs> heights;
+  std::vector<Obs> obs = buildObservations(bias_gyro_rad_s, &end, &heights);
+  if (!heights.empty()) {
+    reason_ = "gravity check: heights are in the window (their floor is below, along −z)";
+    return std::nullopt;
+  }
+  if (static_cast<int>(obs.size()) < options_.min_ranges) {
+    reason_ = "gravity check: " + std::to_string(obs.size()) + " ranges in the window";
+    return std::nullopt;
+  }
+  GravityCheck check;
+  check.n_ranges = static_cast<int>(obs.size());
+  Unknowns best_up;
+  for (const double sign : {-1.0, 1.0}) {
+    gravity_z_sign_ = sign;
+    double best = std::numeric_limits<double>::infinity();
+    for (Unknowns x : starts(obs)) {
+      const double c = fit(obs, heights, x, nullptr);
+      if (std::isfinite(c) && c < best) {
+        best = c;
+        if (sign < 0.0) best_up = x;
+      }
+    }
+    (sign < 0.0 ? check.cost_z_up : check.cost_z_down) = best;
+  }
+  gravity_z_sign_ = assumed_gravity_z_sign_;
+  if (!std::isfinite(check.cost_z_up) || !std::isfinite(check.cost_z_down)) {
+    reason_ = "gravity check: no fit converged";
+    return std::nullopt;
+  }
+  check.margin = options_.ambiguity_chi2 * robustVarianceFactor(obs, best_up);
+  return check;
 }
 
 double MotionAligner::robustVarianceFactor(const std::vector<Obs>& obs, const Unknowns& x) const {

@@ -89,10 +89,11 @@ ate_run=$(/usr/bin/python3 -c 'import sys, yaml; print(yaml.safe_load(open(sys.a
 echo "ATE (se3): LCM $ate_lcm m, in-process $ate_run m, multilateration $ate_ml m"
 # 10 %: the in-motion alignment is tried every 0.5 s on the data that has arrived, so how the two
 # bridges' messages interleave can start the filter 1.5 s earlier with another heading (measured at
-# 10x: 0.266-0.284 m against 0.283 m in one process; docs/real_data.md).
+# 10x before the gravity check: 0.266-0.284 m against 0.283 m in one process; with it 0.243 m in
+# both, docs/real_data.md).
 awk -v a="$ate_lcm" -v b="$ate_run" 'BEGIN{d = a - b; if (d < 0) d = -d; exit !(d <= 0.10 * b)}' \
   || fail "the LCM run's ATE $ate_lcm m is not within 10 % of the in-process run's $ate_run m"
-awk -v a="$ate_lcm" 'BEGIN{exit !(a > 0 && a < 0.35)}' || fail "ATE $ate_lcm m (docs/real_data.md: 0.283 m)"
+awk -v a="$ate_lcm" 'BEGIN{exit !(a > 0 && a < 0.30)}' || fail "ATE $ate_lcm m (docs/real_data.md: 0.243 m)"
 awk -v a="$ate_ml" 'BEGIN{exit !(a > 0.226 && a < 0.286)}' || fail "multilateration ATE $ate_ml m (README: 0.256 m)"
 grep -q "Plots in $D/lcm/" "$WORK/demo.log" || fail "the demo does not say where the plots are"
 for p in trajectory_xy.png position_error.png range_residuals.png; do

@@ -40,8 +40,9 @@ struct Flight {
 };
 
 /// Feeds [t0, t1] of the flight: IMU and ranges from tag 100 (only) to `anchors` every 25 ms.
+/// `R_GtoG2` re-expresses the anchors (only) in another frame G2: the ranges stay those of G.
 void feed(MotionAligner& a, const Flight& f, double t0, double t1, const std::vector<SensorId>& anchors,
-          double sigma_m, std::mt19937_64* rng) {
+          double sigma_m, std::mt19937_64* rng, const Eigen::Matrix3d& R_GtoG2 = Eigen::Matrix3d::Identity()) {
   std::normal_distribution<double> n01(0.0, 1.0);
   for (const ImuSample& s : f.imu)
     if (s.t.sec() >= t0 && s.t.sec() <= t1) a.addImu(s);
@@ -55,6 +56,7 @@ void feed(MotionAligner& a, const Flight& f, double t0, double t1, const std::ve
     r.anchor = anchor;
     r.p_AinG = f.scenario.anchors_p_AinG.at(anchor);
     r.d_m = (r.p_AinG - st.p_IinG - st.R_ItoG * f.scenario.tags_p_TinI.at(100)).norm() + (rng ? sigma_m * n01(*rng) : 0.0);
+    r.p_AinG = R_GtoG2 * r.p_AinG;
     r.sigma_m = sigma_m;
     a.addRange(r);
   }
@@ -247,4 +249,41 @@ TEST(MotionAligner, HeightsRemoveTheMirrorImageAcrossCoplanarAnchors) {
   EXPECT_LT((r1->imu.p_IinG - st.p_IinG).norm(), 3.0 * std::sqrt(3.0) * r1->sigma_p_m);
   EXPECT_LT((r1->imu.p_IinG - st.p_IinG).norm(), 0.5);
   EXPECT_GT(r1->n_heights, 25);
+}
+
+// The anchors' frame upside down (half a turn about x: z points down, as ISAS-Walk1's RTLS frame):
+// the same ranges and IMU fit decisively better with gravity along +z of that frame, and the
+// check says so; in the true frame it says the opposite. Heights (floor below, along −z) are not
+// checked.
+TEST(MotionAligner, GravityCheckFindsAnUpsideDownAnchorFrame) {
+  const Flight f(0.02, 0.002);
+  const std::map<SensorId, Eigen::Vector3d> tags{{100, sim::PaperScenario::paper().tags_p_TinI.at(100)}};
+  const Eigen::Matrix3d R_flip = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+  for (const bool upside_down : {false, true}) {
+    std::mt19937_64 rng(5);
+    MotionAligner a(MotionAlignerOptions{}, tags);
+    feed(a, f, 40.0, 52.0, {101, 102, 103, 104}, 0.1, &rng,
+         upside_down ? R_flip : Eigen::Matrix3d::Identity());
+    const auto c = a.checkGravityDirection(Eigen::Vector3d::Zero());
+    ASSERT_TRUE(c) << a.reason();
+    EXPECT_EQ(c->zDown(), upside_down) << c->cost_z_up << " vs " << c->cost_z_down << ", margin " << c->margin;
+    EXPECT_EQ(c->zUp(), !upside_down) << c->cost_z_up << " vs " << c->cost_z_down << ", margin " << c->margin;
+    EXPECT_EQ(c->n_ranges, 400);  // about 480 ranges in the window, thinned evenly to the fit's bound
+    // The check leaves the aligner's convention alone: a solve afterwards is the one without it.
+    if (!upside_down) {
+      std::mt19937_64 rng2(5);
+      MotionAligner fresh(MotionAlignerOptions{}, tags);
+      feed(fresh, f, 40.0, 52.0, {101, 102, 103, 104}, 0.1, &rng2);
+      const auto res = a.solve(Eigen::Vector3d::Zero());
+      const auto ref = fresh.solve(Eigen::Vector3d::Zero());
+      ASSERT_TRUE(res && ref) << a.reason();
+      EXPECT_EQ(res->imu.p_IinG, ref->imu.p_IinG);
+      EXPECT_EQ(res->imu.q_ItoG.coeffs(), ref->imu.q_ItoG.coeffs());
+    }
+  }
+  MotionAligner with_heights(MotionAlignerOptions{}, tags);
+  feed(with_heights, f, 40.0, 52.0, {101, 102, 103, 104}, 0.1, nullptr);
+  with_heights.addHeight({Timestamp::fromSec(45.0), 3.0, 0.05});
+  EXPECT_FALSE(with_heights.checkGravityDirection(Eigen::Vector3d::Zero()));
+  EXPECT_NE(with_heights.reason().find("heights"), std::string::npos) << with_heights.reason();
 }

@@ -25,6 +25,7 @@ sim::SimulationResult simulate(uint64_t seed, double duration_s = 80.0) {
   return sim::ScenarioSimulator(so).run();
 }
 
+/// A 60 s hand-held walk (one tag) in a 10 × 8 × 3 m hall with four known anchors on the walls.
 /// Runs `ds` through a node; `hook(node, t)` after every input. Returns the position error at
 /// the end and records the largest error after `t_check`.
 struct RunResult {
@@ -63,6 +64,11 @@ sim::SimulationOptions walk(uint64_t seed, const Eigen::Vector3d& hall_m, sim::A
   so.n_unknown_anchors = 0;
   so.duration_s = duration_s;
   return so;
+}
+
+/// The hand-held walk of several tests: four known anchors on the walls of a 10 × 8 × 3 m hall.
+sim::SimulationResult handheldWalk() {
+  return sim::ScenarioSimulator(walk(11, Eigen::Vector3d(10, 8, 3), sim::AnchorLayoutKind::Walls, 4, 60.0)).run();
 }
 
 }  // namespace
@@ -144,7 +150,7 @@ TEST(RobustNode, OneTagWithoutPadPriorWaitsForMotionThenStaysConsistent) {
 }
 
 TEST(RobustNode, HandheldWalkInitializesWithoutALandedPhase) {
-  const auto r = sim::ScenarioSimulator(walk(11, Eigen::Vector3d(10, 8, 3), sim::AnchorLayoutKind::Walls, 4, 60.0)).run();
+  const auto r = handheldWalk();
   ASSERT_TRUE(r.dataset.flight_states.empty());
   ASSERT_FALSE(r.dataset.setup.initial_pose);
   EstimatorNode node(EstimatorOptions{}, r.dataset.setup);
@@ -409,4 +415,30 @@ TEST(RobustNode, MalformedCheckpointIsRefusedNamingFileAndKey) {
     EXPECT_NE(std::string(e.what()).find("p_IinG"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(readCheckpoint(dir + "/absent").has_value());
+}
+
+// The hand-held walk with its anchors given in a frame whose z axis points down (half a turn about
+// x, as ISAS-Walk1's RTLS frame): a window after initializing, the node finds gravity along +z of
+// that frame, re-initializes with it and then tracks the walk as in the true frame. In the true
+// frame nothing is flipped. Without baro (a baro measures along −z and keeps the convention).
+TEST(RobustNode, UpsideDownAnchorFrameIsDetectedAndTakenAsItIs) {
+  auto r = handheldWalk();
+  r.dataset.baro.clear();
+  // A carried height is stated above a floor at z = 0 of a z-up frame: without it here.
+  r.dataset.setup.carried_height.reset();
+  const Eigen::Matrix3d R_flip = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+  for (const bool upside_down : {false, true}) {
+    Dataset ds = r.dataset;
+    if (upside_down) {
+      for (auto& [id, p] : ds.setup.abs_anchor_positions) p = R_flip * p;
+      for (PoseSample& g : ds.ground_truth) g.p_IinG = R_flip * g.p_IinG;
+    }
+    EstimatorNode node(EstimatorOptions{}, ds.setup);
+    const RunResult res = run(node, ds, 35.0, [](EstimatorNode&, Timestamp) {});
+    ASSERT_TRUE(node.initialized()) << node.waitingFor();
+    EXPECT_EQ(node.diagnostics().get("anchor_frame_z_down"), upside_down ? 1 : 0);
+    EXPECT_EQ(node.diagnostics().get("gravity_flip"), upside_down ? 1 : 0);
+    EXPECT_LT(res.max_error_after_m, 0.6) << (upside_down ? "upside down" : "true frame");
+    EXPECT_NE(res.final_health, Health::Lost);
+  }
 }
