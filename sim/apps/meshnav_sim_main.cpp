@@ -39,7 +39,8 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
   cli.optional("out", c.out, "output dataset folder (created if needed)")->type_name("DIR")->required();
   cli.optional("trajectory", c.trajectory,
                "spiral|figure8|lawnmower|helix|hover|walk (default spiral: the paper's flight). hover starts in the "
-               "air; walk is a hand-held rig at 0.9-1.5 m with no take-off, no landed state and no barometer")
+               "air; walk is a hand-held rig at 0.9-1.5 m with no take-off, no landed state and no barometer "
+               "(setup.yaml states its carried height, 1.2 +- 0.3 m)")
       ->type_name("KIND")
       ->group("Scenario (default: the paper's)");
   cli.optional("hall", c.hall,
