@@ -132,7 +132,7 @@ class ProcSpec:
             raise LaunchError('%s: each process must be a map' % where)
         unknown = set(d) - self.KEYS
         if unknown:
-            raise LaunchError('%s: unknown process key(s) %s' % (where, ', '.join(sorted(unknown))))
+            raise LaunchError('%s: unknown process key(s) %s' % (where, ', '.join(sorted(map(repr, unknown)))))
         for k in ('name', 'command'):
             if not d.get(k):
                 raise LaunchError('%s: process needs %r' % (where, k))
@@ -207,7 +207,8 @@ class Launch:
             raise LaunchError('%s: expected a map with processes:' % path)
         unknown = set(doc) - self.KEYS
         if unknown:
-            raise LaunchError('%s: unknown key(s) %s' % (path, ', '.join(sorted(unknown))))
+            # repr: YAML keys need not be strings (`yes:` is a bool, `1:` an int)
+            raise LaunchError('%s: unknown key(s) %s' % (path, ', '.join(sorted(map(repr, unknown)))))
         # Built-in T0_UTIME: a wall time shortly after the launch [us since the Unix epoch], for
         # bridges that replay in step (--t0-utime ${T0_UTIME}); VAR=value or the environment win.
         margin = _number(doc, 't0_margin', 3.0, path, minimum=0.0)

@@ -136,7 +136,10 @@ class Substitution(unittest.TestCase):
                           ('stop_timeout:\nprocesses:\n  - {name: a, command: x}\n', 'stop_timeout must be a number'),
                           ('processes:\n  - {name: a, command: x, delay: soon}\n', 'delay must be a number'),
                           ('processes:\n  - {name: a, command: x, max_respawns: -2}\n', 'max_respawns must be an integer >= -1'),
-                          ('processes:\n  - {name: a, command: x, env: [1]}\n', 'env must be a map')]:
+                          ('processes:\n  - {name: a, command: x, env: [1]}\n', 'env must be a map'),
+                          # 600 s fuzz run 2026-11-26: a key that YAML reads as a bool raised TypeError
+                          ('yes: 1\nprocesses:\n  - {name: a, command: x}\n', 'unknown key(s) True'),
+                          ('processes:\n  - {name: a, command: x, 3: y}\n', 'unknown process key(s) 3')]:
             rc, out, err = run_launch(text)
             self.assertEqual(rc, 2, text)
             self.assertIn(msg, err, text)
