@@ -143,26 +143,25 @@ std::string EstimatorNode::waitingFor() const {
   return initializer_->waitingFor() + (aligner_.reason().empty() ? "" : "; " + aligner_.reason());
 }
 
-void EstimatorNode::feedAlignerHeight(const HeightSample& h) {
-  // Usable readings only, thinned to height.align_rate_hz (a vertical constraint, not a trajectory).
-  if (!options_.height.enabled || options_.height.align_rate_hz <= 0.0 || h.range_m < options_.height.min_range_m)
-    return;
+void EstimatorNode::addAlignHeight(const AlignHeight& h) {
+  // Thinned to height.align_rate_hz: a vertical constraint, not a trajectory.
+  if (options_.height.align_rate_hz <= 0.0) return;
   if (last_align_height_ && (h.t - *last_align_height_).sec() < 1.0 / options_.height.align_rate_hz - 1e-6 &&
       h.t >= *last_align_height_)
     return;
   last_align_height_ = h.t;
-  aligner_.addHeight({h.t, h.range_m, options_.height.sigma_m});
+  aligner_.addHeight(h);
+}
+
+void EstimatorNode::feedAlignerHeight(const HeightSample& h) {
+  if (options_.height.enabled && h.range_m >= options_.height.min_range_m)  // usable readings only
+    addAlignHeight({h.t, h.range_m, options_.height.sigma_m});
 }
 
 void EstimatorNode::feedAlignerBaro(const BaroSample& b) {
-  if (options_.height.align_rate_hz <= 0.0) return;
-  if (last_align_height_ && (b.t - *last_align_height_).sec() < 1.0 / options_.height.align_rate_hz - 1e-6 &&
-      b.t >= *last_align_height_)
-    return;
-  last_align_height_ = b.t;
   const double ref = *setup_.baro_reference_pressure_pa;
   const double sigma_m = std::abs(atmosphere::dHeightDPressure(b.pressure_pa, ref)) * options_.baro.pressure_sigma_pa;
-  aligner_.addHeight({b.t, atmosphere::heightFromPressure(b.pressure_pa, ref), sigma_m});
+  addAlignHeight({b.t, atmosphere::heightFromPressure(b.pressure_pa, ref), sigma_m});
 }
 
 void EstimatorNode::feedAligner(const EstimatorInput& in) {
