@@ -116,6 +116,10 @@ void forEachRestAndHealthField(Opt& o, Visitor& v) {
   v("zupt.sigma_vel_m_s", o.zupt.sigma_vel_m_s, "sigma of v = 0 [m/s]");
   v("zupt.detect_stillness", o.zupt.detect_stillness, "without FLIGHT_STATE: ZUPT while the IMU shows rest");
   v("zupt.stillness_gate_probability", o.zupt.stillness_gate_probability, "chi^2 gate of those ZUPTs [-]");
+  v("zupt.stillness_sigma_vel_m_s", o.zupt.stillness_sigma_vel_m_s,
+    "sigma of v = 0 when only IMU stillness says rest (a smooth hover drifts) [m/s]");
+  v("zupt.stillness_sigma_gyro_rad_s", o.zupt.stillness_sigma_gyro_rad_s,
+    "sigma of omega = 0 and of the initial gyro bias on stillness alone [rad/s]");
   v("health.window_s", o.health.window_s, "innovation statistics window [s]");
   v("health.min_ranges", o.health.min_ranges, "ranges in the window before gating can mean lost [-]");
   v("health.min_anchors", o.health.min_anchors, "anchors gated alike before it means lost [-]");
@@ -247,7 +251,8 @@ void EstimatorOptions::validate() const {
        "process_noise: batch >= 5, lower_ratio in (0, 1), upper_ratio > 1, max_grow > 1, max_shrink > 1, max_scale >= 1, max_prior_ratio > 0");
   need(time.max_offset_s >= window_s && time.max_offset_s <= kMaxTimeSeconds && time.rebase_after >= 1,
        "time.max_offset_s >= window_s, time.rebase_after >= 1");
-  need(zupt.rate_hz > 0 && zupt.sigma_acc_m_s2 > 0 && zupt.sigma_gyro_rad_s > 0 && zupt.sigma_vel_m_s > 0,
+  need(zupt.rate_hz > 0 && zupt.sigma_acc_m_s2 > 0 && zupt.sigma_gyro_rad_s > 0 && zupt.sigma_vel_m_s > 0 &&
+           zupt.stillness_sigma_vel_m_s > 0 && zupt.stillness_sigma_gyro_rad_s > 0,
        "zupt rate and sigmas > 0");
 }
 

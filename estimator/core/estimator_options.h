@@ -154,6 +154,13 @@ struct ZuptOptions {
   /// filter's own velocity (probability `stillness_gate_probability`); flight-state ZUPTs are not.
   bool detect_stillness = true;
   double stillness_gate_probability = 0.999;  ///< [-]
+  /// σ of v = 0 and of ω = 0 when only the IMU's stillness says rest (no FLIGHT_STATE), also the
+  /// velocity and gyro-bias σ of a static initialization on that evidence. A smooth hover or a
+  /// slowly pushed rig is "still" to the detector while it drifts at up to about 0.1 m/s and turns
+  /// at up to the detector's mean-rate limit (0.02 rad/s); the flight-state values (σ 0.02 m/s)
+  /// pinned such a hover's velocity at zero and its range NIS at 4–8× (docs/robustness.md).
+  double stillness_sigma_vel_m_s = 0.1;      ///< [m/s]
+  double stillness_sigma_gyro_rad_s = 0.02;  ///< [rad/s]
 };
 
 /// Re-initialization when the health monitor reports `lost`.

@@ -331,9 +331,10 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
     z.t = s.t;
     z.acc_m_s2 = s.acc_m_s2;
     z.gyro_rad_s = s.gyro_rad_s;
+    // Only a flight state says v = 0 and ω = 0 exactly; IMU stillness allows a slow drift and turn.
     z.sigma_acc_m_s2 = options_.zupt.sigma_acc_m_s2;
-    z.sigma_gyro_rad_s = options_.zupt.sigma_gyro_rad_s;
-    z.sigma_vel_m_s = options_.zupt.sigma_vel_m_s;
+    z.sigma_gyro_rad_s = have_flight_state_ ? options_.zupt.sigma_gyro_rad_s : options_.zupt.stillness_sigma_gyro_rad_s;
+    z.sigma_vel_m_s = have_flight_state_ ? options_.zupt.sigma_vel_m_s : options_.zupt.stillness_sigma_vel_m_s;
     const Linearization lin = zupt_model_.linearize(z, f.state());
     const double gate = have_flight_state_ ? 0.0 : chi2Quantile(static_cast<int>(lin.residual.size()),
                                                                 options_.zupt.stillness_gate_probability);

@@ -176,10 +176,17 @@ std::optional<InitialBelief> StaticInitializer::build(const Eigen::Matrix3d& R_r
   const Eigen::Matrix3d I3 = Eigen::Matrix3d::Identity();
   b.cov.setZero();
   b.cov.block<3, 3>(ImuErr::kP, ImuErr::kP) = I3 * sigma_p * sigma_p;
-  b.cov.block<3, 3>(ImuErr::kV, ImuErr::kV) = I3 * std::pow(options_.init.sigma_v_m_s, 2);
+  // Rest known only from IMU stillness: the body may drift and turn slowly (ZuptOptions).
+  const bool on_stillness = !landed_ && still_;
+  const double sigma_v = on_stillness ? std::max(options_.init.sigma_v_m_s, options_.zupt.stillness_sigma_vel_m_s)
+                                      : options_.init.sigma_v_m_s;
+  const double sigma_bg = on_stillness
+                              ? std::max(options_.init.sigma_bias_gyro_rad_s, options_.zupt.stillness_sigma_gyro_rad_s)
+                              : options_.init.sigma_bias_gyro_rad_s;
+  b.cov.block<3, 3>(ImuErr::kV, ImuErr::kV) = I3 * sigma_v * sigma_v;
   b.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) =
       s_rp * s_rp * (I3 - n * n.transpose()) + sigma_yaw * sigma_yaw * n * n.transpose();
-  b.cov.block<3, 3>(ImuErr::kBg, ImuErr::kBg) = I3 * std::pow(options_.init.sigma_bias_gyro_rad_s, 2);
+  b.cov.block<3, 3>(ImuErr::kBg, ImuErr::kBg) = I3 * sigma_bg * sigma_bg;
   b.cov.block<3, 3>(ImuErr::kBa, ImuErr::kBa) = I3 * std::pow(options_.init.sigma_bias_acc_m_s2, 2);
 
   // Barometer: reference and bias.
