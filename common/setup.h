@@ -33,6 +33,10 @@ struct NoiseFigures {
   std::optional<double> imu_gyro_noise_density;  ///< [rad/s/√Hz]
   std::optional<double> imu_acc_bias_rw;         ///< [m/s³/√Hz]
   std::optional<double> imu_gyro_bias_rw;        ///< [rad/s²/√Hz]
+  /// σ of the biases at switch-on (datasheet "turn-on bias" or "bias repeatability"): the prior of
+  /// the bias states at initialization, instead of init.sigma_bias_acc_m_s2 / _gyro_rad_s.
+  std::optional<double> imu_acc_bias_sigma;      ///< [m/s²]
+  std::optional<double> imu_gyro_bias_sigma;     ///< [rad/s]
   std::optional<double> baro_pressure_sigma_pa;  ///< [Pa]
 };
 

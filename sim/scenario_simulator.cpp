@@ -88,6 +88,9 @@ SystemSetup makeSetup(const SimulationOptions& o, const PaperScenario& scenario,
   setup.noise.imu_gyro_noise_density = o.imu.gyro_noise_density;
   setup.noise.imu_acc_bias_rw = o.imu.acc_bias_rw;
   setup.noise.imu_gyro_bias_rw = o.imu.gyro_bias_rw;
+  // The biases' switch-on spread, as a datasheet states it (absent for an ideal IMU).
+  if (o.imu.acc_bias_initial_sigma > 0.0) setup.noise.imu_acc_bias_sigma = o.imu.acc_bias_initial_sigma;
+  if (o.imu.gyro_bias_initial_sigma > 0.0) setup.noise.imu_gyro_bias_sigma = o.imu.gyro_bias_initial_sigma;
   setup.noise.baro_pressure_sigma_pa = o.baro.pressure_sigma_pa;
   return setup;
 }

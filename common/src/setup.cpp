@@ -258,8 +258,12 @@ SystemSetup loadSetup(const std::string& path) {
   y.read("noise.imu_gyro_noise_density", s.noise.imu_gyro_noise_density);
   y.read("noise.imu_acc_bias_rw", s.noise.imu_acc_bias_rw);
   y.read("noise.imu_gyro_bias_rw", s.noise.imu_gyro_bias_rw);
+  y.read("noise.imu_acc_bias_sigma", s.noise.imu_acc_bias_sigma);
+  y.read("noise.imu_gyro_bias_sigma", s.noise.imu_gyro_bias_sigma);
   y.read("noise.baro_pressure_sigma", s.noise.baro_pressure_sigma_pa);
   for (const auto& [key, v] : {std::pair{"noise.sigma_range", s.noise.sigma_range_m},
+                               {"noise.imu_acc_bias_sigma", s.noise.imu_acc_bias_sigma},
+                               {"noise.imu_gyro_bias_sigma", s.noise.imu_gyro_bias_sigma},
                                {"noise.imu_acc_noise_density", s.noise.imu_acc_noise_density},
                                {"noise.imu_gyro_noise_density", s.noise.imu_gyro_noise_density},
                                {"noise.baro_pressure_sigma", s.noise.baro_pressure_sigma_pa}})
@@ -334,7 +338,7 @@ void saveSetup(const SystemSetup& s, const std::string& path) {
   }
   const auto& n = s.noise;
   if (n.sigma_range_m || n.imu_acc_noise_density || n.imu_gyro_noise_density || n.imu_acc_bias_rw ||
-      n.imu_gyro_bias_rw || n.baro_pressure_sigma_pa) {
+      n.imu_gyro_bias_rw || n.imu_acc_bias_sigma || n.imu_gyro_bias_sigma || n.baro_pressure_sigma_pa) {
     e << YAML::Key << "noise" << YAML::Value << YAML::BeginMap;
     auto put = [&](const char* k, const std::optional<double>& v, const char* unit) {
       if (v) e << YAML::Key << k << YAML::Value << *v << YAML::Comment(unit);
@@ -344,6 +348,8 @@ void saveSetup(const SystemSetup& s, const std::string& path) {
     put("imu_gyro_noise_density", n.imu_gyro_noise_density, "rad/s/sqrt(Hz)");
     put("imu_acc_bias_rw", n.imu_acc_bias_rw, "m/s^3/sqrt(Hz)");
     put("imu_gyro_bias_rw", n.imu_gyro_bias_rw, "rad/s^2/sqrt(Hz)");
+    put("imu_acc_bias_sigma", n.imu_acc_bias_sigma, "m/s^2, bias at switch-on (1 sigma)");
+    put("imu_gyro_bias_sigma", n.imu_gyro_bias_sigma, "rad/s, bias at switch-on (1 sigma)");
     put("baro_pressure_sigma", n.baro_pressure_sigma_pa, "Pa");
     e << YAML::EndMap;
   }

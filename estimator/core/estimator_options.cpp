@@ -261,6 +261,8 @@ void EstimatorOptions::applySetupNoise(const NoiseFigures& n) {
   if (n.imu_gyro_noise_density) imu.gyro_noise_density = *n.imu_gyro_noise_density;
   if (n.imu_acc_bias_rw) imu.acc_bias_rw = *n.imu_acc_bias_rw;
   if (n.imu_gyro_bias_rw) imu.gyro_bias_rw = *n.imu_gyro_bias_rw;
+  if (n.imu_acc_bias_sigma) init.sigma_bias_acc_m_s2 = *n.imu_acc_bias_sigma;
+  if (n.imu_gyro_bias_sigma) init.sigma_bias_gyro_rad_s = *n.imu_gyro_bias_sigma;
   if (n.baro_pressure_sigma_pa) baro.pressure_sigma_pa = *n.baro_pressure_sigma_pa;
 }
 

@@ -65,6 +65,16 @@ TEST(Setup, RoundTrip) {
   ASSERT_TRUE(rc.carried_height);
   EXPECT_DOUBLE_EQ(rc.carried_height->height_m, 1.35);
   EXPECT_DOUBLE_EQ(rc.carried_height->sigma_m, 0.25);
+  EXPECT_FALSE(rc.noise.imu_acc_bias_sigma);
+  // The IMU's switch-on bias spread, written only when given.
+  auto b = s;
+  b.noise.imu_acc_bias_sigma = 0.01;
+  b.noise.imu_gyro_bias_sigma = 5e-4;
+  saveSetup(b, (d / "bias.yaml").string());
+  const auto rb = loadSetup((d / "bias.yaml").string());
+  ASSERT_TRUE(rb.noise.imu_acc_bias_sigma && rb.noise.imu_gyro_bias_sigma);
+  EXPECT_DOUBLE_EQ(*rb.noise.imu_acc_bias_sigma, 0.01);
+  EXPECT_DOUBLE_EQ(*rb.noise.imu_gyro_bias_sigma, 5e-4);
 }
 
 TEST(Setup, ReadsThePublishedToolboxConfig) {
@@ -138,6 +148,8 @@ TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
             std::string::npos);
   EXPECT_NE(error(base + "height: {p_IH: [0, 0]}\n").find("height.p_IH"), std::string::npos);
   EXPECT_NE(error(base + "noise: {sigma_range: -0.1}\n").find("key 'noise.sigma_range' must be > 0"), std::string::npos);
+  EXPECT_NE(error(base + "noise: {imu_acc_bias_sigma: 0}\n").find("key 'noise.imu_acc_bias_sigma' must be > 0"),
+            std::string::npos);
   EXPECT_NE(error(base + "noise: {sigma_rnage: 0.1}\n").find("unknown key 'noise.sigma_rnage'"), std::string::npos);
   EXPECT_NE(error(base + "carried_height: {sigma_m: 0.3}\n").find("carried_height.height_m"), std::string::npos);
   EXPECT_NE(error(base + "carried_height: {height_m: -1}\n").find("key 'carried_height.height_m' must be a height"),

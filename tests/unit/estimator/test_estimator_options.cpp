@@ -97,6 +97,13 @@ TEST(EstimatorOptions, SetupNoiseOverridesImuAndBaro) {
   EXPECT_DOUBLE_EQ(o.imu.acc_noise_density, 0.003);
   EXPECT_DOUBLE_EQ(o.baro.pressure_sigma_pa, 1.5);
   EXPECT_DOUBLE_EQ(o.imu.gyro_noise_density, EstimatorOptions{}.imu.gyro_noise_density);
+  EXPECT_DOUBLE_EQ(o.init.sigma_bias_acc_m_s2, EstimatorOptions{}.init.sigma_bias_acc_m_s2);
+  // A datasheet's switch-on bias spread becomes the bias prior of every initialization.
+  n.imu_acc_bias_sigma = 0.01;
+  n.imu_gyro_bias_sigma = 5e-4;
+  o.applySetupNoise(n);
+  EXPECT_DOUBLE_EQ(o.init.sigma_bias_acc_m_s2, 0.01);
+  EXPECT_DOUBLE_EQ(o.init.sigma_bias_gyro_rad_s, 5e-4);
 }
 
 TEST(EstimatorOptions, Chi2Quantiles) {
