@@ -89,6 +89,14 @@ Health HealthMonitor::assess(Timestamp t, double sigma_p, std::string* why) cons
   return Health::Ok;
 }
 
+bool HealthMonitor::acceptedRangesFit(Timestamp t) const {
+  const auto it = by_type_.find("range");
+  const HealthStats range = it != by_type_.end() ? it->second : HealthStats{};
+  // Too few accepted ranges say nothing either way (MILUV: 2 of 4 in 4 s).
+  const bool nis_ok = range.n - range.n_gated >= options_.min_ranges && range.meanNis() <= options_.degraded_mean_nis;
+  return nis_ok && (t - last_accepted_range_).sec() <= options_.degraded_no_aiding_s;
+}
+
 bool HealthMonitor::evaluate(Timestamp t, double sigma_p_max_m) {
   const Timestamp oldest = t - Duration::fromSec(options_.window_s);
   while (!events_.empty() && events_.front().t < oldest) {

@@ -53,6 +53,10 @@ class HealthMonitor {
   void onUpdate(Timestamp t, const std::string& type, SensorId anchor, bool accepted, double nis);
   /// Re-evaluates at time t with the current largest position σ; returns true on a change.
   bool evaluate(Timestamp t, double sigma_p_max_m);
+  /// Whether at least `min_ranges` accepted ranges in the window fit (mean NIS ≤ `degraded_mean_nis`) and one was
+  /// accepted within `degraded_no_aiding_s`: a `degraded` state then comes from gating alone,
+  /// which NLOS outliers cause as well as a drifting filter.
+  bool acceptedRangesFit(Timestamp t) const;
   /// Forgets the window (after a re-initialization); the state becomes `ok` at `t`.
   void reset(Timestamp t);
 

@@ -344,8 +344,11 @@ void EstimatorNode::updateHealth(Timestamp t) {
     else
       spdlog::warn("{}", msg);
   }
+  // Degraded by gating alone, with the accepted ranges fitting, is what NLOS outliers look like:
+  // a re-alignment from those ranges is then more likely wrong than the filter (docs/robustness.md).
   if (health_.health() == Health::Lost ||
-      (health_.health() == Health::Degraded && options_.recovery.degraded_disagreement_chi2 > 0.0))
+      (health_.health() == Health::Degraded && options_.recovery.degraded_disagreement_chi2 > 0.0 &&
+       !health_.acceptedRangesFit(t)))
     tryRecover(t);
 }
 

@@ -76,3 +76,20 @@ TEST(HealthMonitor, NoAidingIsDegradedThenLostAndLargeSigmaIsLost) {
   n.evaluate(at(2.0), 5.0);
   EXPECT_EQ(n.health(), Health::Lost);
 }
+
+TEST(HealthMonitor, GatingAloneWithFittingAcceptedRangesIsTellable) {
+  // A third of the ranges gated (NLOS outliers, or a filter drifting away): degraded either way.
+  // Whether the accepted ones fit tells the two apart for the recovery (EstimatorNode).
+  HealthMonitor nlos;
+  nlos.reset(at(0));
+  ranges(nlos, 0.0, 8.0, 4, [](int k) { return k % 3 == 0; }, 1.1);
+  EXPECT_EQ(nlos.health(), Health::Degraded);
+  EXPECT_TRUE(nlos.acceptedRangesFit(at(8.0)));
+  HealthMonitor drift;
+  drift.reset(at(0));
+  ranges(drift, 0.0, 8.0, 4, [](int k) { return k % 3 == 0; }, 6.0);
+  EXPECT_EQ(drift.health(), Health::Degraded);
+  EXPECT_FALSE(drift.acceptedRangesFit(at(8.0)));
+  // No range accepted for longer than degraded_no_aiding_s: not fitting either.
+  EXPECT_FALSE(nlos.acceptedRangesFit(at(8.0 + HealthOptions{}.degraded_no_aiding_s + 0.5)));
+}
