@@ -14,7 +14,6 @@
 #include <array>
 #include <string>
 
-#include "estimator/airspeed/airspeed_scale_kind.h"
 #include "estimator/baro/baro_bias_kind.h"
 #include "estimator/core/kind_traits.h"
 #include "estimator/height/height_bias_kind.h"
@@ -26,7 +25,7 @@ namespace meshnav::estimator {
 
 /// THE registration: every kind with state, the IMU (the body) first. The order is the order in
 /// which a recovery re-adds the instances.
-using InstanceKinds = KindList<ImuKind, BaroBiasKind, HeightBiasKind, AnchorKind, TagBiasKind, AirspeedScaleKind>;
+using InstanceKinds = KindList<ImuKind, BaroBiasKind, HeightBiasKind, AnchorKind, TagBiasKind>;
 
 /// Type of a sensor instance: its kind's position in `InstanceKinds` (kindOf<K>).
 enum class InstanceKind : int {};
