@@ -63,7 +63,7 @@ void CentralizedEkf::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vec
   if (n > kI) P_.bottomLeftCorner(n - kI, kI) = P_.topRightCorner(kI, n - kI).transpose();
   for (const StateBlock& b : layout_.blocks()) {
     const double sigma = random_walks_.of(b.kind);
-    if (sigma == 0.0 || b.kind == kindOf<ImuKind>) continue;  // the IMU's noise is Q
+    if (sigma <= 0.0 || b.kind == kindOf<ImuKind>) continue;  // the IMU's noise is Q
     for (int i = b.offset; i < b.offset + b.dim; ++i) P_(i, i) += sigma * sigma * dt;
   }
   checkInvariants("propagate");

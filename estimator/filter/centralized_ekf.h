@@ -4,9 +4,10 @@
 /// with state, one dense covariance P. The reference that DP must equal.
 ///
 /// Propagation (only the IMU block moves): P_II ← Φ P_II Φᵀ + Q, P_Ij ← Φ P_Ij,
-/// every other instance's error states gain σ_k² Δt (σ_k: its kind's random walk). Update: U = P Hᵀ (from the named blocks), S = H U + R,
-/// K = U S⁻¹, δx = K r, P ← P − K Uᵀ − U Kᵀ + K S Kᵀ (Joseph form, valid for any K) or
-/// P ← P − K Uᵀ, then symmetrized; x ← x ⊞ δx.
+/// every other instance's error states gain σ_k² Δt (σ_k: its kind's random walk, KindRandomWalks).
+/// Update: U = P Hᵀ (from the named blocks), S = H U + R, K = U S⁻¹, δx = K r,
+/// P ← P − K Uᵀ − U Kᵀ + K S Kᵀ (Joseph form, valid for any K) or P ← P − K Uᵀ, then symmetrized;
+/// x ← x ⊞ δx.
 
 #include "estimator/filter/fusion_strategy.h"
 #include "estimator/imu/imu_propagator.h"

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "estimator/filter/strategy_factory.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/node/node_internals.h"
 
