@@ -3,7 +3,10 @@
 /// @brief Nominal (mean) values of every instance with state, addressed by kind and instance id.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <map>
+#include <stdexcept>
+#include <string>
 #include <tuple>
 #include <type_traits>
 #include <variant>
@@ -60,6 +63,26 @@ struct NominalState {
     forEachKind([&]<class K>() {
       if constexpr (!K::kBody) values<K>().erase(id);
     });
+  }
+
+  /// δx = this ⊟ `ref` stacked as `layout` (both hold every instance of the layout with the same
+  /// states; throws std::out_of_range or std::invalid_argument otherwise).
+  Eigen::VectorXd boxminus(const NominalState& ref, const StateLayout& layout) const {
+    Eigen::VectorXd dx(layout.dim());
+    for (const StateBlock& b : layout.blocks())
+      forEachKind([&]<class K>() {
+        if (kindOf<K> != b.kind) return;
+        Eigen::VectorXd d;
+        if constexpr (K::kBody)
+          d = K::boxminus(imu, ref.imu);
+        else
+          d = K::boxminus(values<K>().at(b.id), ref.values<K>().at(b.id));
+        if (d.size() != b.dim)
+          throw std::invalid_argument("NominalState::boxminus: instance " + std::to_string(b.id) + " has " +
+                                      std::to_string(d.size()) + " states, its block " + std::to_string(b.dim));
+        std::copy(d.data(), d.data() + d.size(), dx.data() + b.offset);
+      });
+    return dx;
   }
 
   /// Applies a stacked error-state correction laid out as `layout`.

@@ -19,6 +19,7 @@ struct ImuKind {
   static void boxplus(Value& x, const Eigen::Ref<const Eigen::VectorXd>& dx) {
     x.boxplus(dx.template head<ImuErr::kDim>());
   }
+  static Eigen::VectorXd boxminus(const Value& x, const Value& ref) { return x.boxminus(ref); }
   static void check(SensorId id, const Value&, const Eigen::MatrixXd& cov) { requireBlockSize(kName, id, cov, kDim); }
   static double randomWalk(const EstimatorOptions&) { return 0.0; }
   static Eigen::MatrixXd keptCovariance(const Eigen::MatrixXd& cov, const EstimatorOptions&) { return cov; }

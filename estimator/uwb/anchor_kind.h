@@ -30,6 +30,12 @@ struct AnchorKind {
     a.p_AinG += dx.template head<3>();
     if (dx.size() > 3) a.biases.gamma_m += dx.segment(3, dx.size() - 3);
   }
+  static Eigen::VectorXd boxminus(const Value& a, const Value& ref) {
+    requireSameStates(kName, a.biases.gamma_m.size(), ref.biases.gamma_m.size());
+    Eigen::VectorXd d(3 + a.biases.gamma_m.size());
+    d << a.p_AinG - ref.p_AinG, a.biases.gamma_m - ref.biases.gamma_m;
+    return d;
+  }
   /// The joint covariance of [p_AinG, γ] must be (3 + #peers)² and γ hold one value per peer.
   static void check(SensorId id, const Value& a, const Eigen::MatrixXd& cov) {
     const auto k = static_cast<Eigen::Index>(a.biases.peers.size());

@@ -17,6 +17,10 @@ struct TagBiasKind {
   static constexpr bool kBody = false;
   using Value = BiasState;
   static void boxplus(Value& g, const Eigen::Ref<const Eigen::VectorXd>& dx) { g.gamma_m += dx; }
+  static Eigen::VectorXd boxminus(const Value& g, const Value& ref) {
+    requireSameStates(kName, g.gamma_m.size(), ref.gamma_m.size());
+    return g.gamma_m - ref.gamma_m;
+  }
   static void check(SensorId id, const Value& g, const Eigen::MatrixXd& cov) {
     if (g.gamma_m.size() != static_cast<Eigen::Index>(g.peers.size()))
       throw std::invalid_argument("add tag " + std::to_string(id) + ": " + std::to_string(g.gamma_m.size()) +

@@ -84,6 +84,33 @@ TEST(InstanceKinds, EveryStrategyHandlesEachScalarKindThroughTheRegistry) {
   });
 }
 
+TEST(InstanceKinds, BoxminusUndoesBoxplusForEveryKind) {
+  // One instance of each kind of the paper's setup; (x ⊞ δx) ⊟ x = δx block by block.
+  NominalState x;
+  x.imu.p_IinG = {1.0, -2.0, 3.0};
+  x.imu.q_ItoG = Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()));
+  x.values<BaroBiasKind>()[2] = 0.3;
+  x.values<HeightBiasKind>()[3] = -0.05;
+  x.values<AnchorKind>()[106] = AnchorState{Eigen::Vector3d(-1.772, 0.943, 3.256), BiasState{{100, 101}, Eigen::Vector2d(0.1, -0.2)}};
+  x.values<TagBiasKind>()[100] = BiasState{{101, 102, 103}, Eigen::Vector3d(0.05, 0.0, -0.1)};
+  StateLayout l;
+  l.add(x.imu_id, kindOf<ImuKind>);
+  l.add(2, kindOf<BaroBiasKind>);
+  l.add(3, kindOf<HeightBiasKind>);
+  l.add(106, kindOf<AnchorKind>, 5);
+  l.add(100, kindOf<TagBiasKind>, 3);
+  ASSERT_EQ(l.dim(), 15 + 1 + 1 + 5 + 3);
+  std::srand(7);
+  const Eigen::VectorXd dx = Eigen::VectorXd::Random(l.dim()) * 0.1;
+  NominalState y = x;
+  y.boxplus(l, dx);
+  EXPECT_LT((y.boxminus(x, l) - dx).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_EQ(x.boxminus(x, l).cwiseAbs().maxCoeff(), 0.0);
+  // Values with different numbers of states cannot be compared.
+  y.values<TagBiasKind>()[100] = BiasState{{101}, Eigen::VectorXd::Zero(1)};
+  EXPECT_THROW(y.boxminus(x, l), std::invalid_argument);
+}
+
 TEST(InstanceKinds, AddRefusesACovarianceThatDoesNotFitTheValue) {
   for (auto& f : allStrategies(KindRandomWalks{})) {
     EXPECT_THROW(f->addInstance<BaroBiasKind>(2, 0.0, Eigen::MatrixXd::Identity(2, 2)), std::invalid_argument);
