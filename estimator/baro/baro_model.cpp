@@ -3,7 +3,7 @@
 namespace meshnav::estimator {
 
 double BaroModel::predict(const BaroMeasurement& z, const NominalState& x) const {
-  return (x.imu.p_IinG + x.imu.q_ItoG * p_IP_).z() + x.baro_bias_m.at(z.baro_id);
+  return (x.imu.p_IinG + x.imu.q_ItoG * p_IP_).z() + x.values<BaroBiasKind>().at(z.baro_id);
 }
 
 Linearization BaroModel::linearize(const BaroMeasurement& z, const NominalState& x) const {

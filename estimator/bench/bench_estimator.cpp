@@ -283,8 +283,8 @@ struct FactorMicro {
 template <typename F>
 void runMicro(benchmark::State& state, F f0, int N) {
   MicroScenario sc(N);
-  f0.add(1, InstanceKind::Imu, Eigen::MatrixXd::Identity(6, 6) * 0.01);  // the "body" (kind only names it)
-  for (int i = 0; i < N; ++i) f0.add(2 + i, InstanceKind::Anchor, Eigen::MatrixXd::Identity(3, 3) * 0.04);
+  f0.add(1, kindOf<ImuKind>, Eigen::MatrixXd::Identity(6, 6) * 0.01);  // the "body" (kind only names it)
+  for (int i = 0; i < N; ++i) f0.add(2 + i, kindOf<AnchorKind>, Eigen::MatrixXd::Identity(3, 3) * 0.04);
   // Warm-up: 10 s at 100 Hz, every anchor ranged at 10 Hz (one body–anchor and one ring range per
   // step, cycling), so that everything is correlated.
   Timestamp t;

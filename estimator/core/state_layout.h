@@ -16,7 +16,7 @@ namespace meshnav::estimator {
 /// One instance's block in the stacked error state.
 struct StateBlock {
   SensorId id = 0;
-  InstanceKind kind = InstanceKind::Imu;
+  InstanceKind kind = kindOf<ImuKind>;
   int offset = 0;  ///< first row/column in the stacked error state
   int dim = 0;     ///< error-state dimension
 };

@@ -8,12 +8,8 @@
 
 namespace meshnav::estimator {
 
-CentralizedEkf::CentralizedEkf(const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s, bool joseph_form,
-                               double height_bias_rw_m_per_sqrt_s)
-    : propagator_(propagator),
-      baro_bias_rw_(baro_bias_rw_m_per_sqrt_s),
-      height_bias_rw_(height_bias_rw_m_per_sqrt_s),
-      joseph_form_(joseph_form) {}
+CentralizedEkf::CentralizedEkf(const ImuPropagator& propagator, const KindRandomWalks& random_walks, bool joseph_form)
+    : propagator_(propagator), random_walks_(random_walks), joseph_form_(joseph_form) {}
 
 void CentralizedEkf::reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) {
   x_ = NominalState{};
@@ -22,7 +18,7 @@ void CentralizedEkf::reset(SensorId imu_id, const ImuState& x, const ImuMatrix& 
   x_.imu = x;
   layout_ = StateLayout{};
   P_.resize(0, 0);
-  appendBlock(imu_id, InstanceKind::Imu, cov);
+  appendBlock(imu_id, kindOf<ImuKind>, cov);
 }
 
 void CentralizedEkf::appendBlock(SensorId id, InstanceKind kind, const Eigen::MatrixXd& cov) {
@@ -34,37 +30,9 @@ void CentralizedEkf::appendBlock(SensorId id, InstanceKind kind, const Eigen::Ma
   P_ = std::move(P);
 }
 
-void CentralizedEkf::addBaro(SensorId id, double bias_m, double var_m2) {
-  if (layout_.find(id)) removeInstance(id);
-  x_.baro_bias_m[id] = bias_m;
-  appendBlock(id, InstanceKind::Baro, Eigen::MatrixXd::Constant(1, 1, var_m2));
-}
-
-void CentralizedEkf::addHeight(SensorId id, double bias_m, double var_m2) {
-  if (layout_.find(id)) removeInstance(id);
-  x_.height_bias_m[id] = bias_m;
-  appendBlock(id, InstanceKind::Height, Eigen::MatrixXd::Constant(1, 1, var_m2));
-}
-
-void CentralizedEkf::addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::MatrixXd& cov,
-                               const BiasState& biases) {
-  checkAnchorBlock(id, cov, biases);
-  if (layout_.find(id)) removeInstance(id);
-  x_.anchor_p_AinG[id] = p_AinG;
-  if (!biases.peers.empty()) x_.anchor_biases[id] = biases;
-  appendBlock(id, InstanceKind::Anchor, cov);
-}
-
-void CentralizedEkf::addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
-                                  const Eigen::VectorXd& var_m2) {
-  if (layout_.find(tag_id)) removeInstance(tag_id);
-  x_.tag_biases[tag_id] = BiasState{peers, gamma_m};
-  appendBlock(tag_id, InstanceKind::Tag, var_m2.asDiagonal().toDenseMatrix());
-}
-
 bool CentralizedEkf::removeInstance(SensorId id) {
   const StateBlock* blk = layout_.find(id);
-  if (!blk || blk->kind == InstanceKind::Imu) return false;
+  if (!blk || blk->kind == kindOf<ImuKind>) return false;
   const int off = blk->offset, d = blk->dim, n = layout_.dim(), tail = n - off - d;
   Eigen::MatrixXd P(n - d, n - d);
   P.topLeftCorner(off, off) = P_.topLeftCorner(off, off);
@@ -93,11 +61,11 @@ void CentralizedEkf::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vec
   const ImuMatrix Pii = P_.topLeftCorner<kI, kI>();
   P_.topLeftCorner<kI, kI>() = 0.5 * (Pii + Pii.transpose());
   if (n > kI) P_.bottomLeftCorner(n - kI, kI) = P_.topRightCorner(kI, n - kI).transpose();
-  for (const StateBlock& b : layout_.blocks())
-    if (b.kind == InstanceKind::Baro)
-      P_(b.offset, b.offset) += baro_bias_rw_ * baro_bias_rw_ * dt;
-    else if (b.kind == InstanceKind::Height)
-      P_(b.offset, b.offset) += height_bias_rw_ * height_bias_rw_ * dt;
+  for (const StateBlock& b : layout_.blocks()) {
+    const double sigma = random_walks_.of(b.kind);
+    if (sigma <= 0.0 || b.kind == kindOf<ImuKind>) continue;  // the IMU's noise is Q
+    for (int i = b.offset; i < b.offset + b.dim; ++i) P_(i, i) += sigma * sigma * dt;
+  }
   checkInvariants("propagate");
 }
 

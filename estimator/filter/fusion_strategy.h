@@ -6,7 +6,6 @@
 
 #include <Eigen/Core>
 #include <memory>
-#include <stdexcept>
 #include <string>
 
 #include "estimator/core/linearization.h"
@@ -21,16 +20,6 @@ struct UpdateResult {
   double nis = 0.0;  ///< normalized innovation squared rᵀ S⁻¹ r
 };
 
-/// Throws std::invalid_argument unless `cov` is square of size 3 + #peers and `biases` holds one γ
-/// per peer (the contract of FusionStrategy::addAnchor).
-inline void checkAnchorBlock(SensorId id, const Eigen::MatrixXd& cov, const BiasState& biases) {
-  const auto k = static_cast<Eigen::Index>(biases.peers.size());
-  if (biases.gamma_m.size() != k || cov.rows() != 3 + k || cov.cols() != 3 + k)
-    throw std::invalid_argument("addAnchor " + std::to_string(id) + ": covariance " + std::to_string(cov.rows()) + "x" +
-                                std::to_string(cov.cols()) + " does not fit 3 + " + std::to_string(k) +
-                                " bias states (" + std::to_string(biases.gamma_m.size()) + " values)");
-}
-
 class FusionStrategy {
  public:
   virtual ~FusionStrategy() = default;
@@ -40,20 +29,18 @@ class FusionStrategy {
 
   /// (Re)starts the filter with only the IMU instance.
   virtual void reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) = 0;
-  /// Adds a barometer bias instance (uncorrelated with the rest).
-  virtual void addBaro(SensorId id, double bias_m, double var_m2) = 0;
-  /// Adds a downward rangefinder's bias instance (uncorrelated with the rest; random walk
-  /// `height.bias_rw_m_per_sqrt_s`). Replaces it if present.
-  virtual void addHeight(SensorId id, double bias_m, double var_m2) = 0;
-  /// Adds an anchor instance (uncorrelated with the rest; replaces it if present): its position and,
-  /// when `biases` has peers, its pair biases γ towards them as states after the position, with
-  /// the joint covariance `cov` of [p_AinG, γ] ((3 + #peers)², e.g. the calibration's).
-  virtual void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::MatrixXd& cov,
-                         const BiasState& biases = {}) = 0;
-  /// Adds a tag instance whose constant biases γ(tag, peer) towards exactly known anchors are
-  /// estimated (prior mean `gamma_m`, variances `var_m2`, uncorrelated). Replaces it if present.
-  virtual void addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
-                            const Eigen::VectorXd& var_m2) = 0;
+  /// Adds an instance `id` of kind K (any registered kind but the IMU; estimator/core/instance_kind.h)
+  /// with nominal value `value` and covariance `cov`, uncorrelated with the rest; replaces it if
+  /// present. Throws std::invalid_argument when `cov` does not fit `value` (K::check). The
+  /// instance's error states then follow K's random walk (K::randomWalk) in every propagation.
+  template <class K>
+  void addInstance(SensorId id, const typename K::Value& value, const Eigen::MatrixXd& cov) {
+    static_assert(!K::kBody, "the IMU instance is set by reset()");
+    K::check(id, value, cov);
+    if (layout().find(id)) removeInstance(id);
+    mutableState().values<K>()[id] = value;
+    appendBlock(id, kindOf<K>, cov);
+  }
   /// Removes an instance with state (not the IMU). False if absent.
   virtual bool removeInstance(SensorId id) = 0;
 
@@ -75,6 +62,13 @@ class FusionStrategy {
   /// Throws std::logic_error unless the (reconstructed) full covariance is symmetric positive
   /// definite and, for the modular strategies, the factor bookkeeping is consistent.
   virtual void checkInvariants() const = 0;
+
+ protected:
+  /// The nominal state addInstance writes the new value into.
+  virtual NominalState& mutableState() = 0;
+  /// Appends a block of kind `kind` with covariance `cov` (its dimension), uncorrelated with the
+  /// others; the nominal value is already in mutableState().
+  virtual void appendBlock(SensorId id, InstanceKind kind, const Eigen::MatrixXd& cov) = 0;
 };
 
 }  // namespace meshnav::estimator

@@ -73,7 +73,7 @@ class FactorDictionary {
 /// Belief of one instance (the nominal x_i lives in NominalState, addressed by id).
 struct InstanceBelief {
   SensorId id = 0;
-  InstanceKind kind = InstanceKind::Imu;
+  InstanceKind kind = kindOf<ImuKind>;
   int dim = 0;
   Timestamp t;                 ///< time of the last change of this block
   Eigen::MatrixXd Sigma;       ///< Σ_ii (dim × dim)

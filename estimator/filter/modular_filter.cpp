@@ -4,12 +4,9 @@
 
 namespace meshnav::estimator {
 
-ModularFilter::ModularFilter(Mode mode, const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s,
-                             bool joseph_form, double height_bias_rw_m_per_sqrt_s)
-    : propagator_(propagator),
-      baro_bias_rw_(baro_bias_rw_m_per_sqrt_s),
-      height_bias_rw_(height_bias_rw_m_per_sqrt_s),
-      cov_(mode, joseph_form) {}
+ModularFilter::ModularFilter(Mode mode, const ImuPropagator& propagator, const KindRandomWalks& random_walks,
+                             bool joseph_form)
+    : propagator_(propagator), random_walks_(random_walks), cov_(mode, joseph_form) {}
 
 void ModularFilter::checkAfter(const char* where) const {
 #ifdef MESHNAV_CHECK_INVARIANTS
@@ -25,39 +22,11 @@ void ModularFilter::reset(SensorId imu_id, const ImuState& x, const ImuMatrix& c
   x_.imu_id = imu_id;
   x_.imu = x;
   cov_ = FactorizedCovariance(cov_.mode(), cov_.josephForm());
-  cov_.add(imu_id, InstanceKind::Imu, cov, t);
-}
-
-void ModularFilter::addBaro(SensorId id, double bias_m, double var_m2) {
-  if (cov_.has(id)) removeInstance(id);
-  x_.baro_bias_m[id] = bias_m;
-  cov_.add(id, InstanceKind::Baro, Eigen::MatrixXd::Constant(1, 1, var_m2), x_.t);
-}
-
-void ModularFilter::addHeight(SensorId id, double bias_m, double var_m2) {
-  if (cov_.has(id)) removeInstance(id);
-  x_.height_bias_m[id] = bias_m;
-  cov_.add(id, InstanceKind::Height, Eigen::MatrixXd::Constant(1, 1, var_m2), x_.t);
-}
-
-void ModularFilter::addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::MatrixXd& cov,
-                              const BiasState& biases) {
-  checkAnchorBlock(id, cov, biases);
-  if (cov_.has(id)) removeInstance(id);
-  x_.anchor_p_AinG[id] = p_AinG;
-  if (!biases.peers.empty()) x_.anchor_biases[id] = biases;
-  cov_.add(id, InstanceKind::Anchor, cov, x_.t);
-}
-
-void ModularFilter::addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
-                                 const Eigen::VectorXd& var_m2) {
-  if (cov_.has(tag_id)) removeInstance(tag_id);
-  x_.tag_biases[tag_id] = BiasState{peers, gamma_m};
-  cov_.add(tag_id, InstanceKind::Tag, var_m2.asDiagonal().toDenseMatrix(), x_.t);
+  cov_.add(imu_id, kindOf<ImuKind>, cov, t);
 }
 
 bool ModularFilter::removeInstance(SensorId id) {
-  if (!cov_.has(id) || cov_.layout().at(id).kind == InstanceKind::Imu) return false;
+  if (!cov_.has(id) || cov_.layout().at(id).kind == kindOf<ImuKind>) return false;
   cov_.remove(id);
   x_.erase(id);
   return true;
@@ -70,12 +39,17 @@ void ModularFilter::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vect
   propagator_.propagate(x_.imu, acc_m_s2, gyro_rad_s, dt, &Phi, &Q);
   x_.t = t_to;
   cov_.propagate(x_.imu_id, Phi, Q, t_to);
-  if (baro_bias_rw_ > 0.0)
-    for (const auto& [id, b] : x_.baro_bias_m)
-      cov_.addNoise(id, Eigen::MatrixXd::Constant(1, 1, baro_bias_rw_ * baro_bias_rw_ * dt), t_to);
-  if (height_bias_rw_ > 0.0)
-    for (const auto& [id, b] : x_.height_bias_m)
-      cov_.addNoise(id, Eigen::MatrixXd::Constant(1, 1, height_bias_rw_ * height_bias_rw_ * dt), t_to);
+  // Kind by kind in registry order, instances by id: Σ_kk += σ_k² Δt I.
+  forEachKind([&]<class K>() {
+    if constexpr (!K::kBody) {
+      const double sigma = random_walks_.of(kindOf<K>);
+      if (sigma <= 0.0) return;
+      for (const auto& [id, value] : x_.values<K>()) {
+        const int d = cov_.layout().at(id).dim;
+        cov_.addNoise(id, Eigen::MatrixXd::Identity(d, d) * (sigma * sigma * dt), t_to);
+      }
+    }
+  });
   checkAfter("propagate");
 }
 

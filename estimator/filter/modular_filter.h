@@ -4,8 +4,9 @@
 /// every instance (NominalState, addressed by id) plus the isolated instance beliefs with
 /// factorized cross-covariances (FactorizedCovariance).
 ///
-/// - Propagation is isolated: only the IMU instance (x_I, Σ_II, L_I ← Φ L_I) and the baro bias
-///   (Σ_bb += σ_b² Δt) change; no factor is touched.
+/// - Propagation is isolated: only the IMU instance (x_I, Σ_II, L_I ← Φ L_I) and the instances
+///   whose kind has a random walk (Σ_kk += σ_k² Δt I, e.g. the baro bias) change; no factor is
+///   touched.
 /// - DP: every update on the full stacked state (equal to `centralized` to rounding). A private
 ///   measurement (ZUPT) is a full update too: the exact update also corrects the means of the
 ///   instances correlated with the IMU (K_k = Σ_kI Hᵀ S⁻¹ ≠ 0).
@@ -23,20 +24,13 @@ namespace meshnav::estimator {
 class ModularFilter final : public FusionStrategy {
  public:
   using Mode = FactorizedCovariance::Mode;
-  /// `height_bias_rw_m_per_sqrt_s`: random walk of every height bias instance.
-  ModularFilter(Mode mode, const ImuPropagator& propagator, double baro_bias_rw_m_per_sqrt_s, bool joseph_form,
-                double height_bias_rw_m_per_sqrt_s = 0.0);
+  /// `random_walks`: σ of each kind's random walk (KindRandomWalks::fromOptions).
+  ModularFilter(Mode mode, const ImuPropagator& propagator, const KindRandomWalks& random_walks, bool joseph_form);
 
   std::string name() const override { return cov_.mode() == Mode::DP ? "dp" : "dah"; }
   std::unique_ptr<FusionStrategy> clone() const override { return std::make_unique<ModularFilter>(*this); }
 
   void reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) override;
-  void addBaro(SensorId id, double bias_m, double var_m2) override;
-  void addHeight(SensorId id, double bias_m, double var_m2) override;
-  void addAnchor(SensorId id, const Eigen::Vector3d& p_AinG, const Eigen::MatrixXd& cov,
-                 const BiasState& biases = {}) override;
-  void addTagBiases(SensorId tag_id, const std::vector<SensorId>& peers, const Eigen::VectorXd& gamma_m,
-                    const Eigen::VectorXd& var_m2) override;
   bool removeInstance(SensorId id) override;
 
   void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) override;
@@ -54,12 +48,17 @@ class ModularFilter final : public FusionStrategy {
   /// Folds instance `id`'s pending factor into its factors (exact; for tests and maintenance).
   void renormalize(SensorId id) { cov_.renormalize(id); }
 
+ protected:
+  NominalState& mutableState() override { return x_; }
+  void appendBlock(SensorId id, InstanceKind kind, const Eigen::MatrixXd& cov) override {
+    cov_.add(id, kind, cov, x_.t);
+  }
+
  private:
   void checkAfter(const char* where) const;
 
   ImuPropagator propagator_;
-  double baro_bias_rw_;
-  double height_bias_rw_ = 0.0;
+  KindRandomWalks random_walks_;
   NominalState x_;
   FactorizedCovariance cov_;
 };

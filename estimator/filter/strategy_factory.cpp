@@ -12,11 +12,11 @@ bool strategyImplemented(const std::string& name) { return name == "centralized"
 std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& o, double gravity_z_sign) {
   if (o.strategy == "centralized")
     return std::make_unique<CentralizedEkf>(ImuPropagator(o.gravity_m_s2, o.imu, gravity_z_sign),
-                                            o.baro.bias_rw_m_per_sqrt_s, o.joseph_form, o.height.bias_rw_m_per_sqrt_s);
+                                            KindRandomWalks::fromOptions(o), o.joseph_form);
   if (o.strategy == "dp" || o.strategy == "dah")
     return std::make_unique<ModularFilter>(o.strategy == "dp" ? ModularFilter::Mode::DP : ModularFilter::Mode::DAH,
                                            ImuPropagator(o.gravity_m_s2, o.imu, gravity_z_sign),
-                                           o.baro.bias_rw_m_per_sqrt_s, o.joseph_form, o.height.bias_rw_m_per_sqrt_s);
+                                           KindRandomWalks::fromOptions(o), o.joseph_form);
   throw std::invalid_argument("unknown strategy '" + o.strategy + "'");
 }
 

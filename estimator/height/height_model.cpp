@@ -14,7 +14,7 @@ bool HeightModel::valid(const NominalState& x) const {
 
 double HeightModel::predict(const HeightMeasurement& z, const NominalState& x) const {
   const double s_z = (x.imu.p_IinG + x.imu.q_ItoG * p_IH_).z();
-  return s_z / cosTilt(x) + x.height_bias_m.at(z.height_id);
+  return s_z / cosTilt(x) + x.values<HeightBiasKind>().at(z.height_id);
 }
 
 Linearization HeightModel::linearize(const HeightMeasurement& z, const NominalState& x) const {

@@ -412,8 +412,8 @@ std::vector<AnchorEstimate> EstimatorNode::anchors() const {
   if (!initialized()) return out;
   const NominalState& x = cur_.filter->state();
   for (const auto& [id, p] : cur_.network->exactAnchors()) out.push_back({x.t, id, p, Eigen::Matrix3d::Zero()});
-  for (const auto& [id, p] : x.anchor_p_AinG)
-    out.push_back({x.t, id, p, cur_.filter->covariance(id, id).topLeftCorner<3, 3>()});
+  for (const auto& [id, a] : x.values<AnchorKind>())
+    out.push_back({x.t, id, a.p_AinG, cur_.filter->covariance(id, id).topLeftCorner<3, 3>()});
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
   return out;
 }

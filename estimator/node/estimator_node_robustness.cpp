@@ -63,7 +63,7 @@ void EstimatorNode::addSetupAnchorStates(FusionStrategy& f) const {
     biases.gamma_m = Eigen::Map<const Eigen::VectorXd>(gamma.data(), static_cast<Eigen::Index>(gamma.size()));
     Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(var.data(), static_cast<Eigen::Index>(var.size()));
     v.head<3>() *= sig->second * sig->second;
-    f.addAnchor(id, p, v.asDiagonal().toDenseMatrix(), biases);
+    f.addInstance<AnchorKind>(id, AnchorState{p, biases}, v.asDiagonal().toDenseMatrix());
   }
 }
 
@@ -82,8 +82,9 @@ void EstimatorNode::addTagBiasStates(FusionStrategy& f) const {
         var.push_back(pb->sigma_gamma_m * pb->sigma_gamma_m);
       }
       if (!peers.empty())
-        f.addTagBiases(tag, peers, Eigen::Map<Eigen::VectorXd>(gamma.data(), static_cast<long>(gamma.size())),
-                             Eigen::Map<Eigen::VectorXd>(var.data(), static_cast<long>(var.size())));
+        f.addInstance<TagBiasKind>(
+            tag, BiasState{peers, Eigen::Map<Eigen::VectorXd>(gamma.data(), static_cast<long>(gamma.size()))},
+            Eigen::Map<Eigen::VectorXd>(var.data(), static_cast<long>(var.size())).asDiagonal().toDenseMatrix());
     }
   }
 }
@@ -113,10 +114,11 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   filter->reset(setup_.imu_id, b.imu, b.cov, b.t);
   if (options_.baro.enabled && b.baro_reference_pa) {
     baro_reference_pa_ = b.baro_reference_pa;
-    filter->addBaro(setup_.baro_id, b.baro_bias_m, b.baro_bias_var_m2);
+    filter->addInstance<BaroBiasKind>(setup_.baro_id, b.baro_bias_m, Eigen::MatrixXd::Constant(1, 1, b.baro_bias_var_m2));
   } else if (options_.baro.enabled && resume_baro_) {  // a restart in flight: the predecessor's reference
     baro_reference_pa_ = resume_baro_->baro_reference_pa;
-    filter->addBaro(setup_.baro_id, resume_baro_->baro_bias_m, resume_baro_->baro_bias_var_m2);
+    filter->addInstance<BaroBiasKind>(setup_.baro_id, resume_baro_->baro_bias_m,
+                                      Eigen::MatrixXd::Constant(1, 1, resume_baro_->baro_bias_var_m2));
   }
   resume_baro_.reset();
   pending_height_bias_ = b.height_bias;  // the height instance is added at the first usable height
@@ -190,8 +192,8 @@ void EstimatorNode::feedAligner(const EstimatorInput& in) {
     if (!cur_.network->isTag(tag) || cur_.network->isTag(anchor)) return;
     const Eigen::Vector3d* p = cur_.network->exactAnchor(anchor);
     std::optional<Eigen::Vector3d> p_est;
-    if (!p && cur_.filter && cur_.filter->state().anchor_p_AinG.count(anchor))
-      p_est = cur_.filter->state().anchor_p_AinG.at(anchor);
+    if (!p && cur_.filter && cur_.filter->state().values<AnchorKind>().count(anchor))
+      p_est = cur_.filter->state().values<AnchorKind>().at(anchor).p_AinG;
     if (!p && !p_est && setup_.abs_anchor_positions.count(anchor)) p_est = setup_.abs_anchor_positions.at(anchor);
     if (!p && !p_est) return;
     const PairBias pb = cur_.network->pairBias(tag, anchor);
@@ -238,8 +240,8 @@ void EstimatorNode::checkGravityDirection(Timestamp t) {
   if (c->zDown()) {
     diag_.count("anchor_frame_z_down");
     const bool vertical_sensor = last_pressure_pa_ || last_align_height_ ||
-                                 (cur_.filter && (!cur_.filter->state().baro_bias_m.empty() ||
-                                                  !cur_.filter->state().height_bias_m.empty()));
+                                 (cur_.filter && (!cur_.filter->state().values<BaroBiasKind>().empty() ||
+                                                  !cur_.filter->state().values<HeightBiasKind>().empty()));
     if (vertical_sensor) {
       spdlog::warn(
           "estimator: at t={} the anchors' frame G fits the IMU upside down ({}), but baro or heights measure along "
@@ -399,16 +401,13 @@ void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp 
   const NominalState& s = old.state();
   auto f = makeStrategy(options_, gravity_z_sign_);
   f->reset(setup_.imu_id, x, P, t);
-  // The baro bias may have absorbed the runaway: keep its mean, widen it to the init σ.
-  for (const auto& [id, b] : s.baro_bias_m)
-    f->addBaro(id, b, std::max(old.covariance(id, id)(0, 0), std::pow(options_.baro.init_bias_sigma_m, 2)));
-  for (const auto& [id, b] : s.height_bias_m) f->addHeight(id, b, old.covariance(id, id)(0, 0));
-  for (const auto& [id, p] : s.anchor_p_AinG) {
-    auto b = s.anchor_biases.find(id);
-    f->addAnchor(id, p, old.covariance(id, id), b == s.anchor_biases.end() ? BiasState{} : b->second);
-  }
-  for (const auto& [id, tb] : s.tag_biases)
-    f->addTagBiases(id, tb.peers, tb.gamma_m, old.covariance(id, id).diagonal());
+  // Every instance keeps its mean; its marginal covariance as its kind says (the baro bias, which
+  // may have absorbed the runaway, is widened to the init σ; tag γ keep their variances).
+  forEachKind([&]<class K>() {
+    if constexpr (!K::kBody)
+      for (const auto& [id, value] : s.values<K>())
+        f->addInstance<K>(id, value, K::keptCovariance(old.covariance(id, id), options_));
+  });
   cur_.filter = std::move(f);
   cur_.last_imu = last_imu;
   cur_.last_zupt = t;
@@ -431,122 +430,6 @@ void EstimatorNode::injectPoseError(const Eigen::Vector3d& dp_m, double dyaw_rad
   replaceImu(x, P, t, last);
   health_ = keep_health;  // the fault is not a re-initialization
   diag_.count("injected_pose_error");
-}
-
-}  // namespace meshnav::estimator
-
-namespace meshnav::estimator {
-
-EstimatorCheckpoint EstimatorNode::checkpoint() const {
-  if (!initialized()) throw std::logic_error("EstimatorNode::checkpoint: not initialized");
-  const FusionStrategy& f = *cur_.filter;
-  const NominalState& x = f.state();
-  EstimatorCheckpoint c;
-  c.t = x.t;
-  c.imu = x.imu;
-  c.cov_imu = f.covariance(x.imu_id, x.imu_id);
-  c.landed = cur_.landed;
-  c.baro_reference_pa = baro_reference_pa_;
-  if (auto it = x.baro_bias_m.find(setup_.baro_id); it != x.baro_bias_m.end()) {
-    c.baro_bias_m = it->second;
-    c.baro_bias_var_m2 = f.covariance(setup_.baro_id, setup_.baro_id)(0, 0);
-  }
-  // Every device an anchor may have a pair bias with.
-  std::vector<SensorId> devices;
-  for (const auto& [id, p] : cur_.network->tags()) devices.push_back(id);
-  for (const auto& [id, p] : cur_.network->exactAnchors()) devices.push_back(id);
-  for (const auto& [id, p] : x.anchor_p_AinG) devices.push_back(id);
-  for (const auto& [id, p] : x.anchor_p_AinG) {
-    AnchorInit a;
-    a.t = x.t;
-    a.id = id;
-    a.p_AinG = p;
-    const Eigen::MatrixXd C = f.covariance(id, id);
-    a.cov_p_m2 = C.topLeftCorner<3, 3>();
-    // γ states: their current values and the joint covariance with the position (row of each
-    // bias in C, or −1 for a dictionary value).
-    const auto gs = x.anchor_biases.find(id);
-    std::vector<int> row;
-    for (SensorId d : devices) {
-      if (d == id || !cur_.network->hasPairBias(d, id)) continue;
-      PairBias pb = cur_.network->pairBias(d, id);
-      pb.a = d;
-      pb.b = id;
-      const int i = gs == x.anchor_biases.end() ? -1 : gs->second.index(d);
-      if (i >= 0) {
-        pb.gamma_m = gs->second.gamma_m(i);
-        pb.sigma_gamma_m = std::sqrt(C(3 + i, 3 + i));
-      }
-      row.push_back(i < 0 ? -1 : 3 + i);
-      a.biases.push_back(pb);
-    }
-    if (gs != x.anchor_biases.end()) {
-      const auto n = static_cast<Eigen::Index>(a.biases.size());
-      a.cov_gamma_p_m2 = Eigen::MatrixXd::Zero(n, 3);
-      a.cov_gamma_m2 = Eigen::MatrixXd::Zero(n, n);
-      for (Eigen::Index k = 0; k < n; ++k) {
-        const int rk = row[static_cast<size_t>(k)];
-        if (rk < 0) {
-          a.cov_gamma_m2(k, k) = std::pow(a.biases[static_cast<size_t>(k)].sigma_gamma_m, 2);
-          continue;
-        }
-        a.cov_gamma_p_m2.row(k) = C.block(rk, 0, 1, 3);
-        for (Eigen::Index l = 0; l < n; ++l)
-          if (row[static_cast<size_t>(l)] >= 0) a.cov_gamma_m2(k, l) = C(rk, row[static_cast<size_t>(l)]);
-      }
-    }
-    c.anchors.push_back(std::move(a));
-  }
-  return c;
-}
-
-bool EstimatorNode::tryResume(const ImuSample& s) {
-  EstimatorCheckpoint c = std::move(*resume_);
-  resume_.reset();
-  const double dt = (s.t - c.t).sec();
-  if (dt < 0.0 || dt > options_.init.resume_max_age_s) {
-    diag_.report("resume_refused", "estimator: checkpoint of t=" + formatSeconds(c.t) + " not used at t=" +
-                                       formatSeconds(s.t) + " (" + std::to_string(dt) + " s old, limit " +
-                                       std::to_string(options_.init.resume_max_age_s) + " s); initializing anew");
-    return false;
-  }
-  // Anchors (through the ANCHOR_INIT path once the filter exists) and the baro's reference and
-  // bias come back whatever the outage; the pose only across a short one.
-  const size_t n_anchors = c.anchors.size();
-  for (auto& a : c.anchors) pending_anchor_inits_.push_back(std::move(a));
-  if (c.baro_reference_pa) resume_baro_ = c;
-  diag_.count("resumed");
-  if (dt > options_.init.resume_max_outage_s) {
-    spdlog::warn("estimator: restart {:.3f} s after the checkpoint of t={}: {} anchors and the baro reference kept, "
-                 "the pose is initialized anew (outage longer than {} s)",
-                 dt, formatSeconds(c.t), n_anchors, options_.init.resume_max_outage_s);
-    return false;
-  }
-  // Across the outage: position moved with the velocity (Φ_pv = I·dt); what the body did meanwhile
-  // is unknown, bounded by a largest acceleration a and rotation rate ω: velocity σ += a·dt,
-  // position σ += a·dt²/2, attitude σ += ω·dt about each axis.
-  ImuMatrix Phi = ImuMatrix::Identity();
-  Phi.block<3, 3>(ImuErr::kP, ImuErr::kV) = Eigen::Matrix3d::Identity() * dt;
-  InitialBelief b;
-  b.t = s.t;
-  b.imu = c.imu;
-  b.imu.p_IinG += c.imu.v_IinG * dt;
-  b.cov = Phi * c.cov_imu * Phi.transpose();
-  const double a = options_.init.resume_max_acc_m_s2, w = options_.init.resume_max_rate_deg_s * M_PI / 180.0;
-  const Eigen::Matrix3d I3 = Eigen::Matrix3d::Identity();
-  b.cov.block<3, 3>(ImuErr::kV, ImuErr::kV) += I3 * std::pow(a * dt, 2);
-  b.cov.block<3, 3>(ImuErr::kP, ImuErr::kP) += I3 * std::pow(0.5 * a * dt * dt, 2);
-  b.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) += I3 * std::pow(w * dt, 2);
-  b.from_checkpoint = true;
-  b.baro_reference_pa = c.baro_reference_pa;
-  b.baro_bias_m = c.baro_bias_m;
-  b.baro_bias_var_m2 = c.baro_bias_var_m2;
-  b.last_imu = s;
-  b.landed = c.landed;
-  spdlog::warn("estimator: resuming from the checkpoint of t={} ({:.3f} s before the first IMU sample), {} anchors",
-               formatSeconds(c.t), dt, n_anchors);
-  initialize(b);
-  return true;
 }
 
 }  // namespace meshnav::estimator

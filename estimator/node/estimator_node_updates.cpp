@@ -55,11 +55,11 @@ void EstimatorNode::processHeight(const HeightSample& s, bool first) {
     event(first, "height_tilted");
     return;
   }
-  if (!cur_.filter->state().height_bias_m.count(setup_.height_id)) {
+  if (!cur_.filter->state().values<HeightBiasKind>().count(setup_.height_id)) {
     // The floor is at z = 0 of G: the bias is near zero unless the sensor sits far from the IMU.
     const double b = pending_height_bias_ ? pending_height_bias_->first : 0.0;
     const double var = pending_height_bias_ ? pending_height_bias_->second : std::pow(options_.height.init_bias_sigma_m, 2);
-    cur_.filter->addHeight(setup_.height_id, b, var);
+    cur_.filter->addInstance<HeightBiasKind>(setup_.height_id, b, Eigen::MatrixXd::Constant(1, 1, var));
     if (first)
       spdlog::info("estimator: {} {} added at t={} with bias {:.3f} m (σ {:.3f} m)",
                    carried_height_ ? "carried height" : "height sensor", setup_.height_id, formatSeconds(s.t), b,
@@ -89,8 +89,8 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
       event(first, RangeModel::statusName(status));
     return;
   }
-  if (skip_estimated_anchor_pairs_ && cur_.filter->state().anchor_p_AinG.count(z.a) &&
-      cur_.filter->state().anchor_p_AinG.count(z.b)) {
+  if (skip_estimated_anchor_pairs_ && cur_.filter->state().values<AnchorKind>().count(z.a) &&
+      cur_.filter->state().values<AnchorKind>().count(z.b)) {
     event(first, "range_dah_anchor_pair_skipped");  // a policy, not bad input (see UwbOptions)
     return;
   }
@@ -167,7 +167,7 @@ void EstimatorNode::applyAnchorInit(const AnchorInit& a, bool first) {
   Eigen::MatrixXd cov(rows.size(), rows.size());
   for (size_t r = 0; r < rows.size(); ++r)
     for (size_t c = 0; c < rows.size(); ++c) cov(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = J(rows[r], rows[c]);
-  cur_.filter->addAnchor(a.id, a.p_AinG, cov, biases);
+  cur_.filter->addInstance<AnchorKind>(a.id, AnchorState{a.p_AinG, biases}, cov);
   if (first) {
     diag_.count("anchor_init");
     spdlog::info("estimator: anchor {} added at t={} p_AinG=[{:.3f}, {:.3f}, {:.3f}] with {} pair biases, {} as states{}",

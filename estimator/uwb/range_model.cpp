@@ -20,9 +20,10 @@ std::optional<End> resolve(SensorId id, const NominalState& x, const UwbNetwork&
     e.p_inG = x.imu.p_IinG + x.imu.q_ItoG * (*lever);
     return e;
   }
-  if (auto it = x.anchor_p_AinG.find(id); it != x.anchor_p_AinG.end()) {
+  const auto& anchors = x.values<AnchorKind>();
+  if (auto it = anchors.find(id); it != anchors.end()) {
     e.kind = End::Kind::StateAnchor;
-    e.p_inG = it->second;
+    e.p_inG = it->second.p_AinG;
     return e;
   }
   if (const Eigen::Vector3d* p = net.exactAnchor(id)) {
@@ -45,14 +46,14 @@ struct GammaState {
 
 std::optional<GammaState> gammaState(SensorId a, SensorId b, const NominalState& x) {
   for (auto [owner, peer] : {std::make_pair(a, b), std::make_pair(b, a)}) {
-    auto it = x.anchor_biases.find(owner);
-    if (it == x.anchor_biases.end()) continue;
-    const int i = it->second.index(peer);
-    if (i >= 0) return GammaState{owner, 3 + i, true, it->second.gamma_m(i)};
+    auto it = x.values<AnchorKind>().find(owner);
+    if (it == x.values<AnchorKind>().end()) continue;
+    const int i = it->second.biases.index(peer);
+    if (i >= 0) return GammaState{owner, 3 + i, true, it->second.biases.gamma_m(i)};
   }
   for (auto [tag, peer] : {std::make_pair(a, b), std::make_pair(b, a)}) {
-    auto it = x.tag_biases.find(tag);
-    if (it == x.tag_biases.end()) continue;
+    auto it = x.values<TagBiasKind>().find(tag);
+    if (it == x.values<TagBiasKind>().end()) continue;
     const int i = it->second.index(peer);
     if (i >= 0) return GammaState{tag, i, false, it->second.gamma_m(i)};
   }
@@ -64,20 +65,19 @@ double pairGamma(const PairBias& pb, const std::optional<GammaState>& gs) { retu
 
 /// Error-state dimension of an estimated anchor (3 + its γ states).
 int anchorDim(SensorId id, const NominalState& x) {
-  auto it = x.anchor_biases.find(id);
-  return 3 + (it == x.anchor_biases.end() ? 0 : static_cast<int>(it->second.peers.size()));
+  return 3 + static_cast<int>(x.values<AnchorKind>().at(id).biases.peers.size());
 }
 
 }  // namespace
 
 RangeModel::Status RangeModel::classify(const RangeMeasurement& z, const NominalState& x, const UwbNetwork& net) {
-  auto kindOf = [&](SensorId id) -> std::optional<End::Kind> {
+  auto endKind = [&](SensorId id) -> std::optional<End::Kind> {
     if (net.isTag(id)) return End::Kind::Tag;
-    if (x.anchor_p_AinG.count(id)) return End::Kind::StateAnchor;
+    if (x.values<AnchorKind>().count(id)) return End::Kind::StateAnchor;
     if (net.exactAnchor(id)) return End::Kind::ExactAnchor;
     return std::nullopt;
   };
-  const auto a = kindOf(z.a), b = kindOf(z.b);
+  const auto a = endKind(z.a), b = endKind(z.b);
   if (!a || !b) return Status::UnknownId;
   if (*a == End::Kind::Tag && *b == End::Kind::Tag) return Status::TagTag;
   if (*a == End::Kind::ExactAnchor && *b == End::Kind::ExactAnchor) return Status::NoState;
@@ -131,7 +131,7 @@ RangeModel::Status RangeModel::linearize(const RangeMeasurement& z, const Nomina
   if (a->kind == End::Kind::StateAnchor) anchorBlock(a->id, -1.0);
   if (b->kind == End::Kind::StateAnchor) anchorBlock(b->id, 1.0);
   if (gs && !gs->anchor) {  // a tag's γ: ∂z/∂δγ = 1
-    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, x.tag_biases.at(gs->owner).gamma_m.size());
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, x.values<TagBiasKind>().at(gs->owner).gamma_m.size());
     H(0, gs->row) = 1.0;
     lin.blocks.push_back({gs->owner, std::move(H)});
   }

@@ -27,14 +27,17 @@ inline double relativeDifference(const FusionStrategy& a, const FusionStrategy& 
     rel(dimu(ImuErr::kBg + i), y.imu.bias_gyro_rad_s(i));
     rel(dimu(ImuErr::kBa + i), y.imu.bias_acc_m_s2(i));
   }
-  for (const auto& [id, v] : x.baro_bias_m) rel(v - y.baro_bias_m.at(id), v);
-  for (const auto& [id, p] : x.anchor_p_AinG)
-    for (int i = 0; i < 3; ++i) rel(p(i) - y.anchor_p_AinG.at(id)(i), p(i));
-  for (const auto& [id, g] : x.tag_biases)
-    for (int i = 0; i < g.gamma_m.size(); ++i) rel(g.gamma_m(i) - y.tag_biases.at(id).gamma_m(i), g.gamma_m(i));
-  if (x.anchor_biases.size() != y.anchor_biases.size()) return 1e300;
-  for (const auto& [id, g] : x.anchor_biases)
-    for (int i = 0; i < g.gamma_m.size(); ++i) rel(g.gamma_m(i) - y.anchor_biases.at(id).gamma_m(i), g.gamma_m(i));
+  for (const auto& [id, v] : x.values<BaroBiasKind>()) rel(v - y.values<BaroBiasKind>().at(id), v);
+  for (const auto& [id, a] : x.values<AnchorKind>()) {
+    const AnchorState& b = y.values<AnchorKind>().at(id);
+    for (int i = 0; i < 3; ++i) rel(a.p_AinG(i) - b.p_AinG(i), a.p_AinG(i));
+    if (a.biases.peers.size() != b.biases.peers.size()) return 1e300;
+    for (int i = 0; i < a.biases.gamma_m.size(); ++i)
+      rel(a.biases.gamma_m(i) - b.biases.gamma_m(i), a.biases.gamma_m(i));
+  }
+  for (const auto& [id, g] : x.values<TagBiasKind>())
+    for (int i = 0; i < g.gamma_m.size(); ++i)
+      rel(g.gamma_m(i) - y.values<TagBiasKind>().at(id).gamma_m(i), g.gamma_m(i));
   for (const StateBlock& blk : a.layout().blocks()) {
     if (!b.layout().find(blk.id)) return 1e300;
     const Eigen::MatrixXd Pa = a.covariance(blk.id, blk.id), Pb = b.covariance(blk.id, blk.id);

@@ -13,11 +13,8 @@ namespace meshnav::estimator::test {
 inline double stateDifference(const FusionStrategy& a, const FusionStrategy& b) {
   const NominalState &x = a.state(), &y = b.state();
   if (x.t != y.t || a.layout().dim() != b.layout().dim()) return 1e300;
-  double d = x.imu.boxminus(y.imu).cwiseAbs().maxCoeff();
-  for (const auto& [id, v] : x.baro_bias_m) d = std::max(d, std::abs(v - y.baro_bias_m.at(id)));
-  for (const auto& [id, p] : x.anchor_p_AinG) d = std::max(d, (p - y.anchor_p_AinG.at(id)).cwiseAbs().maxCoeff());
-  for (const auto& [id, g] : x.anchor_biases)
-    d = std::max(d, (g.gamma_m - y.anchor_biases.at(id).gamma_m).cwiseAbs().maxCoeff());
+  // Every instance of every registered kind (x ⊟ y over a's layout).
+  double d = x.boxminus(y, a.layout()).cwiseAbs().maxCoeff();
   return std::max(d, (a.fullCovariance() - b.fullCovariance()).cwiseAbs().maxCoeff());
 }
 

@@ -63,9 +63,9 @@ TEST(AnchorBiasStates, RangeModelUsesTheAnchorsGammaWithUnitJacobian) {
   NominalState x;
   x.imu_id = 1;
   x.imu.p_IinG = {0.5, 1.0, 1.0};
-  x.anchor_p_AinG[106] = kAnchor106;
-  x.anchor_biases[106] = BiasState{{100, 102}, Eigen::Vector2d(0.31, -0.12)};
-  x.tag_biases[100] = BiasState{{106}, Eigen::VectorXd::Constant(1, 0.9)};  // the anchor's γ has priority
+  x.values<AnchorKind>()[106].p_AinG = kAnchor106;
+  x.values<AnchorKind>()[106].biases = BiasState{{100, 102}, Eigen::Vector2d(0.31, -0.12)};
+  x.values<TagBiasKind>()[100] = BiasState{{106}, Eigen::VectorXd::Constant(1, 0.9)};  // the anchor's γ has priority
   for (const auto& [z, peer_row, gamma] : {std::make_tuple(RangeMeasurement{Timestamp{}, 100, 106, 5.0, 0.0}, 3, 0.31),
                                            std::make_tuple(RangeMeasurement{Timestamp{}, 106, 102, 5.0, 0.0}, 4, -0.12)}) {
     Linearization lin;
@@ -78,8 +78,8 @@ TEST(AnchorBiasStates, RangeModelUsesTheAnchorsGammaWithUnitJacobian) {
     EXPECT_EQ(lin.find(100), nullptr);  // the tag's γ state is not used for this pair
     for (int c = 0; c < 5; ++c) {       // numerical derivatives: position and both γ
       NominalState xp = x;
-      if (c < 3) xp.anchor_p_AinG.at(106)(c) += 1e-6;
-      else xp.anchor_biases.at(106).gamma_m(c - 3) += 1e-6;
+      if (c < 3) xp.values<AnchorKind>().at(106).p_AinG(c) += 1e-6;
+      else xp.values<AnchorKind>().at(106).biases.gamma_m(c - 3) += 1e-6;
       EXPECT_NEAR((RangeModel::predict(z, xp, net)->first - pred->first) / 1e-6, a->H(0, c), 1e-5) << c;
     }
     EXPECT_EQ(a->H(0, peer_row), 1.0);
@@ -97,18 +97,18 @@ TEST(AnchorBiasStates, StrategiesHoldTheJointBlockAndDpEqualsCentralized) {
   const SystemSetup setup = smallSetup();
   const UwbNetwork net(setup, 0.15);
   const ImuPropagator prop(9.81, ImuNoiseOptions{});
-  CentralizedEkf ekf(prop, 0.0, true);
-  ModularFilter dp(ModularFilter::Mode::DP, prop, 0.0, true), dah(ModularFilter::Mode::DAH, prop, 0.0, true);
+  CentralizedEkf ekf(prop, KindRandomWalks{}, true);
+  ModularFilter dp(ModularFilter::Mode::DP, prop, KindRandomWalks{}, true), dah(ModularFilter::Mode::DAH, prop, KindRandomWalks{}, true);
   const Eigen::MatrixXd J = jointPrior(setup);
   ImuState s;
   s.p_IinG = {0.5, 1.0, 1.0};
   std::vector<FusionStrategy*> all = {&ekf, &dp, &dah};
   for (FusionStrategy* f : all) {
     f->reset(1, s, ImuMatrix::Identity() * 0.01, Timestamp{});
-    f->addAnchor(106, kAnchor106, J, biasesTo({101, 102, 103, 104}, 0.05));
+    f->addInstance<AnchorKind>(106, AnchorState{kAnchor106, biasesTo({101, 102, 103, 104}, 0.05)}, J);
     EXPECT_EQ(f->layout().at(106).dim, 7);
     EXPECT_LT((f->covariance(106, 106) - J).norm(), 1e-15);
-    EXPECT_THROW(f->addAnchor(107, kAnchor106, J, biasesTo({101}, 0.0)), std::invalid_argument);
+    EXPECT_THROW(f->addInstance<AnchorKind>(107, AnchorState{kAnchor106, biasesTo({101}, 0.0)}, J), std::invalid_argument);
   }
   std::mt19937 rng(3);
   std::normal_distribution<double> n01;
@@ -124,7 +124,7 @@ TEST(AnchorBiasStates, StrategiesHoldTheJointBlockAndDpEqualsCentralized) {
   }
   EXPECT_LT(test::stateDifference(ekf, dp), 1e-9);
   // DAH: tag ranges are joint {IMU, 106}, anchor ranges private {106}: the γ states moved too.
-  EXPECT_NE(dah.state().anchor_biases.at(106).gamma_m, biasesTo({101, 102, 103, 104}, 0.05).gamma_m);
+  EXPECT_NE(dah.state().values<AnchorKind>().at(106).biases.gamma_m, biasesTo({101, 102, 103, 104}, 0.05).gamma_m);
   EXPECT_LT(dah.covariance(106, 106).trace(), J.trace());
   dah.checkInvariants();
   dp.checkInvariants();
@@ -151,13 +151,13 @@ TEST(AnchorBiasStates, ConstantGammaErrorsStayConsistentOnlyAsStates) {
     const Eigen::Vector3d p_true = kAnchor106 - err.head<3>();
     const Eigen::Vector4d gamma_true = Eigen::Vector4d::Constant(0.05) - err.tail<4>();
     for (bool states : {true, false}) {
-      ModularFilter f(ModularFilter::Mode::DAH, prop, 0.0, true);
+      ModularFilter f(ModularFilter::Mode::DAH, prop, KindRandomWalks{}, true);
       ImuState s;
       f.reset(1, s, ImuMatrix::Identity() * 0.01, Timestamp{});
       if (states)
-        f.addAnchor(106, kAnchor106, J, biasesTo({101, 102, 103, 104}, 0.05));
+        f.addInstance<AnchorKind>(106, AnchorState{kAnchor106, biasesTo({101, 102, 103, 104}, 0.05)}, J);
       else
-        f.addAnchor(106, kAnchor106, J.topLeftCorner<3, 3>());
+        f.addInstance<AnchorKind>(106, AnchorState{kAnchor106}, J.topLeftCorner<3, 3>());
       for (int i = 0; i < 400; ++i) {
         const SensorId r = 101 + i % 4;
         const double d = (p_true - setup.abs_anchor_positions.at(r)).norm();
@@ -167,7 +167,7 @@ TEST(AnchorBiasStates, ConstantGammaErrorsStayConsistentOnlyAsStates) {
                   RangeModel::Status::Ok);
         f.update(lin, 0.0);
       }
-      const Eigen::Vector3d e = f.state().anchor_p_AinG.at(106) - p_true;
+      const Eigen::Vector3d e = f.state().values<AnchorKind>().at(106).p_AinG - p_true;
       const double nees = e.dot(f.covariance(106, 106).topLeftCorner<3, 3>().ldlt().solve(e));
       (states ? nees_states : nees_fixed) += nees / trials;
     }
@@ -212,7 +212,7 @@ TEST(AnchorBiasStates, AnchorInitBecomesStatesWithTheJointCovariance) {
         node.onAnchorInit(init);
         sent = true;
         const auto& x = node.filter()->state();
-        ASSERT_EQ(x.anchor_biases.at(106).peers, (std::vector<SensorId>{100, 101}));
+        ASSERT_EQ(x.values<AnchorKind>().at(106).biases.peers, (std::vector<SensorId>{100, 101}));
         const Eigen::MatrixXd C = node.filter()->covariance(106, 106);
         ASSERT_EQ(C.rows(), 5);
         EXPECT_EQ(C(3, 0), joint ? -0.002 : 0.0);
@@ -231,7 +231,7 @@ TEST(AnchorBiasStates, AnchorInitBecomesStatesWithTheJointCovariance) {
     EXPECT_EQ(a.jointCovarianceError(), "");
     for (size_t k = 0; k < a.biases.size(); ++k) {
       if (a.biases[k].a == 100) {
-        EXPECT_EQ(a.biases[k].gamma_m, node.filter()->state().anchor_biases.at(106).gamma_m(0));
+        EXPECT_EQ(a.biases[k].gamma_m, node.filter()->state().values<AnchorKind>().at(106).biases.gamma_m(0));
       }
     }
     // … and a restarted node takes it back (the exact pair 102 has a zero row there).
@@ -279,8 +279,8 @@ TEST(AnchorBiasStates, SetupAnchorBiasesAndCalibratedPairsFollowTheirOptions) {
     EXPECT_EQ(node.filter()->layout().at(106).dim, on ? 4 : 3);
     EXPECT_EQ(node.filter()->layout().at(107).dim, on ? 4 : 3);  // γ(107, 106): the larger id holds it
     if (on) {
-      EXPECT_EQ(x.anchor_biases.at(106).peers, std::vector<SensorId>{101});
-      EXPECT_EQ(x.anchor_biases.at(107).peers, std::vector<SensorId>{106});
+      EXPECT_EQ(x.values<AnchorKind>().at(106).biases.peers, std::vector<SensorId>{101});
+      EXPECT_EQ(x.values<AnchorKind>().at(107).biases.peers, std::vector<SensorId>{106});
       EXPECT_LT(node.filter()->covariance(107, 107)(3, 3), 0.03 * 0.03);  // learned from the 106–107 ranges
     }
   }

@@ -11,14 +11,14 @@ using namespace meshnav::estimator;
 namespace {
 
 CentralizedEkf makeFilter(bool joseph) {
-  CentralizedEkf ekf(ImuPropagator(9.81, ImuNoiseOptions{}), 0.02, joseph);
+  CentralizedEkf ekf(ImuPropagator(9.81, ImuNoiseOptions{}), KindRandomWalks{}.set<BaroBiasKind>(0.02), joseph);
   ImuState x;
   x.p_IinG = {1, 2, 3};
   ImuVector sig;
   sig << 0.3, 0.3, 0.3, 0.1, 0.1, 0.1, 0.05, 0.05, 0.2, 0.01, 0.01, 0.01, 0.1, 0.1, 0.1;
   ekf.reset(1, x, sig.array().square().matrix().asDiagonal(), Timestamp{});
-  ekf.addBaro(2, 0.5, 0.25);
-  ekf.addAnchor(106, {0, 0, 2}, Eigen::Matrix3d::Identity() * 0.09);
+  ekf.addInstance<BaroBiasKind>(2, 0.5, Eigen::MatrixXd::Constant(1, 1, 0.25));
+  ekf.addInstance<AnchorKind>(106, AnchorState{Eigen::Vector3d(0, 0, 2)}, Eigen::Matrix3d::Identity() * 0.09);
   return ekf;
 }
 
@@ -53,8 +53,8 @@ TEST(CentralizedEkf, UpdateEqualsTextbookEkf) {
   EXPECT_NEAR(r.nis, 0.04 / S(0, 0), 1e-12);
   EXPECT_TRUE(ekf.fullCovariance().isApprox(P_expected, 1e-12));
   EXPECT_TRUE((ekf.state().imu.p_IinG - Eigen::Vector3d(1, 2, 3)).isApprox(dx.head<3>(), 1e-12));
-  EXPECT_TRUE((ekf.state().anchor_p_AinG.at(106) - Eigen::Vector3d(0, 0, 2)).isApprox(dx.tail<3>(), 1e-12));
-  EXPECT_DOUBLE_EQ(ekf.state().baro_bias_m.at(2), 0.5);  // uncorrelated and unobserved: unchanged
+  EXPECT_TRUE((ekf.state().values<AnchorKind>().at(106).p_AinG - Eigen::Vector3d(0, 0, 2)).isApprox(dx.tail<3>(), 1e-12));
+  EXPECT_DOUBLE_EQ(ekf.state().values<BaroBiasKind>().at(2), 0.5);  // uncorrelated and unobserved: unchanged
 }
 
 TEST(CentralizedEkf, JosephAndStandardFormAgree) {
@@ -79,7 +79,7 @@ TEST(CentralizedEkf, GatedUpdateChangesNothing) {
 TEST(CentralizedEkf, RemoveInstanceKeepsTheRestOfTheCovariance) {
   CentralizedEkf ekf = makeFilter(true);
   ekf.update(rangeLike(0.2), 0.0);
-  ekf.addAnchor(107, {1, 1, 1}, Eigen::Matrix3d::Identity() * 0.04);
+  ekf.addInstance<AnchorKind>(107, AnchorState{Eigen::Vector3d(1, 1, 1)}, Eigen::Matrix3d::Identity() * 0.04);
   const Eigen::MatrixXd P = ekf.fullCovariance();
   ASSERT_TRUE(ekf.removeInstance(106));
   EXPECT_FALSE(ekf.removeInstance(106));
@@ -89,7 +89,7 @@ TEST(CentralizedEkf, RemoveInstanceKeepsTheRestOfTheCovariance) {
   EXPECT_EQ(ekf.covariance(1, 1), P.topLeftCorner(15, 15));
   EXPECT_EQ(ekf.covariance(107, 107), P.bottomRightCorner(3, 3));
   EXPECT_EQ(ekf.covariance(1, 107), P.topRightCorner(15, 3));
-  EXPECT_EQ(ekf.state().anchor_p_AinG.count(106), 0u);
+  EXPECT_EQ(ekf.state().values<AnchorKind>().count(106), 0u);
 }
 
 TEST(CentralizedEkf, CloneIsIndependent) {

@@ -218,7 +218,7 @@ TEST(EstimatorNode, AnchorInitAddsAnEstimatedAnchorThatIsRefined) {
   rm.action = EstimatorCommand::Action::RemoveInstance;
   rm.id = 106;
   node.onCommand(rm);
-  EXPECT_EQ(node.filter()->state().anchor_p_AinG.count(106), 0u);
+  EXPECT_EQ(node.filter()->state().values<AnchorKind>().count(106), 0u);
   RangeSample r{node.filter()->state().t + Duration::fromMs(1), 100, 106, UwbType::Tag, UwbType::Anchor, 4.0, 4.0, 0.01, true};
   node.onRange(r);
   EXPECT_EQ(node.diagnostics().get("unknown_id"), unknown_before + 1);
@@ -264,8 +264,8 @@ TEST(EstimatorNode, HeightsAddABiasInstanceThatConvergesAndBadHeightsAreCounted)
   }
   ASSERT_TRUE(node.initialized());
   const NominalState& x = node.filter()->state();
-  ASSERT_EQ(x.height_bias_m.count(ds.setup.height_id), 1u);
-  EXPECT_NEAR(x.height_bias_m.at(ds.setup.height_id), bias, 0.03);
+  ASSERT_EQ(x.values<HeightBiasKind>().count(ds.setup.height_id), 1u);
+  EXPECT_NEAR(x.values<HeightBiasKind>().at(ds.setup.height_id), bias, 0.03);
   EXPECT_EQ(node.diagnostics().get("bad_input"), n_bad);
   // Also the real readings while landed (z = 0.1 m: 0.08 m) after initialization.
   int n_low_data = 0;

@@ -24,13 +24,13 @@ NominalState tiltedState(unsigned seed) {
   const Eigen::Vector3d rpy = Eigen::Vector3d::Random() * 0.35;
   x.imu.q_ItoG = Eigen::AngleAxisd(rpy.z() * 9.0, Eigen::Vector3d::UnitZ()) *
                  Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX());
-  x.height_bias_m[kHeightId] = -0.12;
+  x.values<HeightBiasKind>()[kHeightId] = -0.12;
   return x;
 }
 
 StateLayout layoutWithHeight(const NominalState& x) {
   StateLayout l = layoutOf(x);
-  l.add(kHeightId, InstanceKind::Height);
+  l.add(kHeightId, kindOf<HeightBiasKind>);
   return l;
 }
 
@@ -58,7 +58,7 @@ TEST(HeightModel, JacobianWithoutTiltCorrection) { expectJacobian(false); }
 TEST(HeightModel, PredictsTheBeamLengthToTheFloor) {
   NominalState x;
   x.imu.p_IinG = Eigen::Vector3d(2.0, -1.0, 1.5);
-  x.height_bias_m[kHeightId] = 0.1;
+  x.values<HeightBiasKind>()[kHeightId] = 0.1;
   const HeightMeasurement z{Timestamp{}, kHeightId, 0.0, 0.05};
   const Eigen::Vector3d p_IH(0.0, 0.0, -0.2);  // 0.2 m below the IMU
   const HeightModel tilted(p_IH, true, 30.0 * M_PI / 180.0), level(p_IH, false, 30.0 * M_PI / 180.0);
@@ -76,24 +76,26 @@ TEST(HeightModel, PredictsTheBeamLengthToTheFloor) {
 
 TEST(HeightModel, BiasInstanceIsARandomWalkInEveryStrategy) {
   const double rw = 0.01, dt = 4.0;
-  CentralizedEkf ekf(ImuPropagator(9.81, ImuNoiseOptions{}), 0.02, true, rw);
-  ModularFilter dah(ModularFilter::Mode::DAH, ImuPropagator(9.81, ImuNoiseOptions{}), 0.02, true, rw);
+  CentralizedEkf ekf(ImuPropagator(9.81, ImuNoiseOptions{}),
+                     KindRandomWalks{}.set<BaroBiasKind>(0.02).set<HeightBiasKind>(rw), true);
+  ModularFilter dah(ModularFilter::Mode::DAH, ImuPropagator(9.81, ImuNoiseOptions{}),
+                     KindRandomWalks{}.set<BaroBiasKind>(0.02).set<HeightBiasKind>(rw), true);
   for (FusionStrategy* f : std::initializer_list<FusionStrategy*>{&ekf, &dah}) {
     f->reset(1, ImuState{}, ImuMatrix::Identity() * 0.01, Timestamp{});
-    f->addHeight(kHeightId, 0.05, 0.09);
+    f->addInstance<HeightBiasKind>(kHeightId, 0.05, Eigen::MatrixXd::Constant(1, 1, 0.09));
     ASSERT_NE(f->layout().find(kHeightId), nullptr);
-    EXPECT_EQ(f->layout().at(kHeightId).kind, InstanceKind::Height);
-    EXPECT_EQ(kindName(InstanceKind::Height), "height");
+    EXPECT_EQ(f->layout().at(kHeightId).kind, kindOf<HeightBiasKind>);
+    EXPECT_EQ(kindName(kindOf<HeightBiasKind>), "height");
     f->propagate(Eigen::Vector3d(0, 0, 9.81), Eigen::Vector3d::Zero(), Timestamp::fromSec(dt));
     EXPECT_NEAR(f->covariance(kHeightId, kHeightId)(0, 0), 0.09 + rw * rw * dt, 1e-12) << f->name();
-    EXPECT_DOUBLE_EQ(f->state().height_bias_m.at(kHeightId), 0.05);
+    EXPECT_DOUBLE_EQ(f->state().values<HeightBiasKind>().at(kHeightId), 0.05);
     // A level body at z = 0 reading 1.05 m: the update moves both z and the bias, by their variances.
     const HeightModel model(Eigen::Vector3d::Zero(), true, 0.5);
     const HeightMeasurement z{f->state().t, kHeightId, 1.05, 0.05};
     ASSERT_TRUE(f->update(model.linearize(z, f->state()), 0.0).accepted);
     EXPECT_GT(f->state().imu.p_IinG.z(), 0.0);
-    EXPECT_GT(f->state().height_bias_m.at(kHeightId), 0.05);
+    EXPECT_GT(f->state().values<HeightBiasKind>().at(kHeightId), 0.05);
     EXPECT_TRUE(f->removeInstance(kHeightId));
-    EXPECT_EQ(f->state().height_bias_m.count(kHeightId), 0u);
+    EXPECT_EQ(f->state().values<HeightBiasKind>().count(kHeightId), 0u);
   }
 }

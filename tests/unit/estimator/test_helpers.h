@@ -20,18 +20,18 @@ inline NominalState randomState(unsigned seed) {
   x.imu.q_ItoG = Eigen::Quaterniond(Eigen::Vector4d::Random()).normalized();
   x.imu.bias_gyro_rad_s = Eigen::Vector3d::Random() * 0.01;
   x.imu.bias_acc_m_s2 = Eigen::Vector3d::Random() * 0.1;
-  x.baro_bias_m[2] = 0.3;
-  x.anchor_p_AinG[106] = Eigen::Vector3d(-1.772, 0.943, 3.256);
-  x.anchor_p_AinG[107] = Eigen::Vector3d(-2.021, 1.814, 1.732);
+  x.values<BaroBiasKind>()[2] = 0.3;
+  x.values<AnchorKind>()[106].p_AinG = Eigen::Vector3d(-1.772, 0.943, 3.256);
+  x.values<AnchorKind>()[107].p_AinG = Eigen::Vector3d(-2.021, 1.814, 1.732);
   return x;
 }
 
 /// Layout IMU, baro 2, anchors 106, 107.
 inline StateLayout layoutOf(const NominalState& x) {
   StateLayout l;
-  l.add(x.imu_id, InstanceKind::Imu);
-  for (const auto& [id, b] : x.baro_bias_m) l.add(id, InstanceKind::Baro);
-  for (const auto& [id, p] : x.anchor_p_AinG) l.add(id, InstanceKind::Anchor);
+  l.add(x.imu_id, kindOf<ImuKind>);
+  for (const auto& [id, b] : x.values<BaroBiasKind>()) l.add(id, kindOf<BaroBiasKind>);
+  for (const auto& [id, a] : x.values<AnchorKind>()) l.add(id, kindOf<AnchorKind>);
   return l;
 }
 

@@ -67,12 +67,12 @@ TEST(ImuPropagation, NoiseFreePropagationMatchesTruth) {
 
 TEST(ImuPropagation, CentralizedCovarianceMovesCrossTermsWithPhi) {
   const ImuPropagator prop(9.81, ImuNoiseOptions{});
-  CentralizedEkf ekf(prop, 0.02, true);
+  CentralizedEkf ekf(prop, KindRandomWalks{}.set<BaroBiasKind>(0.02), true);
   ImuState x;
   x.q_ItoG = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()));
   ekf.reset(1, x, ImuMatrix::Identity() * 0.01, Timestamp{});
-  ekf.addBaro(2, 0.0, 0.25);
-  ekf.addAnchor(106, Eigen::Vector3d(1, 2, 3), Eigen::Matrix3d::Identity() * 0.04);
+  ekf.addInstance<BaroBiasKind>(2, 0.0, Eigen::MatrixXd::Constant(1, 1, 0.25));
+  ekf.addInstance<AnchorKind>(106, AnchorState{Eigen::Vector3d(1, 2, 3)}, Eigen::Matrix3d::Identity() * 0.04);
   // Correlate the anchor with the IMU by one update, then propagate and check Σ against Φ Σ Φᵀ + Q.
   Linearization lin;
   lin.residual = Eigen::VectorXd::Constant(1, 0.1);

@@ -23,14 +23,14 @@ void setUp(F& f) {
   ImuMatrix P = ImuMatrix::Identity() * 0.01;
   P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) *= 0.1;
   f.reset(1, x, P, Timestamp{});
-  f.addBaro(2, 0.1, 0.25);
-  f.addAnchor(106, {-1.772, 0.943, 3.256}, Eigen::Matrix3d::Identity() * 0.04);
-  f.addAnchor(107, {-2.021, 1.814, 1.732}, Eigen::Matrix3d::Identity() * 0.09);
+  f.template addInstance<BaroBiasKind>(2, 0.1, Eigen::MatrixXd::Constant(1, 1, 0.25));
+  f.template addInstance<AnchorKind>(106, AnchorState{Eigen::Vector3d(-1.772, 0.943, 3.256)}, Eigen::Matrix3d::Identity() * 0.04);
+  f.template addInstance<AnchorKind>(107, AnchorState{Eigen::Vector3d(-2.021, 1.814, 1.732)}, Eigen::Matrix3d::Identity() * 0.09);
 }
 
 /// A linearized range between the IMU (tag at the origin of I) and anchor `a`.
 Linearization tagRange(const NominalState& x, SensorId a, double z) {
-  const Eigen::Vector3d d = x.anchor_p_AinG.at(a) - x.imu.p_IinG;
+  const Eigen::Vector3d d = x.values<AnchorKind>().at(a).p_AinG - x.imu.p_IinG;
   Linearization lin;
   lin.residual = Eigen::VectorXd::Constant(1, z - d.norm());
   lin.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
@@ -42,7 +42,7 @@ Linearization tagRange(const NominalState& x, SensorId a, double z) {
 }
 
 Linearization anchorRange(const NominalState& x, SensorId a, SensorId b, double z) {
-  const Eigen::Vector3d d = x.anchor_p_AinG.at(b) - x.anchor_p_AinG.at(a);
+  const Eigen::Vector3d d = x.values<AnchorKind>().at(b).p_AinG - x.values<AnchorKind>().at(a).p_AinG;
   Linearization lin;
   lin.residual = Eigen::VectorXd::Constant(1, z - d.norm());
   lin.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
@@ -56,7 +56,7 @@ const Eigen::Vector3d kAcc(0.1, -0.2, 9.9), kGyro(0.02, -0.01, 0.1);
 }  // namespace
 
 TEST(ModularFilter, SmallerIdStoresTheCrossCovarianceTheOtherTheIdentity) {
-  ModularFilter f(ModularFilter::Mode::DP, propagator(), 0.02, true);
+  ModularFilter f(ModularFilter::Mode::DP, propagator(), KindRandomWalks{}.set<BaroBiasKind>(0.02), true);
   setUp(f);
   f.propagate(kAcc, kGyro, Timestamp::fromSec(0.005));
   ASSERT_TRUE(f.update(tagRange(f.state(), 106, 4.0), 0.0).accepted);
@@ -78,7 +78,7 @@ TEST(ModularFilter, SmallerIdStoresTheCrossCovarianceTheOtherTheIdentity) {
 
 TEST(ModularFilter, PropagationChangesOnlyTheImuBlockAndItsPendingFactor) {
   for (auto mode : {ModularFilter::Mode::DP, ModularFilter::Mode::DAH}) {
-    ModularFilter f(mode, propagator(), 0.0, true);
+    ModularFilter f(mode, propagator(), KindRandomWalks{}, true);
     setUp(f);
     f.update(tagRange(f.state(), 106, 4.0), 0.0);
     f.update(anchorRange(f.state(), 106, 107, 1.8), 0.0);
@@ -98,7 +98,7 @@ TEST(ModularFilter, PropagationChangesOnlyTheImuBlockAndItsPendingFactor) {
     // The snapshot still holds the old covariance.
     EXPECT_EQ(before->fullCovariance(), P0);
     // And the reconstruction equals the dense propagation Σ_Ij ← Φ Σ_Ij.
-    CentralizedEkf ref(propagator(), 0.0, true);
+    CentralizedEkf ref(propagator(), KindRandomWalks{}, true);
     setUp(ref);
     ref.update(tagRange(ref.state(), 106, 4.0), 0.0);
     ref.update(anchorRange(ref.state(), 106, 107, 1.8), 0.0);
@@ -112,7 +112,7 @@ TEST(ModularFilter, PropagationChangesOnlyTheImuBlockAndItsPendingFactor) {
 }
 
 TEST(ModularFilter, DahUpdateTouchesOnlyTheParticipants) {
-  ModularFilter f(ModularFilter::Mode::DAH, propagator(), 0.02, true);
+  ModularFilter f(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}.set<BaroBiasKind>(0.02), true);
   setUp(f);
   f.update(tagRange(f.state(), 106, 4.0), 0.0);
   f.update(tagRange(f.state(), 107, 3.5), 0.0);
@@ -124,7 +124,7 @@ TEST(ModularFilter, DahUpdateTouchesOnlyTheParticipants) {
   EXPECT_EQ(f.instances().beliefPtr(1), cs.beliefPtr(1));
   EXPECT_EQ(f.instances().beliefPtr(2), cs.beliefPtr(2));
   EXPECT_EQ(f.state().imu.p_IinG, x0.imu.p_IinG);
-  EXPECT_NE(f.state().anchor_p_AinG.at(106), x0.anchor_p_AinG.at(106));
+  EXPECT_NE(f.state().values<AnchorKind>().at(106).p_AinG, x0.values<AnchorKind>().at(106).p_AinG);
   // 106 < 107: 106 stores Σ_106,107 relative to its pending factor, 107 its L⁻¹.
   const auto& c = f.instances();
   const InstanceBelief& b106 = c.belief(106);
@@ -139,8 +139,8 @@ TEST(ModularFilter, DahUpdateTouchesOnlyTheParticipants) {
 }
 
 TEST(ModularFilter, PrivateUpdateIsExactForTheCrossCovariancesAndIsolated) {
-  ModularFilter dah(ModularFilter::Mode::DAH, propagator(), 0.02, true);
-  CentralizedEkf ref(propagator(), 0.02, true);
+  ModularFilter dah(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}.set<BaroBiasKind>(0.02), true);
+  CentralizedEkf ref(propagator(), KindRandomWalks{}.set<BaroBiasKind>(0.02), true);
   setUp(dah);
   setUp(ref);
   for (FusionStrategy* f : {static_cast<FusionStrategy*>(&dah), static_cast<FusionStrategy*>(&ref)}) {
@@ -165,7 +165,7 @@ TEST(ModularFilter, PrivateUpdateIsExactForTheCrossCovariancesAndIsolated) {
 
 TEST(ModularFilter, RemovingAnInstanceDropsThePartnersFactors) {
   for (auto mode : {ModularFilter::Mode::DP, ModularFilter::Mode::DAH}) {
-    ModularFilter f(mode, propagator(), 0.02, true);
+    ModularFilter f(mode, propagator(), KindRandomWalks{}.set<BaroBiasKind>(0.02), true);
     setUp(f);
     f.update(tagRange(f.state(), 106, 4.0), 0.0);
     f.update(anchorRange(f.state(), 106, 107, 1.9), 0.0);
@@ -177,18 +177,18 @@ TEST(ModularFilter, RemovingAnInstanceDropsThePartnersFactors) {
     EXPECT_EQ(f.layout().dim(), 15 + 1 + 3);
     EXPECT_FALSE(f.instances().belief(1).factors->find(106));
     EXPECT_FALSE(f.instances().belief(107).factors->find(106));
-    EXPECT_EQ(f.state().anchor_p_AinG.count(106), 0u);
+    EXPECT_EQ(f.state().values<AnchorKind>().count(106), 0u);
     f.checkInvariants();
     EXPECT_EQ(snap->fullCovariance(), P) << "the snapshot keeps the removed instance";
     // Re-adding starts uncorrelated.
-    f.addAnchor(106, {-1.7, 0.9, 3.2}, Eigen::Matrix3d::Identity() * 0.04);
+    f.addInstance<AnchorKind>(106, AnchorState{Eigen::Vector3d(-1.7, 0.9, 3.2)}, Eigen::Matrix3d::Identity() * 0.04);
     EXPECT_TRUE(f.covariance(1, 106).isZero(0.0));
     f.checkInvariants();
   }
 }
 
 TEST(ModularFilter, LazyFactorRenormalizationIsExact) {
-  ModularFilter f(ModularFilter::Mode::DAH, propagator(), 0.02, true);
+  ModularFilter f(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}.set<BaroBiasKind>(0.02), true);
   setUp(f);
   f.update(tagRange(f.state(), 106, 4.0), 0.0);
   f.update(tagRange(f.state(), 107, 3.5), 0.0);

@@ -108,7 +108,7 @@ TEST(ModularNode, RemoveThenReAddAnInstance) {
         node.onCommand(rm);
         removed = true;
         EXPECT_FALSE(node.filter()->layout().find(107)) << s;
-        EXPECT_FALSE(node.filter()->state().anchor_p_AinG.count(107)) << s;
+        EXPECT_FALSE(node.filter()->state().values<AnchorKind>().count(107)) << s;
         node.filter()->checkInvariants();
       }
       if (!readded && t >= 9.0) {
@@ -130,7 +130,7 @@ TEST(ModularNode, RemoveThenReAddAnInstance) {
     node.filter()->checkInvariants();
     // Ranges to 107 between removal and re-adding were unknown; afterwards it is fused again.
     EXPECT_GT(node.diagnostics().get("unknown_id"), 0) << s;
-    const Eigen::Vector3d err = node.filter()->state().anchor_p_AinG.at(107) - synthetic::syntheticAnchors(3).at(107);
+    const Eigen::Vector3d err = node.filter()->state().values<AnchorKind>().at(107).p_AinG - synthetic::syntheticAnchors(3).at(107);
     const Eigen::Matrix3d P = node.filter()->covariance(107, 107);
     EXPECT_LT(err.dot(P.ldlt().solve(err)), 16.27) << s << ": NEES of the re-added anchor (χ²(3) 99.9 %)";
     EXPECT_LT(err.norm(), 0.1) << s;
@@ -183,9 +183,9 @@ TEST(ModularNode, InstancesAddedAndRemovedMidFlightKeepTheOthersConsistent) {
     EXPECT_LT(after.mean(), 6.0) << s;
     EXPECT_GT(after.mean(), 0.3) << s;
     // Anchor 107 kept its belief through both changes.
-    const Eigen::Vector3d err = node.filter()->state().anchor_p_AinG.at(107) - synthetic::syntheticAnchors(3).at(107);
+    const Eigen::Vector3d err = node.filter()->state().values<AnchorKind>().at(107).p_AinG - synthetic::syntheticAnchors(3).at(107);
     EXPECT_LT(err.dot(node.filter()->covariance(107, 107).ldlt().solve(err)), 16.27) << s;
-    const Eigen::Vector3d err108 = node.filter()->state().anchor_p_AinG.at(108) - synthetic::syntheticAnchors(3).at(108);
+    const Eigen::Vector3d err108 = node.filter()->state().values<AnchorKind>().at(108).p_AinG - synthetic::syntheticAnchors(3).at(108);
     EXPECT_LT(err108.norm(), 0.1) << s;
   }
 }

@@ -24,7 +24,7 @@ NominalState stateWithGamma(double gamma) {
   x.imu_id = 1;
   x.imu.p_IinG = {0.5, 1.0, 2.0};
   x.imu.q_ItoG = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()));
-  x.tag_biases[100] = BiasState{{101}, Eigen::VectorXd::Constant(1, gamma)};
+  x.values<TagBiasKind>()[100] = BiasState{{101}, Eigen::VectorXd::Constant(1, gamma)};
   return x;
 }
 
@@ -47,7 +47,7 @@ TEST(RangeModelTagBias, UsesTheStateGammaWithUnitJacobianAndNoInflation) {
   EXPECT_DOUBLE_EQ(tag->H(0, 0), 1.0);
   // Numerical derivative of the prediction w.r.t. the γ state.
   NominalState xp = x;
-  xp.tag_biases.at(100).gamma_m(0) += 1e-6;
+  xp.values<TagBiasKind>().at(100).gamma_m(0) += 1e-6;
   EXPECT_NEAR((RangeModel::predict(z, xp, net)->first - pred->first) / 1e-6, tag->H(0, 0), 1e-6);
   // σ_γ lives in the state, so the noise is the pair's σ only.
   EXPECT_NEAR(lin.R(0, 0), 0.1 * 0.1, 1e-12);
@@ -57,7 +57,7 @@ TEST(RangeModelTagBias, WithoutStateTheDictionaryGammaInflatesTheNoise) {
   const SystemSetup setup = setupWithUncertainBias();
   const UwbNetwork net(setup, 0.15);
   NominalState x = stateWithGamma(0.0);
-  x.tag_biases.clear();
+  x.values<TagBiasKind>().clear();
   Linearization lin;
   ASSERT_EQ(RangeModel::linearize({Timestamp{}, 100, 101, 5.0, 0.0}, x, net, &lin), RangeModel::Status::Ok);
   EXPECT_EQ(lin.find(100), nullptr);
@@ -72,11 +72,11 @@ TEST(RangeModelTagBias, EkfLearnsAConstantBiasFromRepeatedRanges) {
   // state (prior 0.2 ± 0.02) towards 0.25 and shrink its variance.
   const SystemSetup setup = setupWithUncertainBias();
   const UwbNetwork net(setup, 0.15);
-  CentralizedEkf ekf(ImuPropagator(9.81, ImuNoiseOptions{}), 0.0, true);
+  CentralizedEkf ekf(ImuPropagator(9.81, ImuNoiseOptions{}), KindRandomWalks{}, true);
   ImuState s;
   s.p_IinG = {0.5, 1.0, 2.0};
   ekf.reset(1, s, ImuMatrix::Identity() * 1e-8, Timestamp{});
-  ekf.addTagBiases(100, {101}, Eigen::VectorXd::Constant(1, 0.2), Eigen::VectorXd::Constant(1, 0.02 * 0.02));
+  ekf.addInstance<TagBiasKind>(100, BiasState{{101}, Eigen::VectorXd::Constant(1, 0.2)}, Eigen::MatrixXd::Constant(1, 1, 0.02 * 0.02));
   const Eigen::Vector3d p_T = s.p_IinG + setup.rel_tag_positions.at(100);
   const double d = (setup.abs_anchor_positions.at(101) - p_T).norm();
   for (int i = 0; i < 400; ++i) {
@@ -85,6 +85,6 @@ TEST(RangeModelTagBias, EkfLearnsAConstantBiasFromRepeatedRanges) {
               RangeModel::Status::Ok);
     ASSERT_TRUE(ekf.update(lin, 0.0).accepted);
   }
-  EXPECT_NEAR(ekf.state().tag_biases.at(100).gamma_m(0), 0.25, 0.005);
+  EXPECT_NEAR(ekf.state().values<TagBiasKind>().at(100).gamma_m(0), 0.25, 0.005);
   EXPECT_LT(ekf.covariance(100, 100)(0, 0), 0.2 * 0.02 * 0.02);
 }
