@@ -11,10 +11,13 @@
 #include "estimator/node/estimator_node.h"
 #include "sim/scenario_simulator.h"
 #include "sim/uncertain_anchors.h"
+#include "robust_node_helpers.h"
 
 
 using namespace meshnav;
 using namespace meshnav::estimator;
+using meshnav::estimator::test::run;
+using meshnav::estimator::test::RunResult;
 
 namespace {
 
@@ -25,32 +28,6 @@ sim::SimulationResult simulate(uint64_t seed, double duration_s = 80.0) {
   return sim::ScenarioSimulator(so).run();
 }
 
-/// A 60 s hand-held walk (one tag) in a 10 × 8 × 3 m hall with four known anchors on the walls.
-/// Runs `ds` through a node; `hook(node, t)` after every input. Returns the position error at
-/// the end and records the largest error after `t_check`.
-struct RunResult {
-  double final_error_m = 0.0;
-  double max_error_after_m = 0.0;
-  Health final_health = Health::Initializing;
-};
-
-template <typename Hook>
-RunResult run(EstimatorNode& node, const Dataset& ds, double t_check, Hook hook) {
-  RunResult res;
-  size_t gi = 0;
-  for (const auto& in : mergeInTimeOrder(ds)) {
-    node.onInput(in);
-    hook(node, inputTime(in));
-    if (!std::holds_alternative<ImuSample>(in) || !node.initialized()) continue;
-    const Timestamp t = inputTime(in);
-    while (gi + 1 < ds.ground_truth.size() && ds.ground_truth[gi + 1].t <= t) ++gi;
-    const double e = (node.pose()->p_IinG - ds.ground_truth[gi].p_IinG).norm();
-    res.final_error_m = e;
-    if (t.sec() > t_check) res.max_error_after_m = std::max(res.max_error_after_m, e);
-  }
-  res.final_health = node.health();
-  return res;
-}
 
 /// A hand-held walk without unknown anchors (setup.yaml states its carried height).
 sim::SimulationOptions walk(uint64_t seed, const Eigen::Vector3d& hall_m, sim::AnchorLayoutKind layout, int n_known,
@@ -202,40 +179,6 @@ TEST(RobustNode, ARealHeightSensorIsIgnoredWhileTheCarriedHeightIsUsed) {
   EXPECT_GT(node.diagnostics().get("height_ignored_carried_height"), static_cast<int64_t>(r.dataset.heights.size() / 2));
   EXPECT_EQ(node.diagnostics().get("gated_height"), 0);
   EXPECT_LT(res.max_error_after_m, 0.6);
-}
-
-TEST(RobustNode, BaroHeightsKeepAHoverUnderCeilingAnchorsOffTheMirrorImage) {
-  // Sweep run161 (seed 2): a hover 1.2 m above the floor under four known anchors on a 3.6 m
-  // ceiling, no landed phase, the baro's reference pressure in setup.yaml. From the ranges alone
-  // the in-motion alignment placed it at z = 5.5 m, the mirror image across the anchors' plane, and
-  // the baro's bias (prior σ 1 m) then absorbed the difference (max error 4.6 m).
-  sim::SimulationOptions so;
-  so.seed = 193831;
-  so.trajectory_kind = sim::TrajectoryKind::Hover;
-  so.hall_size_m = Eigen::Vector3d(8.7, 8.4, 3.9);
-  so.anchor_layout = sim::AnchorLayoutKind::Ceiling;
-  so.n_tags = 2;
-  so.n_known_anchors = 4;
-  so.n_unknown_anchors = 3;
-  so.uwb.sigma_range_m = 0.178;
-  so.uwb.outlier_fraction = 0.123;
-  so.uwb.drop_fraction = 0.017;
-  so.imu = sim::ImuNoiseOptions::forGrade("fc");
-  so.duration_s = 40.0;
-  const auto r = sim::ScenarioSimulator(so).run();
-  ASSERT_TRUE(r.dataset.setup.baro_reference_pressure_pa);
-  auto runWith = [&](bool use_baro) {
-    EstimatorOptions o;
-    o.init.motion_use_baro = use_baro;
-    EstimatorNode node(o, r.dataset.setup);
-    const RunResult res = run(node, r.dataset, 10.0, [](EstimatorNode&, Timestamp) {});
-    std::cout << (use_baro ? "baro heights" : "ranges only") << ": max error after 10 s " << res.max_error_after_m
-              << " m" << std::endl;
-    EXPECT_TRUE(node.initialized()) << node.waitingFor();
-    return res;
-  };
-  EXPECT_GT(runWith(false).max_error_after_m, 2.0);  // the mirror image
-  EXPECT_LT(runWith(true).max_error_after_m, 1.0);
 }
 
 TEST(RobustNode, UnderstatedImuNoiseIsScaledUpFromTheRangeInnovations) {
@@ -441,105 +384,4 @@ TEST(RobustNode, UpsideDownAnchorFrameIsDetectedAndTakenAsItIs) {
     EXPECT_LT(res.max_error_after_m, 0.6) << (upside_down ? "upside down" : "true frame");
     EXPECT_NE(res.final_health, Health::Lost);
   }
-}
-
-TEST(RobustNode, StillnessZuptsLetASmoothHoverDrift) {
-  // Sweep run123 (seed 2): a 90 s hover with no flight state and no vibration, so the IMU looks
-  // still to the StillnessDetector while the body drifts at up to 0.12 m/s. Zero-velocity updates
-  // with the flight-state σ (0.02 m/s) pinned the velocity at zero: range NIS 4–8× expected, the
-  // IMU noise scale at its cap and a 1.34 m excursion with the generic bias prior (0.64 m with
-  // the tactical grade's from setup.yaml). With the stillness σ the drift is allowed (0.22 m).
-  sim::SimulationOptions so;
-  so.seed = 706317;
-  so.trajectory_kind = sim::TrajectoryKind::Hover;
-  so.hall_size_m = Eigen::Vector3d(11.5, 8.6, 4.2);
-  so.anchor_layout = sim::AnchorLayoutKind::Random;
-  so.n_tags = 3;
-  so.n_known_anchors = 4;
-  so.n_unknown_anchors = 2;
-  so.uwb.sigma_range_m = 0.127;
-  so.uwb.outlier_fraction = 0.103;
-  so.uwb.drop_fraction = 0.043;
-  so.imu = sim::ImuNoiseOptions::forGrade("tactical");
-  so.duration_s = 90.0;
-  const auto r = sim::ScenarioSimulator(so).run();
-  ASSERT_TRUE(r.dataset.flight_states.empty());
-  auto runWith = [&](double sigma_vel_m_s, double sigma_gyro_rad_s) {
-    EstimatorOptions o;
-    o.zupt.stillness_sigma_vel_m_s = sigma_vel_m_s;
-    o.zupt.stillness_sigma_gyro_rad_s = sigma_gyro_rad_s;
-    EstimatorNode node(o, r.dataset.setup);
-    const RunResult res = run(node, r.dataset, 10.0, [](EstimatorNode&, Timestamp) {});
-    std::cout << "stillness sigma " << sigma_vel_m_s << " m/s: max error after 10 s " << res.max_error_after_m
-              << " m, zupts gated " << node.diagnostics().get("gated_zupt") << std::endl;
-    EXPECT_TRUE(node.initialized()) << node.waitingFor();
-    return res;
-  };
-  const EstimatorOptions defaults;
-  EXPECT_GT(runWith(defaults.zupt.sigma_vel_m_s, defaults.zupt.sigma_gyro_rad_s).max_error_after_m, 0.5);
-  EXPECT_LT(runWith(defaults.zupt.stillness_sigma_vel_m_s, defaults.zupt.stillness_sigma_gyro_rad_s).max_error_after_m,
-            0.3);
-}
-
-TEST(RobustNode, TheImuGradesBiasSpreadKeepsAOneTagTakeOffUnderClusteredCeilingAnchors) {
-  // Sweep run028 (seed 2): a helix with one tag, 7 tag ranges per second, four known anchors
-  // clustered on a 6.8 m ceiling, a tactical-grade IMU (switch-on acc bias σ 0.01 m/s²). With the
-  // generic prior (σ_ba 0.2 m/s²) the ZUPTs at rest cannot tell tilt from bias, the horizontal
-  // position σ grows 0.3 m per second after take-off and the weak ranges let it run 1.2 m off.
-  sim::SimulationOptions so;
-  so.seed = 266946;
-  so.trajectory_kind = sim::TrajectoryKind::Helix;
-  so.hall_size_m = Eigen::Vector3d(6.2, 6.5, 6.8);
-  so.anchor_layout = sim::AnchorLayoutKind::Ceiling;
-  so.n_tags = 1;
-  so.n_known_anchors = 4;
-  so.n_unknown_anchors = 3;
-  so.uwb.sigma_range_m = 0.178;
-  so.uwb.outlier_fraction = 0.061;
-  so.uwb.drop_fraction = 0.034;
-  so.imu = sim::ImuNoiseOptions::forGrade("tactical");
-  so.duration_s = 90.0;
-  const auto r = sim::ScenarioSimulator(so).run();
-  ASSERT_TRUE(r.dataset.setup.noise.imu_acc_bias_sigma);
-  EXPECT_DOUBLE_EQ(*r.dataset.setup.noise.imu_acc_bias_sigma, 0.01);
-  auto runWith = [&](bool datasheet) {
-    SystemSetup setup = r.dataset.setup;
-    if (!datasheet) setup.noise.imu_acc_bias_sigma = setup.noise.imu_gyro_bias_sigma = std::nullopt;
-    EstimatorNode node(EstimatorOptions{}, setup);
-    const RunResult res = run(node, r.dataset, 10.0, [](EstimatorNode&, Timestamp) {});
-    std::cout << (datasheet ? "grade's bias spread" : "generic bias prior") << ": max error after 10 s "
-              << res.max_error_after_m << " m" << std::endl;
-    return res;
-  };
-  EXPECT_GT(runWith(false).max_error_after_m, 1.0);
-  EXPECT_LT(runWith(true).max_error_after_m, 0.8);
-}
-
-TEST(RobustNode, NlosOutliersDoNotTriggerAWrongReAlignment) {
-  // 30 % NLOS ranges (+0.5 to +3 m) and 20 % drops, a spiral in a 9 × 8 × 5 m hall: a third of the
-  // ranges are gated, so the health is `degraded` most of the time. The re-alignment from those
-  // ranges disagreed with a filter that was right (0.04–0.14 m) and replaced it eight times,
-  // 2–5 m off each time (max error 5.2 m). Gating alone with fitting accepted ranges no longer
-  // triggers it.
-  sim::SimulationOptions so;
-  so.seed = 16;
-  so.trajectory_kind = sim::TrajectoryKind::Spiral;
-  so.hall_size_m = Eigen::Vector3d(9.0, 8.0, 5.0);
-  so.anchor_layout = sim::AnchorLayoutKind::Paper;
-  so.n_tags = 2;
-  so.n_known_anchors = 5;
-  so.n_unknown_anchors = 0;
-  so.uwb.sigma_range_m = 0.15;
-  so.uwb.outlier_fraction = 0.3;
-  so.uwb.drop_fraction = 0.2;
-  so.duration_s = 90.0;
-  const auto r = sim::ScenarioSimulator(so).run();
-  EstimatorNode node(EstimatorOptions{}, r.dataset.setup);
-  const RunResult res = run(node, r.dataset, 10.0, [](EstimatorNode&, Timestamp) {});
-  std::cout << "max error after 10 s " << res.max_error_after_m << " m, recoveries "
-            << node.diagnostics().get("recovery") << ", degraded " << node.diagnostics().get("health_degraded")
-            << std::endl;
-  EXPECT_GT(node.diagnostics().get("health_degraded"), 0);  // the outliers are seen
-  EXPECT_EQ(node.diagnostics().get("recovery"), 0);
-  EXPECT_LT(res.max_error_after_m, 0.5);
 }
