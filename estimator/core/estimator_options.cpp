@@ -160,10 +160,14 @@ void forEachRefineField(Opt& o, Visitor& v) {
   v("refine.rerun_on_anchor_join", o.refine.rerun_on_anchor_join,
     "on ANCHOR_INIT re-run from the oldest stored input with the calibrated anchors uncertain from there");
   v("refine.max_history_s", o.refine.max_history_s,
-    "inputs kept for re-runs (about 150 B each); older ones are dropped in eighths, counted [s]");
+    "inputs kept for re-runs (about 260 B each, S2: 360 inputs/s); older ones are dropped in eighths, counted [s]");
   v("refine.rerun_prior_sigma_m", o.refine.rerun_prior_sigma_m,
     "position sigma per axis of a calibrated anchor in a re-run, around its calibration [m]");
-  v("refine.rerun_gamma_sigma_m", o.refine.rerun_gamma_sigma_m, "sigma of its calibrated gamma in a re-run [m]");
+  v("refine.rerun_gamma_sigma_m", o.refine.rerun_gamma_sigma_m, "sigma of its gamma in a re-run [m]");
+  v("refine.rerun_gamma_from_calibration", o.refine.rerun_gamma_from_calibration,
+    "gamma means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false)");
+  v("refine.rerun_with_dah", o.refine.rerun_with_dah,
+    "strategy dah too (off: its factorization loses the anchor-anchor correlations, see docs)");
 }
 
 /// Visits every option as (dotted key, field, unit/comment). The single list used for loading,

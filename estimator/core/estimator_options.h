@@ -181,11 +181,19 @@ struct RecoveryOptions {
 /// (loose, since the ranges that made the calibration are fused again), then continues live.
 struct RefineOptions {
   bool rerun_on_anchor_join = true;      ///< re-run from the oldest stored input on ANCHOR_INIT
-  /// Inputs are kept this long for re-runs (memory ≈ 150 B per input, 8 checkpoints); older
-  /// inputs are dropped in eighths and counted ("rerun_history_cut") [s]
-  double max_history_s = 600.0;
+  /// Inputs are kept this long for re-runs (≈ 260 B per input, S2 360 inputs/s: 28 MB at 300 s,
+  /// plus 8 checkpoints); older inputs are dropped in eighths and counted ("rerun_history_cut").
+  /// A re-run costs about the live processing of the same data (S2, DP, 5 anchors: 0.85 s wall
+  /// for 99 s) and blocks the node meanwhile [s]
+  double max_history_s = 300.0;
   double rerun_prior_sigma_m = 0.3;      ///< position σ per axis of a calibrated anchor in a re-run [m]
-  double rerun_gamma_sigma_m = 0.25;     ///< σ of its calibrated γ in a re-run (no joint covariance) [m]
+  double rerun_gamma_sigma_m = 0.25;     ///< σ of its γ in a re-run (no joint covariance) [m]
+  /// The γ means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false).
+  bool rerun_gamma_from_calibration = false;
+  /// Strategy `dah` too. Off by default: DAH's factorization loses the anchor–anchor correlations
+  /// the joint estimation builds through the pose (S2: 0.118 → 0.114 m as without it, but final
+  /// NEES ≤ 13.93 for 45 instead of 52 of 60 anchors, pose ANEES 4.26 vs 3.81; docs/results.md).
+  bool rerun_with_dah = false;
 };
 
 struct EstimatorOptions {

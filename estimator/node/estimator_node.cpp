@@ -114,6 +114,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
     throw std::invalid_argument("strategy '" + options_.strategy + "' is not implemented yet (next issue)");
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
   skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
+  rerun_enabled_ = options_.refine.rerun_on_anchor_join && (options_.strategy != "dah" || options_.refine.rerun_with_dah);
   if (options_.baro.gate_probability > 0) baro_gate_ = chi2Quantile(1, options_.baro.gate_probability);
   if (options_.height.gate_probability > 0) height_gate_ = chi2Quantile(1, options_.height.gate_probability);
   resetAll();

@@ -271,6 +271,8 @@ class EstimatorNode {
   std::optional<Timestamp> last_checkpoint_;  ///< time of the newest checkpoint in archive_
   std::vector<AnchorInit> rerun_anchors_;  ///< calibrated anchors joined live, by order of joining
   bool rerun_pending_ = false;           ///< an anchor joined: re-run after the next other input
+  /// refine.rerun_on_anchor_join for this strategy (dah: and refine.rerun_with_dah).
+  bool rerun_enabled_ = false;
   bool applying_pending_inits_ = false;  ///< initialize() is applying held anchors (no re-run)
   std::set<InputOrder> seen_;  ///< keys of the inputs admitted within the window (duplicates)
   std::optional<Timestamp> newest_;   ///< newest input time seen (also before init)

@@ -21,12 +21,12 @@ constexpr double kCheckpointsPerHistory = 8.0;
 }  // namespace
 
 int64_t EstimatorNode::oldestReplayUs(int64_t newest_us) const {
-  const double keep_s = options_.refine.rerun_on_anchor_join ? options_.refine.max_history_s : options_.window_s;
+  const double keep_s = rerun_enabled_ ? options_.refine.max_history_s : options_.window_s;
   return newest_us - Duration::fromSec(keep_s + 1.0).us;
 }
 
 void EstimatorNode::retireHistory(Timestamp oldest_kept) {
-  const bool keep = options_.refine.rerun_on_anchor_join;
+  const bool keep = rerun_enabled_;
   const Duration interval = Duration::fromSec(options_.refine.max_history_s / kCheckpointsPerHistory);
   while (!history_.empty() && history_.front().key.t_us < oldest_kept.us) {
     Entry& e = history_.front();
@@ -57,12 +57,12 @@ void EstimatorNode::retireHistory(Timestamp oldest_kept) {
 }
 
 bool EstimatorNode::skipReplayedAnchorInit(const AnchorInit& a, bool first) const {
-  if (first || !options_.refine.rerun_on_anchor_join || !cur_.filter->state().anchor_p_AinG.count(a.id)) return false;
+  if (first || !rerun_enabled_ || !cur_.filter->state().anchor_p_AinG.count(a.id)) return false;
   return std::any_of(rerun_anchors_.begin(), rerun_anchors_.end(), [&](const AnchorInit& r) { return r.id == a.id; });
 }
 
 void EstimatorNode::noteAnchorJoin(const AnchorInit& a, bool first) {
-  if (!first || !options_.refine.rerun_on_anchor_join || applying_pending_inits_ ||
+  if (!first || !rerun_enabled_ || applying_pending_inits_ ||
       !cur_.filter->state().anchor_p_AinG.count(a.id))
     return;
   std::erase_if(rerun_anchors_, [&](const AnchorInit& r) { return r.id == a.id; });
@@ -77,7 +77,10 @@ AnchorInit EstimatorNode::loosePrior(const AnchorInit& a, Timestamp t) const {
   l.cov_gamma_p_m2.resize(0, 0);
   l.cov_gamma_m2.resize(0, 0);
   for (PairBias& b : l.biases)
-    if (b.sigma_gamma_m > 0.0) b.sigma_gamma_m = options_.refine.rerun_gamma_sigma_m;
+    if (b.sigma_gamma_m > 0.0) {
+      b.sigma_gamma_m = options_.refine.rerun_gamma_sigma_m;
+      if (!options_.refine.rerun_gamma_from_calibration) b.gamma_m = 0.0;
+    }
   return l;
 }
 

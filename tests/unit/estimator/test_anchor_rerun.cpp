@@ -1,7 +1,7 @@
 // The second pass on an anchor join (issue 10, RefineOptions): when ANCHOR_INIT arrives the node
 // re-runs from its oldest stored input with the anchor uncertain from there (counted, inputs
 // replayed), which refines the anchor with every range it took part in; the history limit cuts
-// the stored inputs at a checkpoint and is counted; off, nothing is stored or re-run.
+// the stored inputs at a checkpoint and is counted; off (and for dah unless asked), no re-run.
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
@@ -95,6 +95,16 @@ TEST(AnchorRerun, JoinReRunsFromTheStartAndRefinesTheAnchorMore) {
     EXPECT_LT(on.error_m, 0.06) << strategy;
     EXPECT_LT(on.nees, 16.27) << strategy;  // χ²(3) at 99.9 %
   }
+}
+
+TEST(AnchorRerun, DahReRunsOnlyOnRequest) {
+  const Case c = makeCase();
+  EXPECT_EQ(run(c, options("dah", true)).reruns, 0);  // refine.rerun_with_dah: false (docs/results.md)
+  EstimatorOptions o = options("dah", true);
+  o.refine.rerun_with_dah = true;
+  const Outcome on = run(c, o);
+  EXPECT_EQ(on.reruns, 1);
+  EXPECT_LT(on.error_m, 0.06);
 }
 
 TEST(AnchorRerun, HistoryLimitCutsAtACheckpointAndIsCounted) {
