@@ -138,8 +138,7 @@ void EstimatorNode::resetAll() {
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);
   cur_.network = std::make_shared<const UwbNetwork>(setup_, options_.uwb.sigma_range_m);
   history_.clear();
-  archive_.clear();
-  last_checkpoint_.reset();
+  clearRerunHistory();
   rerun_anchors_.clear();
   rerun_pending_ = false;
   pending_height_bias_.reset();

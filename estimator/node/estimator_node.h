@@ -219,6 +219,11 @@ class EstimatorNode {
   void rerunFromOldest();
   /// The ANCHOR_INIT of a re-run: the calibration's means, position σ and γ σ of RefineOptions.
   AnchorInit loosePrior(const AnchorInit& a, Timestamp t) const;
+  /// The anchors held before initialization (or from a resumed checkpoint), applied at `t` with
+  /// their own covariance (no re-run).
+  void applyPendingAnchorInits(Timestamp t);
+  /// Forgets the stored inputs of re-runs (a re-initialization: no re-run may restore the state before it).
+  void clearRerunHistory();
   /// Oldest IMU time whose stillness a replay may need [µs].
   int64_t oldestReplayUs(int64_t newest_us) const;
   void event(bool first, const std::string& kind, const std::string& message = "");

@@ -20,6 +20,22 @@ namespace {
 constexpr double kCheckpointsPerHistory = 8.0;
 }  // namespace
 
+void EstimatorNode::applyPendingAnchorInits(Timestamp t) {
+  const auto pending = std::move(pending_anchor_inits_);
+  pending_anchor_inits_.clear();
+  applying_pending_inits_ = true;  // resumed or early anchors keep their covariance (no re-run)
+  for (auto a : pending) {
+    a.t = t;
+    onInput(a);
+  }
+  applying_pending_inits_ = false;
+}
+
+void EstimatorNode::clearRerunHistory() {
+  archive_.clear();
+  last_checkpoint_.reset();
+}
+
 int64_t EstimatorNode::oldestReplayUs(int64_t newest_us) const {
   const double keep_s = rerun_enabled_ ? options_.refine.max_history_s : options_.window_s;
   return newest_us - Duration::fromSec(keep_s + 1.0).us;

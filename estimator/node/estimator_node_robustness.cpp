@@ -130,14 +130,7 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   health_.reset(b.t);
   newest_ = newest_ ? std::max(*newest_, b.t) : b.t;
   logInitialization(b);
-  const auto pending = std::move(pending_anchor_inits_);
-  pending_anchor_inits_.clear();
-  applying_pending_inits_ = true;  // resumed or early anchors keep their covariance (no re-run)
-  for (auto a : pending) {
-    a.t = b.t;
-    onInput(a);
-  }
-  applying_pending_inits_ = false;
+  applyPendingAnchorInits(b.t);
 }
 
 std::string EstimatorNode::waitingFor() const {
@@ -412,8 +405,7 @@ void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp 
   cur_.last_imu = last_imu;
   cur_.last_zupt = t;
   history_.clear();  // a rewind must not restore the state before the re-initialization
-  archive_.clear();  // nor a re-run (it starts from the new pose, with the anchors it has)
-  last_checkpoint_.reset();
+  clearRerunHistory();  // nor a re-run (it starts from the new pose, with the anchors it has)
   init_time_ = t;
   health_.reset(t);
 }

@@ -92,19 +92,23 @@ TEST(AnchorRerun, JoinReRunsFromTheStartAndRefinesTheAnchorMore) {
     // Off: 6 s of ranges after the join refine the 0.2 m calibration a little; on: 27 s of them,
     // with the anchor estimated jointly with the trajectory.
     EXPECT_LT(on.error_m, 0.5 * off.error_m) << strategy << ": " << on.error_m << " vs " << off.error_m;
-    EXPECT_LT(on.error_m, 0.06) << strategy;
+    EXPECT_LT(on.error_m, 0.02) << strategy;  // without the re-run 0.055
     EXPECT_LT(on.nees, 16.27) << strategy;  // χ²(3) at 99.9 %
   }
 }
 
 TEST(AnchorRerun, DahReRunsOnlyOnRequest) {
   const Case c = makeCase();
-  EXPECT_EQ(run(c, options("dah", true)).reruns, 0);  // refine.rerun_with_dah: false (docs/results.md)
+  const Outcome dflt = run(c, options("dah", true));
+  EXPECT_EQ(dflt.reruns, 0);  // refine.rerun_with_dah: false (docs/results.md)
   EstimatorOptions o = options("dah", true);
   o.refine.rerun_with_dah = true;
   const Outcome on = run(c, o);
   EXPECT_EQ(on.reruns, 1);
-  EXPECT_LT(on.error_m, 0.06);
+  // It works (0.2 m → 0.031 m here) but does not gain for DAH (0.015 m without it; on S2 its
+  // beliefs get more overconfident), hence off by default.
+  EXPECT_LT(on.error_m, 0.05);
+  EXPECT_LT(dflt.error_m, 0.05);
 }
 
 TEST(AnchorRerun, HistoryLimitCutsAtACheckpointAndIsCounted) {
@@ -126,4 +130,51 @@ TEST(AnchorRerun, HistoryLimitCutsAtACheckpointAndIsCounted) {
   // A longer history than the flight: no cut.
   o.refine.max_history_s = 60.0;
   EXPECT_EQ(run(c, o).cuts, 0);
+}
+
+TEST(AnchorRerun, LateInputsAfterAReRunRewindToReRunStatesAndResumedAnchorsDoNotReRun) {
+  const Case c = makeCase();
+  const auto inputs = mergeInTimeOrder(c.ds);
+  EstimatorNode node(options("dp", true), c.ds.setup);
+  // Ranges of the 0.5 s before the join, delivered 0.3 s after it (inside the 1 s window): their
+  // rewinds restore snapshots from before the join, which the re-run must have refreshed.
+  std::vector<EstimatorInput> held;
+  bool sent = false;
+  for (const auto& in : inputs) {
+    const double t = inputTime(in).sec();
+    if (!sent && t >= kJoinS) {
+      AnchorInit a = calibration(c);
+      a.t = inputTime(in);
+      node.onAnchorInit(a);
+      sent = true;
+    }
+    if (t >= kJoinS - 0.5 && t < kJoinS && std::holds_alternative<RangeSample>(in)) {
+      held.push_back(in);
+      continue;
+    }
+    node.onInput(in);
+    if (t >= kJoinS + 0.3 && !held.empty()) {
+      for (const auto& h : held) node.onInput(h);
+      held.clear();
+    }
+  }
+  const Diagnostics& d = node.diagnostics();
+  EXPECT_EQ(d.get("rerun"), 1);
+  EXPECT_GT(d.get("out_of_sequence"), 0);
+  // The rewinds restored re-run states: the anchor kept the joint estimate from the start.
+  EXPECT_LT((node.filter()->state().anchor_p_AinG.at(106) - c.p_true).norm(), 0.02);  // without the re-run 0.055
+  EXPECT_EQ(node.filter()->layout().at(106).dim, 3);
+
+  // A restart from the checkpoint takes the anchor back with its covariance: no re-run.
+  const EstimatorCheckpoint cp = node.checkpoint();
+  const Eigen::Matrix3d P = node.filter()->covariance(106, 106).topLeftCorner<3, 3>();
+  EstimatorNode again(options("dp", true), c.ds.setup);
+  again.resumeFrom(cp);
+  for (const auto& in : inputs) {
+    if (inputTime(in) >= cp.t) again.onInput(in);
+    if (again.initialized()) break;
+  }
+  ASSERT_TRUE(again.initialized());
+  EXPECT_EQ(again.diagnostics().get("rerun"), 0);
+  EXPECT_LT((again.filter()->covariance(106, 106).topLeftCorner<3, 3>() - P).norm(), 1e-12);
 }
