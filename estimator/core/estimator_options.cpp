@@ -154,6 +154,22 @@ void forEachAdaptationField(Opt& o, Visitor& v) {
     "this many consecutive refused inputs agreeing among themselves move the clock (a real jump) [-]");
 }
 
+/// forEachField, part: anchor refinement (the re-run on an anchor join, issue 10).
+template <typename Opt, typename Visitor>
+void forEachRefineField(Opt& o, Visitor& v) {
+  v("refine.rerun_on_anchor_join", o.refine.rerun_on_anchor_join,
+    "on ANCHOR_INIT re-run from the oldest stored input with the calibrated anchors uncertain from there");
+  v("refine.max_history_s", o.refine.max_history_s,
+    "inputs kept for re-runs (about 260 B each, S2: 360 inputs/s); older ones are dropped in eighths, counted [s]");
+  v("refine.rerun_prior_sigma_m", o.refine.rerun_prior_sigma_m,
+    "position sigma per axis of a calibrated anchor in a re-run, around its calibration [m]");
+  v("refine.rerun_gamma_sigma_m", o.refine.rerun_gamma_sigma_m, "sigma of its gamma in a re-run [m]");
+  v("refine.rerun_gamma_from_calibration", o.refine.rerun_gamma_from_calibration,
+    "gamma means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false)");
+  v("refine.rerun_with_dah", o.refine.rerun_with_dah,
+    "strategy dah too (off: its factorization loses the anchor-anchor correlations, see docs)");
+}
+
 /// Visits every option as (dotted key, field, unit/comment). The single list used for loading,
 /// printing and the shipped YAML, so they cannot drift apart.
 template <typename Opt, typename Visitor>
@@ -164,6 +180,7 @@ void forEachField(Opt& o, Visitor&& v) {
   forEachUwbField(o, v);
   forEachRestAndHealthField(o, v);
   forEachAdaptationField(o, v);
+  forEachRefineField(o, v);
 }
 
 std::vector<std::string> splitKey(const std::string& key) {
@@ -251,6 +268,8 @@ void EstimatorOptions::validate() const {
        "process_noise: batch >= 5, lower_ratio in (0, 1), upper_ratio > 1, max_grow > 1, max_shrink > 1, max_scale >= 1, max_prior_ratio > 0");
   need(time.max_offset_s >= window_s && time.max_offset_s <= kMaxTimeSeconds && time.rebase_after >= 1,
        "time.max_offset_s >= window_s, time.rebase_after >= 1");
+  need(refine.max_history_s >= window_s && refine.rerun_prior_sigma_m > 0 && refine.rerun_gamma_sigma_m > 0,
+       "refine.max_history_s >= window_s, refine.rerun_prior_sigma_m > 0, refine.rerun_gamma_sigma_m > 0");
   need(zupt.rate_hz > 0 && zupt.sigma_acc_m_s2 > 0 && zupt.sigma_gyro_rad_s > 0 && zupt.sigma_vel_m_s > 0 &&
            zupt.stillness_sigma_vel_m_s > 0 && zupt.stillness_sigma_gyro_rad_s > 0,
        "zupt rate and sigmas > 0");

@@ -172,6 +172,30 @@ struct RecoveryOptions {
   double degraded_disagreement_chi2 = 23.5;
 };
 
+/// Anchor refinement (issue 10): a second pass when a calibrated anchor joins. The calibration used
+/// the filter's trajectory, so refining the calibrated belief forward cannot undo the trajectory's
+/// error (docs/results.md, "What limits the refinement"); estimating the anchor jointly with the
+/// trajectory from the start can. On ANCHOR_INIT the node restores its oldest stored state and
+/// re-processes every stored input with the calibrated anchors as uncertain anchors from there:
+/// mean = the calibration, position σ `rerun_prior_sigma_m` per axis, γ σ `rerun_gamma_sigma_m`
+/// (loose, since the ranges that made the calibration are fused again), then continues live.
+struct RefineOptions {
+  bool rerun_on_anchor_join = true;      ///< re-run from the oldest stored input on ANCHOR_INIT
+  /// Inputs are kept this long for re-runs (≈ 260 B per input, S2 360 inputs/s: 28 MB at 300 s,
+  /// plus 8 checkpoints); older inputs are dropped in eighths and counted ("rerun_history_cut").
+  /// A re-run costs about the live processing of the same data (S2, DP, 5 anchors: 0.85 s wall
+  /// for 99 s) and blocks the node meanwhile [s]
+  double max_history_s = 300.0;
+  double rerun_prior_sigma_m = 0.3;      ///< position σ per axis of a calibrated anchor in a re-run [m]
+  double rerun_gamma_sigma_m = 0.25;     ///< σ of its γ in a re-run (no joint covariance) [m]
+  /// The γ means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false).
+  bool rerun_gamma_from_calibration = false;
+  /// Strategy `dah` too. Off by default: DAH's factorization loses the anchor–anchor correlations
+  /// the joint estimation builds through the pose (S2: 0.118 → 0.114 m as without it, but final
+  /// NEES ≤ 13.93 for 45 instead of 52 of 60 anchors, pose ANEES 4.26 vs 3.81; docs/results.md).
+  bool rerun_with_dah = false;
+};
+
 struct EstimatorOptions {
   std::string strategy = "centralized";  ///< centralized | dp | dah
   double gravity_m_s2 = 9.81;            ///< |g|, gravity is −g along z of G [m/s²]
@@ -190,6 +214,7 @@ struct EstimatorOptions {
   HealthOptions health;
   ProcessNoiseAdaptOptions process_noise;
   RecoveryOptions recovery;
+  RefineOptions refine;
   /// Inputs stamped far from the node's current time (common/time_guard.h): `time.max_offset_s`
   /// (>= window_s) and `time.rebase_after`.
   TimeGuardOptions time;

@@ -114,6 +114,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
     throw std::invalid_argument("strategy '" + options_.strategy + "' is not implemented yet (next issue)");
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
   skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
+  rerun_enabled_ = options_.refine.rerun_on_anchor_join && (options_.strategy != "dah" || options_.refine.rerun_with_dah);
   if (options_.baro.gate_probability > 0) baro_gate_ = chi2Quantile(1, options_.baro.gate_probability);
   if (options_.height.gate_probability > 0) height_gate_ = chi2Quantile(1, options_.height.gate_probability);
   resetAll();
@@ -137,6 +138,9 @@ void EstimatorNode::resetAll() {
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);
   cur_.network = std::make_shared<const UwbNetwork>(setup_, options_.uwb.sigma_range_m);
   history_.clear();
+  clearRerunHistory();
+  rerun_anchors_.clear();
+  rerun_pending_ = false;
   pending_height_bias_.reset();
   last_align_height_.reset();
   seen_.clear();
@@ -270,9 +274,11 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     }
   }
   newest_ = std::max(*newest_, t);
-  const Timestamp oldest_kept = *newest_ - Duration::fromSec(options_.window_s);
-  while (!history_.empty() && history_.front().key.t_us < oldest_kept.us) history_.pop_front();
-  while (!still_at_.empty() && still_at_.begin()->first < oldest_kept.us) still_at_.erase(still_at_.begin());
+  // Anchors calibrated together arrive as consecutive ANCHOR_INITs: one re-run for all of them.
+  if (rerun_pending_ && !std::holds_alternative<AnchorInit>(in)) rerunFromOldest();
+  retireHistory(*newest_ - Duration::fromSec(options_.window_s));
+  const int64_t oldest_still_us = oldestReplayUs(newest_->us);
+  while (!still_at_.empty() && still_at_.begin()->first < oldest_still_us) still_at_.erase(still_at_.begin());
   updateHealth(*newest_);
   publishPeriodic();
 }
@@ -291,7 +297,10 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
             processHeight(m, first);
         }
         if constexpr (std::is_same_v<T, FlightStateSample>) cur_.landed = m.landed;
-        if constexpr (std::is_same_v<T, AnchorInit>) applyAnchorInit(m, first);
+        if constexpr (std::is_same_v<T, AnchorInit>) {
+          if (!skipReplayedAnchorInit(m, first)) applyAnchorInit(m, first);
+          noteAnchorJoin(m, first);
+        }
         if constexpr (std::is_same_v<T, EstimatorCommand>) applyCommand(m, first);
       },
       in);
@@ -372,6 +381,7 @@ void EstimatorNode::applyCommand(const EstimatorCommand& c, bool first) {
         break;
       }
       bool removed = cur_.filter->removeInstance(c.id);
+      if (first) std::erase_if(rerun_anchors_, [&](const AnchorInit& a) { return a.id == c.id; });
       if (cur_.network->isTag(c.id) || cur_.network->exactAnchor(c.id) || cur_.network->isCalibrated(c.id)) {
         auto net = std::make_shared<UwbNetwork>(*cur_.network);
         removed = net->removeDevice(c.id) || removed;

@@ -26,6 +26,10 @@
 ///   updates propagate to their own time with the latest reading held. While landed a
 ///   zero-velocity update runs at `zupt.rate_hz` with the latest IMU reading.
 /// - ANCHOR_INIT and ESTIMATOR_CMD apply at max(their time, newest time).
+/// - Re-run on an anchor join (RefineOptions, estimator_node_rerun.cpp): inputs that leave the
+///   window are archived up to `refine.max_history_s`; after a live ANCHOR_INIT the node restores
+///   the oldest stored state, adds the calibrated anchors there with a loose prior and
+///   re-processes every stored input ("rerun", "rerun_inputs"; centralized and dp by default).
 /// - Initialization: while at rest (flight state, else IMU stillness) from the landed data
 ///   (StaticInitializer); in motion, or when the landed data cannot fix the pose (one tag,
 ///   coplanar anchors), from ranges and strapdown increments over a window (MotionAligner).
@@ -138,6 +142,14 @@ class EstimatorNode {
     EstimatorInput input;
     std::shared_ptr<const Snapshot> before;
   };
+  /// An input older than the out-of-sequence window, kept for re-runs (RefineOptions); every
+  /// eighth of `refine.max_history_s` one keeps the state before it (a checkpoint), and the
+  /// oldest always does: the re-run's starting state.
+  struct Archived {
+    InputOrder key;
+    EstimatorInput input;
+    std::shared_ptr<const Snapshot> checkpoint;
+  };
 
   bool validate(const EstimatorInput& in);
   /// The time guard on `in` (may restamp a command); false: refused and counted.
@@ -196,6 +208,28 @@ class EstimatorNode {
   /// marginal covariance (cross-covariances dropped). History before `t` is forgotten.
   void replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu);
   bool landedAt(Timestamp t) const;
+  /// Pops history entries older than `oldest_kept`; with re-runs on they move to archive_, which
+  /// is cut to `refine.max_history_s` at a checkpoint (counted "rerun_history_cut", logged).
+  void retireHistory(Timestamp oldest_kept);
+  /// True when an ANCHOR_INIT replayed by a re-run or rewind must be skipped: its anchor is
+  /// already in the state as a re-run's uncertain anchor.
+  bool skipReplayedAnchorInit(const AnchorInit& a, bool first) const;
+  /// A live ANCHOR_INIT: remembered for re-runs and a re-run scheduled after the next input that is
+  /// not an ANCHOR_INIT (anchors calibrated together share one re-run).
+  void noteAnchorJoin(const AnchorInit& a, bool first);
+  /// The second pass (RefineOptions): restores the oldest stored state, adds every calibrated
+  /// anchor it lacks with the loose prior, re-processes archive_ and history_ (refreshing their
+  /// snapshots) and continues live from there. Counted "rerun", logged with the wall time.
+  void rerunFromOldest();
+  /// The ANCHOR_INIT of a re-run: the calibration's means, position σ and γ σ of RefineOptions.
+  AnchorInit loosePrior(const AnchorInit& a, Timestamp t) const;
+  /// The anchors held before initialization (or from a resumed checkpoint), applied at `t` with
+  /// their own covariance (no re-run).
+  void applyPendingAnchorInits(Timestamp t);
+  /// Forgets the stored inputs of re-runs (a re-initialization: no re-run may restore the state before it).
+  void clearRerunHistory();
+  /// Oldest IMU time whose stillness a replay may need [µs].
+  int64_t oldestReplayUs(int64_t newest_us) const;
   void event(bool first, const std::string& kind, const std::string& message = "");
   void publishPeriodic();
   void resetAll();
@@ -242,6 +276,13 @@ class EstimatorNode {
 
   Snapshot cur_;
   std::deque<Entry> history_;
+  std::deque<Archived> archive_;        ///< inputs before history_, kept for re-runs
+  std::optional<Timestamp> last_checkpoint_;  ///< time of the newest checkpoint in archive_
+  std::vector<AnchorInit> rerun_anchors_;  ///< calibrated anchors joined live, by order of joining
+  bool rerun_pending_ = false;           ///< an anchor joined: re-run after the next other input
+  /// refine.rerun_on_anchor_join for this strategy (dah: and refine.rerun_with_dah).
+  bool rerun_enabled_ = false;
+  bool applying_pending_inits_ = false;  ///< initialize() is applying held anchors (no re-run)
   std::set<InputOrder> seen_;  ///< keys of the inputs admitted within the window (duplicates)
   std::optional<Timestamp> newest_;   ///< newest input time seen (also before init)
   TimeGuard time_guard_;

@@ -132,12 +132,7 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   health_.reset(b.t);
   newest_ = newest_ ? std::max(*newest_, b.t) : b.t;
   logInitialization(b);
-  const auto pending = std::move(pending_anchor_inits_);
-  pending_anchor_inits_.clear();
-  for (auto a : pending) {
-    a.t = b.t;
-    onInput(a);
-  }
+  applyPendingAnchorInits(b.t);
 }
 
 std::string EstimatorNode::waitingFor() const {
@@ -175,7 +170,7 @@ void EstimatorNode::feedAligner(const EstimatorInput& in) {
       const bool still = still_detector_.add(*s);
       still_at_[s->t.us] = still;
       // Kept for rewinds within the window (also pruned there); bounded while not initialized too.
-      const int64_t oldest_us = s->t.us - Duration::fromSec(options_.window_s + 1.0).us;
+      const int64_t oldest_us = oldestReplayUs(s->t.us);
       while (!still_at_.empty() && still_at_.begin()->first < oldest_us) still_at_.erase(still_at_.begin());
       if (!initialized()) initializer_->addStillness(still);
     }
@@ -412,6 +407,7 @@ void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp 
   cur_.last_imu = last_imu;
   cur_.last_zupt = t;
   history_.clear();  // a rewind must not restore the state before the re-initialization
+  clearRerunHistory();  // nor a re-run (it starts from the new pose, with the anchors it has)
   init_time_ = t;
   health_.reset(t);
 }
