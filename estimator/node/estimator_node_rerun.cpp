@@ -73,13 +73,13 @@ void EstimatorNode::retireHistory(Timestamp oldest_kept) {
 }
 
 bool EstimatorNode::skipReplayedAnchorInit(const AnchorInit& a, bool first) const {
-  if (first || !rerun_enabled_ || !cur_.filter->state().anchor_p_AinG.count(a.id)) return false;
+  if (first || !rerun_enabled_ || !cur_.filter->state().values<AnchorKind>().count(a.id)) return false;
   return std::any_of(rerun_anchors_.begin(), rerun_anchors_.end(), [&](const AnchorInit& r) { return r.id == a.id; });
 }
 
 void EstimatorNode::noteAnchorJoin(const AnchorInit& a, bool first) {
   if (!first || !rerun_enabled_ || applying_pending_inits_ ||
-      !cur_.filter->state().anchor_p_AinG.count(a.id))
+      !cur_.filter->state().values<AnchorKind>().count(a.id))
     return;
   std::erase_if(rerun_anchors_, [&](const AnchorInit& r) { return r.id == a.id; });
   rerun_anchors_.push_back(a);
@@ -115,7 +115,7 @@ void EstimatorNode::rerunFromOldest() {
   const Timestamp t0 = cur_.filter->state().t;
   std::string ids;
   for (const AnchorInit& a : rerun_anchors_) {
-    if (cur_.filter->state().anchor_p_AinG.count(a.id)) continue;  // from an earlier re-run's checkpoint
+    if (cur_.filter->state().values<AnchorKind>().count(a.id)) continue;  // from an earlier re-run's checkpoint
     applyAnchorInit(loosePrior(a, t0), false);
     ids += (ids.empty() ? "" : ", ") + std::to_string(a.id);
   }

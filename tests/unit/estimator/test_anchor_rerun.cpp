@@ -63,7 +63,7 @@ Outcome run(const Case& c, const EstimatorOptions& opt) {
     node.onInput(in);
   }
   EXPECT_TRUE(sent);
-  const Eigen::Vector3d e = node.filter()->state().anchor_p_AinG.at(106) - c.p_true;
+  const Eigen::Vector3d e = node.filter()->state().values<AnchorKind>().at(106).p_AinG - c.p_true;
   const Eigen::Matrix3d P = node.filter()->covariance(106, 106).topLeftCorner<3, 3>();
   const Diagnostics& d = node.diagnostics();
   return {e.norm(), e.dot(P.ldlt().solve(e)), d.get("rerun"), d.get("rerun_inputs"), d.get("rerun_history_cut")};
@@ -162,7 +162,7 @@ TEST(AnchorRerun, LateInputsAfterAReRunRewindToReRunStatesAndResumedAnchorsDoNot
   EXPECT_EQ(d.get("rerun"), 1);
   EXPECT_GT(d.get("out_of_sequence"), 0);
   // The rewinds restored re-run states: the anchor kept the joint estimate from the start.
-  EXPECT_LT((node.filter()->state().anchor_p_AinG.at(106) - c.p_true).norm(), 0.02);  // without the re-run 0.055
+  EXPECT_LT((node.filter()->state().values<AnchorKind>().at(106).p_AinG - c.p_true).norm(), 0.02);  // without the re-run 0.055
   EXPECT_EQ(node.filter()->layout().at(106).dim, 3);
 
   // A restart from the checkpoint takes the anchor back with its covariance: no re-run.
