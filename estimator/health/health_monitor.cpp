@@ -53,8 +53,7 @@ std::map<std::string, HealthStats> HealthMonitor::stats() const {
 }
 
 Health HealthMonitor::assess(Timestamp t, double sigma_p, std::string* why) const {
-  const auto it = by_type_.find("range");
-  const HealthStats range = it != by_type_.end() ? it->second : HealthStats{};
+  const HealthStats range = rangeStats();
   int gated_anchors = 0;
   for (const auto& [id, h] : by_anchor_)
     if (h.n >= 2 && h.gatedFraction() >= options_.lost_gated_fraction) ++gated_anchors;
@@ -89,9 +88,13 @@ Health HealthMonitor::assess(Timestamp t, double sigma_p, std::string* why) cons
   return Health::Ok;
 }
 
-bool HealthMonitor::acceptedRangesFit(Timestamp t) const {
+HealthStats HealthMonitor::rangeStats() const {
   const auto it = by_type_.find("range");
-  const HealthStats range = it != by_type_.end() ? it->second : HealthStats{};
+  return it != by_type_.end() ? it->second : HealthStats{};
+}
+
+bool HealthMonitor::acceptedRangesFit(Timestamp t) const {
+  const HealthStats range = rangeStats();
   // Too few accepted ranges say nothing either way (MILUV: 2 of 4 in 4 s).
   const bool nis_ok = range.n - range.n_gated >= options_.min_ranges && range.meanNis() <= options_.degraded_mean_nis;
   return nis_ok && (t - last_accepted_range_).sec() <= options_.degraded_no_aiding_s;

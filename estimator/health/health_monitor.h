@@ -76,6 +76,8 @@ class HealthMonitor {
   /// Adds (+1) or removes (−1) an event from the running statistics.
   void account(const Event& e, int sign);
   Health assess(Timestamp t, double sigma_p_max_m, std::string* why) const;
+  /// The window's tag-range statistics (empty before the first).
+  HealthStats rangeStats() const;
 
   HealthOptions options_;
   std::deque<Event> events_;
