@@ -47,6 +47,7 @@
 /// worker owns its own copies and never touches the node).
 
 #include <atomic>
+#include <chrono>
 #include <deque>
 #include <functional>
 #include <map>
@@ -248,8 +249,9 @@ class EstimatorNode {
   /// ran), and re-processes from there.
   /// Returns the number of inputs re-processed, nullopt when a snapshot is missing (nothing changed).
   std::optional<int64_t> applyRerun(RerunResult& r, std::optional<InputOrder> divergence);
-  /// Starts `job` on a worker with a replay node of its own (refine.rerun_mode async).
-  void launchRerun(RerunJob job);
+  /// Starts `job` on a worker with a replay node of its own (refine.rerun_mode async); `t_job`:
+  /// when the node began taking its copies (logged at the swap).
+  void launchRerun(RerunJob job, std::chrono::steady_clock::time_point t_job);
   /// The re-run's log line; `how` tells where it ran.
   void logRerun(const RerunResult& r, const std::string& how) const;
   /// Swaps a finished worker re-run in (`wait`: blocks until it is finished).

@@ -104,6 +104,7 @@ AnchorInit EstimatorNode::loosePrior(const AnchorInit& a, Timestamp t) const {
 
 void EstimatorNode::startRerun() {
   rerun_pending_ = false;
+  const auto t_job = std::chrono::steady_clock::now();
   std::optional<RerunJob> job = makeRerunJob();
   if (!job) {
     diag_.count("rerun_skipped");  // nothing stored (e.g. right after a re-initialization)
@@ -112,7 +113,7 @@ void EstimatorNode::startRerun() {
   diag_.count("rerun");
   diag_.count("rerun_inputs", static_cast<int64_t>(job->inputs.size()));
   if (rerun_async_) {
-    launchRerun(std::move(*job));
+    launchRerun(std::move(*job), t_job);
     return;
   }
   ScopedStepTimer timer(timings_, "rerun");

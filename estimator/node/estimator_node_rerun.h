@@ -49,6 +49,7 @@ struct EstimatorNode::RunningRerun {
   InputOrder end_key;                    ///< the job's newest input
   std::optional<InputOrder> divergence;  ///< oldest input inserted at or before end_key meanwhile
   std::chrono::steady_clock::time_point started;
+  double start_ms = 0.0;  ///< the node's thread taking the copies and starting the worker
   /// An input inserted into the stored ones: from it on the re-run's snapshots do not hold.
   void noteInserted(const InputOrder& k) {
     if (k <= end_key && (!divergence || k < *divergence)) divergence = k;

@@ -24,8 +24,8 @@ void EstimatorNode::copyReplayContext(const EstimatorNode& live) {
   zupt_model_ = live.zupt_model_;
 }
 
-void EstimatorNode::launchRerun(RerunJob job) {
-  ScopedStepTimer timer(timings_, "rerun_start");  // the copies, on the node's thread
+void EstimatorNode::launchRerun(RerunJob job, std::chrono::steady_clock::time_point t_job) {
+  ScopedStepTimer timer(timings_, "rerun_start");  // the worker's node, on the node's thread
   // options_ already hold the setup's figures; applying them again changes nothing.
   auto replay = std::make_unique<EstimatorNode>(options_, setup_);
   replay->copyReplayContext(*this);
@@ -37,6 +37,7 @@ void EstimatorNode::launchRerun(RerunJob job) {
     if (hook) hook();
     return replay->computeRerun(std::move(job), *cancel);
   });
+  run->start_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_job).count();
   rerun_ = std::move(run);
 }
 
@@ -55,10 +56,11 @@ void EstimatorNode::pollRerun(bool wait) {
   diag_.count("rerun_replayed", *replayed);
   const auto ms = [](auto d) { return std::chrono::duration<double, std::milli>(d).count(); };
   const auto now = std::chrono::steady_clock::now();
-  logRerun(r, fmt::format(" on a worker; swapped in {:.1f} ms after its start, re-processing the {} inputs stored "
-                          "meanwhile{} in {:.1f} ms",
-                          ms(now - run->started), *replayed, run->divergence ? " (some inserted among its own)" : "",
-                          ms(now - swap0)));
+  // What blocked the node: taking the copies and starting the worker, and the swap.
+  logRerun(r, fmt::format(" on a worker (started in {:.1f} ms); swapped in {:.1f} ms after its start, re-processing "
+                          "the {} inputs stored meanwhile{} in {:.1f} ms",
+                          run->start_ms, ms(now - run->started), *replayed,
+                          run->divergence ? " (some inserted among its own)" : "", ms(now - swap0)));
 }
 
 void EstimatorNode::abandonRerun() {
