@@ -133,6 +133,11 @@ class EstimatorNode {
   /// Waits for the running re-run, swaps it in and runs (and waits for) a re-run queued behind it:
   /// a deterministic point for tests and the end of a replay or of the process.
   void finishRerun();
+  /// Shutdown without waiting: swaps a finished worker re-run in, abandons one still running.
+  void stopRerun() {
+    pollRerun(false);
+    abandonRerun();
+  }
   /// Test hook: called on the re-run worker before it starts (a test holds the worker there until
   /// it releases it; the hook must return before the node is destroyed or re-initialized).
   void setRerunWorkerHook(std::function<void()> hook) { rerun_worker_hook_ = std::move(hook); }

@@ -86,7 +86,9 @@ class EstimatorProcess {
 
   /// After the loop: the final anchors and status, for the recorder.
   void finish() {
-    node_.finishRerun();  // a re-run still on its worker comes in before the final anchors
+    // A re-run done on its worker comes in before the final anchors; one still running is dropped
+    // (waiting could outlast the supervisor's stop timeout under a sanitizer).
+    node_.stopRerun();
     if (node_.initialized()) lcm_.publish(channels::kAnchors, node_.anchors());
     const EstimatorStatus st = process_.stamped(node_.status());
     lcm_.publish(channels::kEstimatorStatus, st);
