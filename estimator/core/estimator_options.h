@@ -203,6 +203,12 @@ struct RefineOptions {
   /// the joint estimation builds through the pose (S2: 0.118 → 0.114 m as without it, but final
   /// NEES ≤ 13.93 for 45 instead of 52 of 60 anchors, pose ANEES 4.26 vs 3.81; docs/results.md).
   bool rerun_with_dah = false;
+  /// Where a re-run is computed: `sync` inline in the input handler (the node publishes nothing
+  /// meanwhile: 0.1–0.4 s on S2, seconds under ASan), `async` on a worker thread from immutable
+  /// copies while the node keeps publishing, swapped in at the first input after it is done (wall
+  /// clock dependent, so not bit-for-bit repeatable), `auto`: async in the LCM estimator process,
+  /// sync in in-process replays (meshnav_run, tests, paper tables), which stay deterministic.
+  std::string rerun_mode = "auto";
 };
 
 struct EstimatorOptions {
