@@ -104,6 +104,10 @@ void forEachUwbField(Opt& o, Visitor& v) {
     "fuse ranges between two calibrated anchors (their correlated calibration errors are not known)");
   v("uwb.dah_fuse_estimated_anchor_pairs", o.uwb.dah_fuse_estimated_anchor_pairs,
     "dah only: fuse ranges between two estimated anchors (overconfident, see docs)");
+  v("uwb.dah_joint_anchors", o.uwb.dah_joint_anchors,
+    "dah only: anchors updated jointly: none | batch (added together, e.g. by a re-run) | all");
+  v("uwb.dah_joint_tag_biases", o.uwb.dah_joint_tag_biases,
+    "dah only: the tags' gamma instances join the anchors' joint set (merges the batches into one)");
 }
 
 /// forEachField, part: zero-velocity updates and the health monitor.
@@ -226,6 +230,8 @@ void EstimatorOptions::validate() const {
   };
   need(strategy == "centralized" || strategy == "dp" || strategy == "dah", "strategy must be centralized, dp or dah");
   need(gravity_m_s2 > 0.0, "gravity_m_s2 > 0");
+  need(uwb.dah_joint_anchors == "none" || uwb.dah_joint_anchors == "batch" || uwb.dah_joint_anchors == "all",
+       "uwb.dah_joint_anchors must be none, batch or all");
   need(window_s >= 0.0, "window_s >= 0");
   need(pose_output_rate_hz >= 0.0 && anchors_output_rate_hz > 0.0 && status_rate_hz > 0.0, "output rates");
   need(imu.acc_noise_density > 0 && imu.gyro_noise_density > 0 && imu.acc_bias_rw >= 0 && imu.gyro_bias_rw >= 0,

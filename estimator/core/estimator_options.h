@@ -141,6 +141,16 @@ struct UwbOptions {
   /// filter overconfident (docs/modular_estimator.md, "DAH and anchor–anchor ranges"). Ranges
   /// between an estimated and an exactly known anchor are private updates and always fused.
   bool dah_fuse_estimated_anchor_pairs = false;
+  /// Strategy `dah` only: which estimated anchors form a joint set (FactorizedCovariance::joinSet),
+  /// i.e. are always updated together so that their mutual correlation is exact (issue 10):
+  /// `none`; `batch`: the anchors added together (one batch of ANCHOR_INITs between two other
+  /// inputs, and the anchors a re-run adds at its start); `all`: every anchor added at run time.
+  std::string dah_joint_anchors = "batch";
+  /// Strategy `dah` only: the tags' γ instances (TagBiasKind) join that set too. A tag range to an
+  /// exactly known anchor updates {IMU, tag}; the tag's γ and the anchors become correlated through
+  /// the pose, and DAH without this drops that correlation. Since every set then holds the tags,
+  /// the batches merge into one set with them.
+  bool dah_joint_tag_biases = true;
 };
 
 struct ZuptOptions {

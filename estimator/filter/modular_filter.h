@@ -32,6 +32,9 @@ class ModularFilter final : public FusionStrategy {
 
   void reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) override;
   bool removeInstance(SensorId id) override;
+  void joinJointSet(const std::vector<SensorId>& ids) override {
+    if (cov_.mode() == Mode::DAH) cov_.joinSet(ids);
+  }
 
   void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) override;
   void addImuNoise(const ImuMatrix& Q) override;
