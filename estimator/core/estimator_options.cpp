@@ -108,6 +108,8 @@ void forEachUwbField(Opt& o, Visitor& v) {
     "dah only: anchors updated jointly: none | batch (added together, e.g. by a re-run) | all");
   v("uwb.dah_joint_tag_biases", o.uwb.dah_joint_tag_biases,
     "dah only: the tags' gamma instances join the anchors' joint set (merges the batches into one)");
+  v("uwb.dah_joint_imu", o.uwb.dah_joint_imu,
+    "dah only: the IMU joins that set too (every pose update also corrects its anchors)");
 }
 
 /// forEachField, part: zero-velocity updates and the health monitor.
@@ -171,7 +173,7 @@ void forEachRefineField(Opt& o, Visitor& v) {
   v("refine.rerun_gamma_from_calibration", o.refine.rerun_gamma_from_calibration,
     "gamma means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false)");
   v("refine.rerun_with_dah", o.refine.rerun_with_dah,
-    "strategy dah too (off: its factorization loses the anchor-anchor correlations, see docs)");
+    "strategy dah too (with its joint sets, uwb.dah_joint_anchors; see docs)");
 }
 
 /// Visits every option as (dotted key, field, unit/comment). The single list used for loading,

@@ -151,6 +151,10 @@ struct UwbOptions {
   /// the pose, and DAH without this drops that correlation. Since every set then holds the tags,
   /// the batches merge into one set with them.
   bool dah_joint_tag_biases = true;
+  /// Strategy `dah` only: the IMU joins that set too, so that every update of the pose (baro,
+  /// ZUPT, ranges to exactly known anchors) also corrects the set's anchors through their
+  /// correlation with the pose, as the exact filter does.
+  bool dah_joint_imu = true;
 };
 
 struct ZuptOptions {
@@ -200,10 +204,10 @@ struct RefineOptions {
   double rerun_gamma_sigma_m = 0.25;     ///< σ of its γ in a re-run (no joint covariance) [m]
   /// The γ means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false).
   bool rerun_gamma_from_calibration = false;
-  /// Strategy `dah` too. Off by default: DAH's factorization loses the anchor–anchor correlations
-  /// the joint estimation builds through the pose (S2: 0.118 → 0.114 m as without it, but final
-  /// NEES ≤ 13.93 for 45 instead of 52 of 60 anchors, pose ANEES 4.26 vs 3.81; docs/results.md).
-  bool rerun_with_dah = false;
+  /// Strategy `dah` too. With the joint set of the re-run's anchors and the tags' γ
+  /// (uwb.dah_joint_anchors, uwb.dah_joint_tag_biases) DAH reaches DP's refinement (S2: 0.115 →
+  /// 0.063 m, DP 0.061 m); without the sets it did not gain (0.116 m; docs/results.md).
+  bool rerun_with_dah = true;
 };
 
 struct EstimatorOptions {

@@ -193,6 +193,7 @@ void EstimatorNode::joinAnchorSet(SensorId id) {
       if (cur_.network->isCalibrated(other)) set.push_back(other);
   if (options_.uwb.dah_joint_tag_biases)  // merges every batch into one set with the tags' γ
     for (const auto& [tag, value] : cur_.filter->state().values<TagBiasKind>()) set.push_back(tag);
+  if (options_.uwb.dah_joint_imu) set.push_back(cur_.filter->state().imu_id);
   cur_.filter->joinJointSet(set);
 }
 
