@@ -10,6 +10,7 @@
 #include "estimator/filter/modular_filter.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/testing/synthetic_scenario.h"
+#include "modular_test_helpers.h"
 #include "node_test_helpers.h"
 
 using namespace meshnav;
@@ -38,31 +39,6 @@ void setUp(F& f) {
   }
 }
 
-/// A range between the IMU (tag at its origin) and anchor `a`, measured without noise from the
-/// true anchor position and the IMU's true position `p_true`.
-Linearization tagRange(const NominalState& x, SensorId a, const Eigen::Vector3d& p_true) {
-  const Eigen::Vector3d d = x.values<AnchorKind>().at(a).p_AinG - x.imu.p_IinG;
-  Linearization lin;
-  lin.residual = Eigen::VectorXd::Constant(1, (kTruth.at(a) - p_true).norm() - d.norm());
-  lin.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, 15);
-  H.block<1, 3>(0, ImuErr::kP) = -d.normalized().transpose();
-  lin.blocks.push_back({1, H});
-  lin.blocks.push_back({a, Eigen::MatrixXd(d.normalized().transpose())});
-  return lin;
-}
-
-/// A noise-free range between two anchors.
-Linearization anchorRange(const NominalState& x, SensorId a, SensorId b) {
-  const Eigen::Vector3d d = x.values<AnchorKind>().at(b).p_AinG - x.values<AnchorKind>().at(a).p_AinG;
-  Linearization lin;
-  lin.residual = Eigen::VectorXd::Constant(1, (kTruth.at(b) - kTruth.at(a)).norm() - d.norm());
-  lin.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
-  lin.blocks.push_back({a, Eigen::MatrixXd(-d.normalized().transpose())});
-  lin.blocks.push_back({b, Eigen::MatrixXd(d.normalized().transpose())});
-  return lin;
-}
-
 /// 0.6 s of hovering with a tag range every 20 ms, the anchors in turn, and (if asked) an
 /// anchor–anchor range every 100 ms.
 void fly(FusionStrategy& f, bool anchor_pairs) {
@@ -70,9 +46,29 @@ void fly(FusionStrategy& f, bool anchor_pairs) {
   const std::vector<SensorId> ids = {106, 107, 108};
   for (int k = 1; k <= 30; ++k) {
     f.propagate(acc, gyro, Timestamp::fromSec(0.02 * k));
-    ASSERT_TRUE(f.update(tagRange(f.state(), ids[static_cast<size_t>(k % 3)], p_true), 0.0).accepted);
-    if (anchor_pairs && k % 5 == 0) ASSERT_TRUE(f.update(anchorRange(f.state(), 106, 107 + k % 2), 0.0).accepted);
+    const SensorId a = ids[static_cast<size_t>(k % 3)];
+    ASSERT_TRUE(f.update(test::imuAnchorRange(f.state(), a, (kTruth.at(a) - p_true).norm()), 0.0).accepted);
+    if (anchor_pairs && k % 5 == 0) {
+      const SensorId b = 107 + k % 2;
+      ASSERT_TRUE(f.update(test::anchorPairRange(f.state(), 106, b, (kTruth.at(b) - kTruth.at(106)).norm()), 0.0).accepted);
+    }
   }
+}
+
+std::unique_ptr<CentralizedEkf> centralizedFlight(bool anchor_pairs) {
+  auto f = std::make_unique<CentralizedEkf>(propagator(), KindRandomWalks{}, true);
+  setUp(*f);
+  fly(*f, anchor_pairs);
+  return f;
+}
+
+/// DAH with the joint set `set` (empty: none) over the same flight.
+std::unique_ptr<ModularFilter> dahFlight(const std::vector<SensorId>& set, bool anchor_pairs) {
+  auto f = std::make_unique<ModularFilter>(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}, true);
+  setUp(*f);
+  if (!set.empty()) f->joinJointSet(set);
+  fly(*f, anchor_pairs);
+  return f;
 }
 
 double maxRelative(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
@@ -89,47 +85,32 @@ double maxAnchorDifference(const FusionStrategy& a, const FusionStrategy& b) {
 }  // namespace
 
 TEST(DahJointSets, AnchorSetWithTagRangesEqualsCentralized) {
-  CentralizedEkf ref(propagator(), KindRandomWalks{}, true);
-  setUp(ref);
-  fly(ref, false);
-  ModularFilter dah(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}, true);
-  setUp(dah);
-  dah.joinJointSet({106, 107, 108});
-  fly(dah, false);
+  const auto ref = centralizedFlight(false);
+  const auto dah = dahFlight({106, 107, 108}, false);
   // Every tag range names the IMU and one member: DAH stacks all instances, the exact update.
-  EXPECT_LT(maxRelative(dah.fullCovariance(), ref.fullCovariance()), 1e-9);
-  EXPECT_LT(maxAnchorDifference(dah, ref), 1e-12);
+  EXPECT_LT(maxRelative(dah->fullCovariance(), ref->fullCovariance()), 1e-9);
+  EXPECT_LT(maxAnchorDifference(*dah, *ref), 1e-12);
   // The anchors' cross-covariance built through the pose is there, as in the centralized filter…
-  const Eigen::MatrixXd C_ref = ref.covariance(106, 107);
+  const Eigen::MatrixXd C_ref = ref->covariance(106, 107);
   EXPECT_GT(C_ref.cwiseAbs().maxCoeff(), 1e-4);
-  EXPECT_LT(maxRelative(dah.covariance(106, 107), C_ref), 1e-9);
+  EXPECT_LT(maxRelative(dah->covariance(106, 107), C_ref), 1e-9);
   // … and plain DAH never builds it.
-  ModularFilter plain(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}, true);
-  setUp(plain);
-  fly(plain, false);
-  EXPECT_EQ(plain.covariance(106, 107).cwiseAbs().maxCoeff(), 0.0);
-  EXPECT_GT(maxAnchorDifference(plain, ref), 1e-4);
-  dah.checkInvariants();
+  const auto plain = dahFlight({}, false);
+  EXPECT_EQ(plain->covariance(106, 107).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(maxAnchorDifference(*plain, *ref), 1e-4);
+  dah->checkInvariants();
 }
 
 TEST(DahJointSets, SetWithTheImuKeepsAnchorPairUpdatesExact) {
-  CentralizedEkf ref(propagator(), KindRandomWalks{}, true);
-  setUp(ref);
-  fly(ref, true);
+  const auto ref = centralizedFlight(true);
   // Anchor–anchor ranges name no IMU: with the anchors alone in the set the IMU's pairs are
   // approximated (DAH's correction), with the IMU in the set the update is exact again.
-  ModularFilter anchors_only(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}, true);
-  setUp(anchors_only);
-  anchors_only.joinJointSet({106, 107, 108});
-  fly(anchors_only, true);
-  EXPECT_GT(maxRelative(anchors_only.fullCovariance(), ref.fullCovariance()), 1e-6);
-  ModularFilter with_imu(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}, true);
-  setUp(with_imu);
-  with_imu.joinJointSet({106, 107, 108, 1});
-  fly(with_imu, true);
-  EXPECT_LT(maxRelative(with_imu.fullCovariance(), ref.fullCovariance()), 1e-9);
-  EXPECT_LT(maxAnchorDifference(with_imu, ref), 1e-12);
-  with_imu.checkInvariants();
+  const auto anchors_only = dahFlight({106, 107, 108}, true);
+  EXPECT_GT(maxRelative(anchors_only->fullCovariance(), ref->fullCovariance()), 1e-6);
+  const auto with_imu = dahFlight({106, 107, 108, 1}, true);
+  EXPECT_LT(maxRelative(with_imu->fullCovariance(), ref->fullCovariance()), 1e-9);
+  EXPECT_LT(maxAnchorDifference(*with_imu, *ref), 1e-12);
+  with_imu->checkInvariants();
 }
 
 TEST(DahJointSets, SetsMergeForgetRemovedMembersAndAreSnapshotWithTheFilter) {
