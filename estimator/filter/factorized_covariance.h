@@ -11,7 +11,8 @@
 ///    updates Σ_PP exactly, writes the pair factors within P (S̄_ij = L_i'⁻¹ Σ_ij',
 ///    S̄_ji = L_j'⁻¹) and folds the correction of the other pairs into the pending factor:
 ///    Σ_ik' = Σ_ii' Σ_ii⁻¹ Σ_ik for k ∉ P, i.e. L_i ← Σ_ii' Σ_ii⁻¹ L_i (|P| = 1: L_i ← (I − K H) L_i,
-///    exact). Cost O(|P|³ + log #partners), independent of the number of instances.
+///    exact). Cost O(|P|³ + log #partners), independent of the number of instances. P includes
+///    the joint sets (joinSet) of the named instances: the pairs inside a set are never approximated.
 /// Only the instance a step concerns is written (copy-on-write, so snapshots stay valid).
 
 #include <Eigen/Core>
