@@ -110,6 +110,11 @@ void forEachUwbField(Opt& o, Visitor& v) {
     "dah only: the tags' gamma instances join the anchors' joint set (merges the batches into one)");
   v("uwb.dah_joint_imu", o.uwb.dah_joint_imu,
     "dah only: the IMU joins that set too (every pose update also corrects its anchors)");
+  v("uwb.reentry_gap_s", o.uwb.reentry_gap_s, "no tag range accepted for this long: hold and cross-check the next ones, 0 = off [s]");
+  v("uwb.reentry_hold_s", o.uwb.reentry_hold_s, "longest hold after a gap, at most window_s [s]");
+  v("uwb.reentry_min_ranges", o.uwb.reentry_min_ranges, "held ranges needed to test them against each other [-]");
+  v("uwb.reentry_min_anchors", o.uwb.reentry_min_anchors, "distinct anchors among them [-]");
+  v("uwb.reentry_gate_probability", o.uwb.reentry_gate_probability, "leave-one-out chi^2 gate of a held range [-]");
 }
 
 /// forEachField, part: zero-velocity updates and the health monitor.
@@ -235,6 +240,11 @@ void EstimatorOptions::validate() const {
   need(uwb.dah_joint_anchors == "none" || uwb.dah_joint_anchors == "batch" || uwb.dah_joint_anchors == "all",
        "uwb.dah_joint_anchors must be none, batch or all");
   need(window_s >= 0.0, "window_s >= 0");
+  need(uwb.reentry_gap_s >= 0.0 && (uwb.reentry_gap_s == 0.0 || (uwb.reentry_hold_s > 0.0 && uwb.reentry_hold_s <= window_s)),
+       "uwb.reentry_gap_s >= 0; with a gap, 0 < uwb.reentry_hold_s <= window_s");
+  need(uwb.reentry_min_ranges >= 2 && uwb.reentry_min_anchors >= 2 && uwb.reentry_gate_probability > 0.0 &&
+           uwb.reentry_gate_probability < 1.0,
+       "uwb.reentry_min_ranges >= 2, uwb.reentry_min_anchors >= 2, 0 < uwb.reentry_gate_probability < 1");
   need(pose_output_rate_hz >= 0.0 && anchors_output_rate_hz > 0.0 && status_rate_hz > 0.0, "output rates");
   need(imu.acc_noise_density > 0 && imu.gyro_noise_density > 0 && imu.acc_bias_rw >= 0 && imu.gyro_bias_rw >= 0,
        "imu noise densities > 0");

@@ -155,6 +155,15 @@ struct UwbOptions {
   /// ZUPT, ranges to exactly known anchors) also corrects the set's anchors through their
   /// correlation with the pose, as the exact filter does.
   bool dah_joint_imu = true;
+  /// Ranges after an aiding gap (issue 8, docs/robustness.md "Range gaps"): when no tag–anchor
+  /// range was accepted for `reentry_gap_s`, the tag ranges of the next `reentry_hold_s` are held,
+  /// tested against each other (ReentryCheck; with at least `reentry_min_ranges` from
+  /// `reentry_min_anchors` anchors, else all are fused) and the agreeing ones fused at their own times.
+  double reentry_gap_s = 2.0;             ///< gap that starts a hold, 0 = off [s]
+  double reentry_hold_s = 0.5;            ///< longest hold, at most window_s [s]
+  int reentry_min_ranges = 4;             ///< held ranges needed to test them against each other [-]
+  int reentry_min_anchors = 3;            ///< distinct anchors among them [-]
+  double reentry_gate_probability = 0.999;  ///< leave-one-out χ²₁ gate [-]
 };
 
 struct ZuptOptions {

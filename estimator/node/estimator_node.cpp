@@ -141,6 +141,8 @@ void EstimatorNode::resetAll() {
   clearRerunHistory();
   rerun_anchors_.clear();
   rerun_pending_ = false;
+  reentry_ = ReentryHold{};
+  last_tag_range_accepted_.reset();
   pending_height_bias_.reset();
   last_align_height_.reset();
   seen_.clear();
@@ -268,12 +270,10 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     e.before = pos->before;
     auto it = history_.insert(pos, std::move(e));
     process(it->input, true);
-    for (++it; it != history_.end(); ++it) {
-      it->before = std::make_shared<const Snapshot>(cur_.copy());
-      process(it->input, false);
-    }
+    replayAfter(it);
   }
   newest_ = std::max(*newest_, t);
+  releaseReentryIfDue();
   // Anchors calibrated together arrive as consecutive ANCHOR_INITs: one re-run for all of them.
   if (rerun_pending_ && !std::holds_alternative<AnchorInit>(in)) rerunFromOldest();
   retireHistory(*newest_ - Duration::fromSec(options_.window_s));
@@ -281,6 +281,13 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   while (!still_at_.empty() && still_at_.begin()->first < oldest_still_us) still_at_.erase(still_at_.begin());
   updateHealth(*newest_);
   publishPeriodic();
+}
+
+void EstimatorNode::replayAfter(std::deque<Entry>::iterator it) {
+  for (++it; it != history_.end(); ++it) {
+    it->before = std::make_shared<const Snapshot>(cur_.copy());
+    process(it->input, false);
+  }
 }
 
 void EstimatorNode::process(const EstimatorInput& in, bool first) {

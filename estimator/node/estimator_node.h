@@ -66,6 +66,7 @@
 #include "estimator/node/static_initializer.h"
 #include "estimator/zupt/stillness_detector.h"
 #include "estimator/node/step_timings.h"
+#include "estimator/uwb/reentry_check.h"
 #include "estimator/uwb/uwb_network.h"
 #include "estimator/zupt/zupt_model.h"
 
@@ -232,6 +233,15 @@ class EstimatorNode {
   void clearRerunHistory();
   /// Oldest IMU time whose stillness a replay may need [µs].
   int64_t oldestReplayUs(int64_t newest_us) const;
+  /// Re-processes the entries after `it` on cur_ (refreshing their snapshots), as replays do.
+  void replayAfter(std::deque<Entry>::iterator it);
+  /// processRange's part for tag ranges after an aiding gap (UwbOptions reentry_*): false when the
+  /// range is not fused now (held, or rejected by the joint check); `count` is set when a released
+  /// range is fused for the first time (its counters and health were deferred).
+  bool reentryAdmit(const RangeSample& s, SensorId anchor, const Linearization& lin, bool first, bool* count);
+  /// Releases the held ranges once reentry_hold_s passed: ReentryCheck decides,
+  /// then the node rewinds to the first held range and re-processes from there.
+  void releaseReentryIfDue();
   void event(bool first, const std::string& kind, const std::string& message = "");
   void publishPeriodic();
   void resetAll();
@@ -288,6 +298,16 @@ class EstimatorNode {
   /// refine.rerun_on_anchor_join for this strategy (dah: and refine.rerun_with_dah).
   bool rerun_enabled_ = false;
   bool applying_pending_inits_ = false;  ///< initialize() is applying held anchors (no re-run)
+  /// Tag ranges after an aiding gap (reentryAdmit): held until released, then their fate by key.
+  enum class HeldFate { kRejected, kAcceptedUncounted, kAccepted };
+  struct ReentryHold {
+    std::optional<Timestamp> since;  ///< time of the first held range (holding while set)
+    std::vector<std::pair<InputOrder, ReentryCheck::Held>> held;
+    Eigen::Matrix3d P_pp = Eigen::Matrix3d::Zero();  ///< position covariance at the first held range [m²]
+    std::map<InputOrder, HeldFate> decided;
+  };
+  ReentryHold reentry_;
+  std::optional<Timestamp> last_tag_range_accepted_;
   std::set<InputOrder> seen_;  ///< keys of the inputs admitted within the window (duplicates)
   std::optional<Timestamp> newest_;   ///< newest input time seen (also before init)
   TimeGuard time_guard_;

@@ -328,6 +328,7 @@ void EstimatorNode::propagateFilter(const Eigen::Vector3d& acc, const Eigen::Vec
 
 void EstimatorNode::updateHealth(Timestamp t) {
   if (!initialized()) return;
+  if (reentry_.since) return;  // ranges are arriving, held for their joint check (at most uwb.reentry_hold_s)
   if (last_health_eval_ && (t - *last_health_eval_).sec() < 0.1) return;
   last_health_eval_ = t;
   const auto [sigma_p, axis] = weakestPositionAxis(cur_.filter->covariance(setup_.imu_id, setup_.imu_id)
@@ -408,6 +409,8 @@ void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp 
   cur_.last_zupt = t;
   history_.clear();  // a rewind must not restore the state before the re-initialization
   clearRerunHistory();  // nor a re-run (it starts from the new pose, with the anchors it has)
+  reentry_ = ReentryHold{};  // held ranges were in the history; the new pose comes from ranges
+  last_tag_range_accepted_ = t;
   init_time_ = t;
   health_.reset(t);
 }

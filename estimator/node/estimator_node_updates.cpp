@@ -107,8 +107,10 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
     event(first, RangeModel::statusName(st));
     return;
   }
-  const UpdateResult r = cur_.filter->update(lin, range_gate_);
   const bool tag_range = cur_.network->isTag(z.a) || cur_.network->isTag(z.b);
+  bool count = first;
+  if (tag_range && !reentryAdmit(s, cur_.network->isTag(z.a) ? z.b : z.a, lin, first, &count)) return;
+  const UpdateResult r = cur_.filter->update(lin, range_gate_);
   // H P Hᵀ / R from NIS = ν²/S, S = H P Hᵀ + R (scalar range).
   const double nu2 = lin.residual(0) * lin.residual(0), R = lin.R(0, 0);
   const double prior_ratio = r.nis > 0.0 && R > 0.0 ? std::max(0.0, nu2 / r.nis - R) / R : 0.0;
@@ -117,8 +119,9 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
     spdlog::info("estimator: IMU noise scale {:.3g} at t={} (median range NIS {:.2f} of its expected value)",
                  cur_.noise_adapter.scale(), formatSeconds(s.t), cur_.noise_adapter.lastRatio());
   }
-  if (!first) return;
+  if (!count) return;
   if (!r.accepted) diag_.count("gated_range");
+  if (tag_range && r.accepted) last_tag_range_accepted_ = s.t;
   // Tag ranges tell whether the pose is right; ranges between anchors do not.
   if (tag_range)
     health_.onUpdate(s.t, "range", cur_.network->isTag(z.a) ? z.b : z.a, r.accepted, r.nis);

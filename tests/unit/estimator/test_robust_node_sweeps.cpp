@@ -105,3 +105,66 @@ TEST(RobustNode, NlosOutliersDoNotTriggerAWrongReAlignment) {
   EXPECT_EQ(node.diagnostics().get("recovery"), 0);
   EXPECT_LT(res.max_error_after_m, 0.5);
 }
+
+TEST(RobustNode, TheFirstRangesAfterARangeGapAreCrossCheckedBeforeTheyAreFused) {
+  // docs/robustness.md "Range gaps": no range for 10 s, the IMU carries the pose (3σ grows to
+  // about 1.7 m), then NLOS ranges among the first ones after the gap. Each passes its own χ²
+  // gate against the wide prior and pulls the estimate; held for 0.5 s and tested against each
+  // other (ReentryCheck) they are found and left out.
+  const sim::SimulationOptions so = simulationOptions({4242, sim::TrajectoryKind::Figure8, Eigen::Vector3d(10, 8, 5),
+                                                      sim::AnchorLayoutKind::Walls, 3, 4, 0,
+                                                      0.12, 0.0, 0.0, "fc", 80.0});
+  auto r = sim::ScenarioSimulator(so).run();
+  Dataset& ds = r.dataset;
+  std::erase_if(ds.ranges, [](const RangeSample& s) { return s.t.sec() >= 50.0 && s.t.sec() < 60.0; });
+  int n_tag_ranges = 0, n_nlos = 0;
+  for (RangeSample& s : ds.ranges) {
+    if (s.t.sec() < 60.0 || !(ds.setup.isTag(s.id_initiator) || ds.setup.isTag(s.id_responder))) continue;
+    if (ds.setup.isTag(s.id_initiator) && ds.setup.isTag(s.id_responder)) continue;
+    if (++n_tag_ranges > 12) break;
+    if (n_tag_ranges % 3 == 1) {  // the 1st, 4th, 7th and 10th tag–anchor range: 1.2 m too long
+      s.range_m += 1.2;
+      s.range_corr_m += 1.2;
+      ++n_nlos;
+    }
+  }
+  ASSERT_EQ(n_nlos, 4);
+  // Error at the end of the gap (dead-reckoned), largest in 60–63 s and in 60.6–63 s (after the hold).
+  struct Errors {
+    double at_gap_end_m = 0.0, max_m = 0.0, max_after_hold_m = 0.0;
+    int64_t rejected = 0, recoveries = 0;
+  };
+  auto runWith = [&](double gap_s) {
+    EstimatorOptions o;
+    o.uwb.reentry_gap_s = gap_s;
+    EstimatorNode node(o, ds.setup);
+    Errors err;
+    size_t gi = 0;
+    for (const auto& in : mergeInTimeOrder(ds)) {
+      node.onInput(in);
+      const Timestamp t = inputTime(in);
+      if (!node.initialized() || !std::holds_alternative<ImuSample>(in) || t.sec() < 59.9 || t.sec() > 63.0) continue;
+      while (gi + 1 < ds.ground_truth.size() && ds.ground_truth[gi + 1].t <= t) ++gi;
+      const double e = (node.pose()->p_IinG - ds.ground_truth[gi].p_IinG).norm();
+      if (t.sec() < 60.0) err.at_gap_end_m = e;
+      if (t.sec() >= 60.0) err.max_m = std::max(err.max_m, e);
+      if (t.sec() >= 60.6) err.max_after_hold_m = std::max(err.max_after_hold_m, e);
+    }
+    err.rejected = node.diagnostics().get("range_reentry_rejected");
+    err.recoveries = node.diagnostics().get("recovery");
+    std::cout << "reentry_gap_s " << gap_s << ": error " << err.at_gap_end_m << " m at the end of the gap, max "
+              << err.max_m << " m in 60-63 s, " << err.max_after_hold_m << " m in 60.6-63 s; rejected " << err.rejected
+              << ", recoveries " << err.recoveries << std::endl;
+    EXPECT_TRUE(node.initialized()) << node.waitingFor();
+    return err;
+  };
+  const Errors off = runWith(0.0);
+  const Errors on = runWith(EstimatorOptions{}.uwb.reentry_gap_s);
+  // Fused one by one, the NLOS ranges pull the dead-reckoned pose further off.
+  EXPECT_EQ(off.rejected, 0);
+  EXPECT_GT(off.max_m, off.at_gap_end_m + 0.3);
+  // Held and cross-checked: they are found, and the others bring the pose back at once.
+  EXPECT_GE(on.rejected, 3);
+  EXPECT_EQ(on.recoveries, 0);
+  EXPECT_LT(on.max_after_hold_m, 0.15);
+}
