@@ -165,6 +165,7 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
   if (inputs.empty()) throw std::runtime_error(o.dataset + ": no samples");
   const double data_s = (inputTime(inputs.back()) - inputTime(inputs.front())).sec();
   const double wall_s = feed(pipe, inputs, data_s);
+  node.finishRerun();  // refine.rerun_mode async: a re-run still on its worker comes in before the final anchors
   if (node.initialized())
     for (const auto& a : node.anchors()) anchor_writer.write(a);
   est_writer.flush();

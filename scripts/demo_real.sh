@@ -104,21 +104,10 @@ say "5/5 evaluating the in-process run for comparison"
 "$BIN/meshnav_eval" --dataset "$out/dataset" --run "$out/run" --no-plots > "$out/run/eval.txt" 2>> "$out/eval.log" \
   || { tail -20 "$out/eval.log"; die "meshnav_eval of the in-process run failed; full log: $out/eval.log"; }
 
-# Summary from the two metrics.yaml files (the baseline is the same dataset's, so either has it).
-"$PY" - "$out/lcm/metrics.yaml" "$out/run/metrics.yaml" >&2 <<'EOF'
-import sys, yaml
-lcm, run = (yaml.safe_load(open(p)) for p in sys.argv[1:3])
-mode = lcm["alignment"]["mode"]
-b = lcm.get("baseline") or {}
-rows = [("meshnav over LCM (estimator process)", lcm["pose"]["position"]["rmse_m"], lcm["pose"]["n_evaluated"], "estimates"),
-        ("meshnav in one process (meshnav_run)", run["pose"]["position"]["rmse_m"], run["pose"]["n_evaluated"], "estimates"),
-        ("plain multilateration of the ranges", b.get("position_rmse_m", float("nan")), b.get("n_evaluated", 0), "fixes")]
-print("\nISAS-Walk1: position ATE (RMSE) after %s alignment to the Vive truth" % mode)
-for name, v, n, what in rows:
-    print("  %-38s %6.3f m   (%d %s)" % (name, v, n, what))
-d = lcm["pose"]["position"]["rmse_m"] - run["pose"]["position"]["rmse_m"]
-print("  LCM minus in-process: %+.3f m" % d)
-EOF
+# Summary from the two metrics.yaml files; without pose metrics (the estimator never initialized)
+# a message and exit 1 instead of a table.
+"$PY" "$ROOT/scripts/demo_compare.py" "$out/lcm/metrics.yaml" "$out/run/metrics.yaml" >&2 \
+  || die "the comparison failed (above); the estimators' logs: $out/processes.log (LCM), $out/run.log (in-process)"
 echo >&2
 say "done. Plots in $out/lcm/:"
 for p in trajectory_xy.png trajectory_3d.png position_error.png range_residuals.png orientation_error.png nees.png; do

@@ -179,6 +179,8 @@ void forEachRefineField(Opt& o, Visitor& v) {
     "gamma means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false)");
   v("refine.rerun_with_dah", o.refine.rerun_with_dah,
     "strategy dah too (with its joint sets, uwb.dah_joint_anchors; see docs)");
+  v("refine.rerun_mode", o.refine.rerun_mode,
+    "auto | sync | async: re-run inline, or on a worker while the node keeps publishing; auto = async in the LCM process");
 }
 
 /// Visits every option as (dotted key, field, unit/comment). The single list used for loading,
@@ -288,6 +290,8 @@ void EstimatorOptions::validate() const {
        "time.max_offset_s >= window_s, time.rebase_after >= 1");
   need(refine.max_history_s >= window_s && refine.rerun_prior_sigma_m > 0 && refine.rerun_gamma_sigma_m > 0,
        "refine.max_history_s >= window_s, refine.rerun_prior_sigma_m > 0, refine.rerun_gamma_sigma_m > 0");
+  need(refine.rerun_mode == "auto" || refine.rerun_mode == "sync" || refine.rerun_mode == "async",
+       "refine.rerun_mode must be auto, sync or async");
   need(zupt.rate_hz > 0 && zupt.sigma_acc_m_s2 > 0 && zupt.sigma_gyro_rad_s > 0 && zupt.sigma_vel_m_s > 0 &&
            zupt.stillness_sigma_vel_m_s > 0 && zupt.stillness_sigma_gyro_rad_s > 0,
        "zupt rate and sigmas > 0");

@@ -217,6 +217,12 @@ struct RefineOptions {
   /// (uwb.dah_joint_anchors, uwb.dah_joint_tag_biases) DAH reaches DP's refinement (S2: 0.115 →
   /// 0.063 m, DP 0.061 m); without the sets it did not gain (0.116 m; docs/results.md).
   bool rerun_with_dah = true;
+  /// Where a re-run is computed: `sync` inline in the input handler (the node publishes nothing
+  /// meanwhile: 0.1–0.4 s on S2, seconds under ASan), `async` on a worker thread from immutable
+  /// copies while the node keeps publishing, swapped in at the first input after it is done (wall
+  /// clock dependent, so not bit-for-bit repeatable), `auto`: async in the LCM estimator process,
+  /// sync in in-process replays (meshnav_run, tests, paper tables), which stay deterministic.
+  std::string rerun_mode = "auto";
 };
 
 struct EstimatorOptions {

@@ -4,7 +4,7 @@
 /// anchor initialization) are in estimator_node_updates.cpp; initialization, health and recovery
 /// in estimator_node_robustness.cpp.
 
-#include "estimator/node/estimator_node.h"
+#include "estimator/node/estimator_node_rerun.h"
 #include "common/plausibility.h"
 
 #include <spdlog/spdlog.h>
@@ -115,12 +115,11 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
   skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
   rerun_enabled_ = options_.refine.rerun_on_anchor_join && (options_.strategy != "dah" || options_.refine.rerun_with_dah);
+  rerun_async_ = options_.refine.rerun_mode == "async";
   if (options_.baro.gate_probability > 0) baro_gate_ = chi2Quantile(1, options_.baro.gate_probability);
   if (options_.height.gate_probability > 0) height_gate_ = chi2Quantile(1, options_.height.gate_probability);
   resetAll();
 }
-
-EstimatorNode::~EstimatorNode() = default;
 
 void EstimatorNode::resetAll() {
   initializer_ = std::make_unique<StaticInitializer>(options_, setup_);
@@ -255,6 +254,7 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
                                          " minus the window " + std::to_string(options_.window_s) + " s");
     return;
   }
+  pollRerun(false);  // a worker re-run that is done comes in before this input
   Entry e{inputOrder(in), in, nullptr};
   auto pos = std::upper_bound(history_.begin(), history_.end(), e.key,
                               [](const InputOrder& k, const Entry& x) { return k < x.key; });
@@ -265,6 +265,7 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   } else {
     // Out of sequence: rewind to the snapshot before its place, re-process in order.
     diag_.count("out_of_sequence");
+    if (rerun_) rerun_->noteInserted(e.key);
     ScopedStepTimer rewind_timer(timings_, "rewind");
     cur_ = pos->before->copy();
     e.before = pos->before;
@@ -275,7 +276,7 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   newest_ = std::max(*newest_, t);
   releaseReentryIfDue();
   // Anchors calibrated together arrive as consecutive ANCHOR_INITs: one re-run for all of them.
-  if (rerun_pending_ && !std::holds_alternative<AnchorInit>(in)) rerunFromOldest();
+  if (rerun_pending_ && !rerun_ && !std::holds_alternative<AnchorInit>(in)) startRerun();
   retireHistory(*newest_ - Duration::fromSec(options_.window_s));
   const int64_t oldest_still_us = oldestReplayUs(newest_->us);
   while (!still_at_.empty() && still_at_.begin()->first < oldest_still_us) still_at_.erase(still_at_.begin());

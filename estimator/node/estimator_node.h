@@ -30,6 +30,10 @@
 ///   window are archived up to `refine.max_history_s`; after a live ANCHOR_INIT the node restores
 ///   the oldest stored state, adds the calibrated anchors there with a loose prior and
 ///   re-processes every stored input ("rerun", "rerun_inputs"; centralized and dp by default).
+///   With `refine.rerun_mode` async (the LCM process) the re-run is computed on a worker thread
+///   from immutable copies while the node keeps processing and publishing; its result is swapped
+///   in at the first input after the worker is done and the inputs that came meanwhile are
+///   re-processed from it (estimator_node_rerun_async.cpp).
 /// - Initialization: while at rest (flight state, else IMU stillness) from the landed data
 ///   (StaticInitializer); in motion, or when the landed data cannot fix the pose (one tag,
 ///   coplanar anchors), from ranges and strapdown increments over a window (MotionAligner).
@@ -39,8 +43,11 @@
 ///   IMU instance from the MotionAligner that keeps anchors, baro and tag bias states
 ///   ("recovery"); see docs/robustness.md.
 /// Poses are published per in-order IMU step (decimated to `pose_output_rate_hz`), anchors
-/// and status at their rates in data time. Not thread-safe: call from one thread.
+/// and status at their rates in data time. Not thread-safe: call from one thread (the re-run
+/// worker owns its own copies and never touches the node).
 
+#include <atomic>
+#include <chrono>
 #include <deque>
 #include <functional>
 #include <map>
@@ -122,6 +129,19 @@ class EstimatorNode {
   /// the pose too when the outage is at most `init.resume_max_outage_s` (else the pose is
   /// initialized as usual: in flight by the MotionAligner). Older: counted "resume_refused".
   void resumeFrom(EstimatorCheckpoint c) { resume_ = std::move(c); }
+  /// A re-run computed on a worker (`refine.rerun_mode` async) has not been swapped in yet.
+  bool rerunRunning() const { return rerun_ != nullptr; }
+  /// Waits for the running re-run, swaps it in and runs (and waits for) a re-run queued behind it:
+  /// a deterministic point for tests and the end of a replay or of the process.
+  void finishRerun();
+  /// Shutdown without waiting: swaps a finished worker re-run in, abandons one still running.
+  void stopRerun() {
+    pollRerun(false);
+    abandonRerun();
+  }
+  /// Test hook: called on the re-run worker before it starts (a test holds the worker there until
+  /// it releases it; the hook must return before the node is destroyed or re-initialized).
+  void setRerunWorkerHook(std::function<void()> hook) { rerun_worker_hook_ = std::move(hook); }
   /// Fault injection for tests and drills: moves the pose estimate by `dp_m` (G) and turns it by
   /// `dyaw_rad` about z, keeping its covariance, as a corrupted state would look to the filter.
   void injectPoseError(const Eigen::Vector3d& dp_m, double dyaw_rad);
@@ -143,6 +163,9 @@ class EstimatorNode {
     EstimatorInput input;
     std::shared_ptr<const Snapshot> before;
   };
+  struct RerunJob;      ///< estimator_node_rerun_async.cpp
+  struct RerunResult;
+  struct RunningRerun;
   /// An input older than the out-of-sequence window, kept for re-runs (RefineOptions); every
   /// eighth of `refine.max_history_s` one keeps the state before it (a checkpoint), and the
   /// oldest always does: the re-run's starting state.
@@ -222,8 +245,30 @@ class EstimatorNode {
   void noteAnchorJoin(const AnchorInit& a, bool first);
   /// The second pass (RefineOptions): restores the oldest stored state, adds every calibrated
   /// anchor it lacks with the loose prior, re-processes archive_ and history_ (refreshing their
-  /// snapshots) and continues live from there. Counted "rerun", logged with the wall time.
-  void rerunFromOldest();
+  /// snapshots) and continues live from there. Counted "rerun", logged with the wall time. Inline
+  /// (sync) or on a worker (async, swapped in by pollRerun).
+  void startRerun();
+  /// Immutable copies of what a re-run needs (nullopt: nothing stored, counted "rerun_skipped").
+  std::optional<RerunJob> makeRerunJob() const;
+  /// Runs `job` on this node's cur_ (the live node inline, a replay node on the worker).
+  RerunResult computeRerun(RerunJob job, const std::atomic<bool>& cancel);
+  /// Takes a re-run's result: its snapshots for the stored inputs it processed, the state before
+  /// the first input it did not (`divergence`: the oldest input inserted among its inputs while it
+  /// ran), and re-processes from there.
+  /// Returns the number of inputs re-processed, nullopt when a snapshot is missing (nothing changed).
+  std::optional<int64_t> applyRerun(RerunResult& r, std::optional<InputOrder> divergence);
+  /// Starts `job` on a worker with a replay node of its own (refine.rerun_mode async); `t_job`:
+  /// when the node began taking its copies (logged at the swap).
+  void launchRerun(RerunJob job, std::chrono::steady_clock::time_point t_job);
+  /// The re-run's log line; `how` tells where it ran.
+  void logRerun(const RerunResult& r, const std::string& how) const;
+  /// Swaps a finished worker re-run in (`wait`: blocks until it is finished).
+  void pollRerun(bool wait);
+  /// Drops a running worker re-run (a re-initialization or the destructor), counted "rerun_abandoned".
+  void abandonRerun();
+  /// The replay node's copy of what processing reads besides cur_ (stillness, flight state, baro
+  /// reference, pending height bias, re-run anchors, gravity direction).
+  void copyReplayContext(const EstimatorNode& live);
   /// The ANCHOR_INIT of a re-run: the calibration's means, position σ and γ σ of RefineOptions.
   AnchorInit loosePrior(const AnchorInit& a, Timestamp t) const;
   /// The anchors held before initialization (or from a resumed checkpoint), applied at `t` with
@@ -305,9 +350,14 @@ class EstimatorNode {
     std::vector<std::pair<InputOrder, ReentryCheck::Held>> held;
     Eigen::Matrix3d P_pp = Eigen::Matrix3d::Zero();  ///< position covariance at the first held range [m²]
     std::map<InputOrder, HeldFate> decided;
+    int64_t n_seen = 0;                  ///< tag ranges seen live (their mean rate decides whether a hold can check)
+    std::optional<Timestamp> first_seen;
   };
   ReentryHold reentry_;
   std::optional<Timestamp> last_tag_range_accepted_;
+  bool rerun_async_ = false;             ///< refine.rerun_mode async: re-runs on a worker
+  std::unique_ptr<RunningRerun> rerun_;  ///< the worker re-run not swapped in yet
+  std::function<void()> rerun_worker_hook_;
   std::set<InputOrder> seen_;  ///< keys of the inputs admitted within the window (duplicates)
   std::optional<Timestamp> newest_;   ///< newest input time seen (also before init)
   TimeGuard time_guard_;

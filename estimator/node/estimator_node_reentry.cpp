@@ -32,8 +32,19 @@ bool EstimatorNode::reentryAdmit(const RangeSample& s, SensorId anchor, const Li
   const auto held = std::find_if(reentry_.held.begin(), reentry_.held.end(), [&](const auto& h) { return h.first == key; });
   if (held != reentry_.held.end()) return false;  // replayed by a rewind while still held
   if (!first) return true;
+  ++reentry_.n_seen;
+  if (!reentry_.first_seen) reentry_.first_seen = s.t;
   const Timestamp last = last_tag_range_accepted_.value_or(init_time_);
   if (!reentry_.since && (s.t - last).sec() < o.reentry_gap_s) return true;
+  if (!reentry_.since) {
+    // Sparse ranging (MILUV: about one tag range per second) fills no hold with enough ranges to
+    // test; holding would only delay them. The mean tag-range rate since the first one decides.
+    const double span_s = (s.t - *reentry_.first_seen).sec();
+    if (span_s <= 0.0 || static_cast<double>(reentry_.n_seen) / span_s * o.reentry_hold_s < o.reentry_min_ranges) {
+      diag_.count("range_reentry_too_sparse");
+      return true;
+    }
+  }
   const NominalState& x = cur_.filter->state();
   const JacobianBlock* b = lin.find(x.imu_id);
   if (!b || lin.dim() != 1) return true;

@@ -11,7 +11,7 @@
 #include <algorithm>
 #include <chrono>
 
-#include "estimator/node/estimator_node.h"
+#include "estimator/node/estimator_node_rerun.h"
 
 namespace meshnav::estimator {
 
@@ -32,6 +32,7 @@ void EstimatorNode::applyPendingAnchorInits(Timestamp t) {
 }
 
 void EstimatorNode::clearRerunHistory() {
+  abandonRerun();  // its base is gone too
   archive_.clear();
   last_checkpoint_.reset();
 }
@@ -84,6 +85,7 @@ void EstimatorNode::noteAnchorJoin(const AnchorInit& a, bool first) {
   std::erase_if(rerun_anchors_, [&](const AnchorInit& r) { return r.id == a.id; });
   rerun_anchors_.push_back(a);
   rerun_pending_ = true;
+  if (rerun_) diag_.count("rerun_queued");  // runs after the current one, with every joined anchor
 }
 
 AnchorInit EstimatorNode::loosePrior(const AnchorInit& a, Timestamp t) const {
@@ -100,42 +102,124 @@ AnchorInit EstimatorNode::loosePrior(const AnchorInit& a, Timestamp t) const {
   return l;
 }
 
-void EstimatorNode::rerunFromOldest() {
+void EstimatorNode::startRerun() {
   rerun_pending_ = false;
-  const std::shared_ptr<const Snapshot> base = !archive_.empty() ? archive_.front().checkpoint
-                                               : history_.empty()  ? nullptr
-                                                                   : history_.front().before;
-  if (!base || !base->filter) {
+  const auto t_job = std::chrono::steady_clock::now();
+  std::optional<RerunJob> job = makeRerunJob();
+  if (!job) {
     diag_.count("rerun_skipped");  // nothing stored (e.g. right after a re-initialization)
     return;
   }
-  const auto wall0 = std::chrono::steady_clock::now();
-  ScopedStepTimer timer(timings_, "rerun");
-  cur_ = base->copy();
-  const Timestamp t0 = cur_.filter->state().t;
-  std::string ids;
-  for (const AnchorInit& a : rerun_anchors_) {
-    if (cur_.filter->state().values<AnchorKind>().count(a.id)) continue;  // from an earlier re-run's checkpoint
-    applyAnchorInit(loosePrior(a, t0), false);
-    ids += (ids.empty() ? "" : ", ") + std::to_string(a.id);
-  }
-  int64_t n = 0;
-  for (auto it = archive_.begin(); it != archive_.end(); ++it, ++n) {
-    if (it != archive_.begin() && it->checkpoint) it->checkpoint = std::make_shared<const Snapshot>(cur_.copy());
-    process(it->input, false);
-  }
-  for (Entry& e : history_) {  // the out-of-sequence window: a later rewind must restore re-run states
-    e.before = std::make_shared<const Snapshot>(cur_.copy());
-    process(e.input, false);
-    ++n;
-  }
-  const double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
   diag_.count("rerun");
-  diag_.count("rerun_inputs", n);
+  diag_.count("rerun_inputs", static_cast<int64_t>(job->inputs.size()));
+  if (rerun_async_) {
+    launchRerun(std::move(*job), t_job);
+    return;
+  }
+  ScopedStepTimer timer(timings_, "rerun");
+  const std::atomic<bool> never{false};
+  RerunResult r = computeRerun(std::move(*job), never);
+  applyRerun(r, std::nullopt);  // inline: every stored input is the job's own, nothing to re-process
+  logRerun(r, "");
+}
+
+std::optional<EstimatorNode::RerunJob> EstimatorNode::makeRerunJob() const {
+  const bool from_archive = !archive_.empty();
+  RerunJob job;
+  job.base = from_archive ? archive_.front().checkpoint : history_.empty() ? nullptr : history_.front().before;
+  if (!job.base || !job.base->filter) return std::nullopt;
+  job.base_key = from_archive ? archive_.front().key : history_.front().key;
+  const Timestamp t0 = job.base->filter->state().t;
+  for (const AnchorInit& a : rerun_anchors_) job.priors.push_back(loosePrior(a, t0));
+  const size_t n = archive_.size() + history_.size();
+  job.keys.reserve(n);
+  job.inputs.reserve(n);
+  job.keep_before.reserve(n);
+  for (const Archived& a : archive_) {
+    job.keys.push_back(a.key);
+    job.inputs.push_back(a.input);
+    job.keep_before.push_back(a.checkpoint && a.key != job.base_key);  // the base stays the state without them
+  }
+  for (const Entry& e : history_) {  // the out-of-sequence window: a later rewind must restore re-run states
+    job.keys.push_back(e.key);
+    job.inputs.push_back(e.input);
+    job.keep_before.push_back(1);
+  }
+  return job;
+}
+
+EstimatorNode::RerunResult EstimatorNode::computeRerun(RerunJob job, const std::atomic<bool>& cancel) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  RerunResult r;
+  r.base_key = job.base_key;
+  cur_ = job.base->copy();
+  r.t0 = cur_.filter->state().t;
+  for (const AnchorInit& a : job.priors) {
+    if (cur_.filter->state().values<AnchorKind>().count(a.id)) continue;  // from an earlier re-run's checkpoint
+    applyAnchorInit(a, false);
+    r.ids += (r.ids.empty() ? "" : ", ") + std::to_string(a.id);
+  }
+  for (size_t i = 0; i < job.inputs.size(); ++i) {
+    if (cancel.load(std::memory_order_relaxed)) {
+      r.cancelled = true;
+      break;
+    }
+    if (job.keep_before[i]) r.before.emplace(job.keys[i], std::make_shared<const Snapshot>(cur_.copy()));
+    process(job.inputs[i], false);
+  }
+  r.t_end = cur_.filter->state().t;
+  r.state = std::move(cur_);
+  r.keys = std::move(job.keys);
+  r.wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
+  return r;
+}
+
+std::optional<int64_t> EstimatorNode::applyRerun(RerunResult& r, std::optional<InputOrder> divergence) {
+  using SnapshotPtr = std::shared_ptr<const Snapshot>;
+  // The job's own stored inputs: up to its newest, before any input inserted among them meanwhile.
+  auto own = [&](const InputOrder& k) { return !r.keys.empty() && k <= r.keys.back() && (!divergence || k < *divergence); };
+  auto lookup = [&](const InputOrder& k, SnapshotPtr& out) {
+    const auto it = r.before.find(k);
+    if (it != r.before.end()) out = it->second;
+    return it != r.before.end();
+  };
+  std::vector<SnapshotPtr> archive_snap(archive_.size()), history_snap(history_.size());
+  size_t a = 0, h = 0;  // the first archived / windowed input that is not the job's own
+  for (; a < archive_.size() && own(archive_[a].key); ++a)
+    if (archive_[a].checkpoint && archive_[a].key != r.base_key && !lookup(archive_[a].key, archive_snap[a]))
+      return std::nullopt;
+  if (a == archive_.size())
+    for (; h < history_.size() && own(history_[h].key); ++h)
+      if (!lookup(history_[h].key, history_snap[h])) return std::nullopt;
+  // The state before that input: the job's before its next own input (an inserted input), or its final state.
+  SnapshotPtr resume;
+  if (a < archive_.size() || h < history_.size()) {
+    const InputOrder k = a < archive_.size() ? archive_[a].key : history_[h].key;
+    const auto next = std::lower_bound(r.keys.begin(), r.keys.end(), k);
+    if (next != r.keys.end() && !lookup(*next, resume)) return std::nullopt;
+  }
+  for (size_t i = 0; i < a; ++i)
+    if (archive_snap[i]) archive_[i].checkpoint = std::move(archive_snap[i]);
+  for (size_t i = 0; i < h; ++i) history_[i].before = std::move(history_snap[i]);
+  cur_ = resume ? resume->copy() : std::move(r.state);
+  int64_t n = 0;
+  for (size_t i = a; i < archive_.size(); ++i, ++n) {
+    if (archive_[i].checkpoint && archive_[i].key != r.base_key)
+      archive_[i].checkpoint = std::make_shared<const Snapshot>(cur_.copy());
+    process(archive_[i].input, false);
+  }
+  for (size_t i = h; i < history_.size(); ++i, ++n) {
+    history_[i].before = std::make_shared<const Snapshot>(cur_.copy());
+    process(history_[i].input, false);
+  }
+  return n;
+}
+
+void EstimatorNode::logRerun(const RerunResult& r, const std::string& how) const {
   spdlog::info("estimator: re-run from t={} over {} inputs ({:.1f} s of data), anchors [{}] uncertain from there "
-               "(σ {} m around their calibration): {:.1f} ms wall",
-               formatSeconds(t0), n, (cur_.filter->state().t - t0).sec(), ids, options_.refine.rerun_prior_sigma_m,
-               wall_ms);
+               "(σ {} m around their calibration): {:.1f} ms wall{}",
+               formatSeconds(r.t0), r.keys.size(), (r.t_end - r.t0).sec(), r.ids, options_.refine.rerun_prior_sigma_m,
+               r.wall_ms, how);
 }
 
 }  // namespace meshnav::estimator

@@ -86,6 +86,9 @@ class EstimatorProcess {
 
   /// After the loop: the final anchors and status, for the recorder.
   void finish() {
+    // A re-run done on its worker comes in before the final anchors; one still running is dropped
+    // (waiting could outlast the supervisor's stop timeout under a sanitizer).
+    node_.stopRerun();
     if (node_.initialized()) lcm_.publish(channels::kAnchors, node_.anchors());
     const EstimatorStatus st = process_.stamped(node_.status());
     lcm_.publish(channels::kEstimatorStatus, st);
@@ -142,6 +145,8 @@ int main(int argc, char** argv) {
     estimator::EstimatorOptions options;
     if (!o.config_path.empty()) options = estimator::EstimatorOptions::fromYaml(o.config_path);
     if (!o.strategy.empty()) options.strategy = o.strategy;
+    // A re-run must not stop the POSE stream here (docs/modular_estimator.md, "Re-run on anchor join").
+    if (options.refine.rerun_mode == "auto") options.refine.rerun_mode = "async";
     if (o.print_config) {
       std::cout << options.toString();
       return 0;

@@ -28,6 +28,22 @@ inline synthetic::SyntheticOptions shortNoisyFlight(uint32_t seed) {
   return o;
 }
 
+/// 30 s of the noisy synthetic flight (seed 4) with the first `n` estimated anchors (106, ...)
+/// unknown to the setup; their ranges stay in the data (the anchor re-run tests).
+inline Dataset flightWithUnknownAnchors(int n) {
+  synthetic::SyntheticOptions o;
+  o.duration_s = 30.0;
+  o.noise = true;
+  o.seed = 4;
+  o.n_estimated_anchors = n;
+  Dataset ds = synthetic::makeSyntheticDataset(o);
+  for (SensorId id = 106; id < 106 + n; ++id) {
+    ds.setup.abs_anchor_positions.erase(id);
+    ds.setup.abs_anchor_sigmas_m.erase(id);
+  }
+  return ds;
+}
+
 inline EstimatorOptions testOptions() {
   EstimatorOptions o;
   o.window_s = 1.0;

@@ -23,18 +23,7 @@ struct Case {
   Eigen::Vector3d p_true;
 };
 
-Case makeCase() {
-  synthetic::SyntheticOptions o;
-  o.duration_s = 30.0;
-  o.noise = true;
-  o.seed = 4;
-  o.n_estimated_anchors = 1;
-  Case c{synthetic::makeSyntheticDataset(o), {}};
-  c.p_true = c.ds.setup.abs_anchor_positions.at(106);
-  c.ds.setup.abs_anchor_positions.erase(106);
-  c.ds.setup.abs_anchor_sigmas_m.erase(106);
-  return c;
-}
+Case makeCase() { return {test::flightWithUnknownAnchors(1), synthetic::syntheticAnchors(1).at(106)}; }
 
 /// A calibration 0.2 m off whose covariance says so (σ 0.12 m per axis).
 AnchorInit calibration(const Case& c) {

@@ -78,6 +78,9 @@ TEST(EstimatorOptions, UnknownKeysAndBadValuesNameFileAndKey) {
   EXPECT_NE(e.find("'uwb' must be a map"), std::string::npos) << e;
   e = loadError("opts_time.yaml", "time:\n  max_offset_s: 0.5\n");  // below window_s
   EXPECT_NE(e.find("time.max_offset_s >= window_s"), std::string::npos) << e;
+  e = loadError("opts_rerun_mode.yaml", "refine:\n  rerun_mode: threaded\n");
+  EXPECT_NE(e.find("refine.rerun_mode must be auto, sync or async"), std::string::npos) << e;
+  EXPECT_EQ(loadError("opts_rerun_async.yaml", "refine:\n  rerun_mode: async\n"), "");
 }
 
 TEST(EstimatorOptions, InvalidValuesAndFilesAreRejected) {
