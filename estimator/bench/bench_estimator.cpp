@@ -9,6 +9,8 @@
 ///  - AnchorRangeUpdate/<s>/<n>: one anchor–anchor range;
 ///  - RangeUpdateGamma/dah/<n>: RangeUpdate with every estimated anchor carrying its γ towards
 ///    101–104 as states (7-state anchors, issue 10; a-priori σ_γ 0.02 m in the setup);
+///  - RangeUpdateJointSet/dah/<n>: RangeUpdate to the first 5 estimated anchors, which form one DAH
+///    joint set with the IMU (issue 10, uwb.dah_joint_anchors): the cost of the set, not of <n>;
 ///  - DelayedRangeUpdate/<s>/<n>: through EstimatorNode, one IMU sample plus one range arriving
 ///    50 ms late (rewind to the snapshot before it, re-process 50 ms of inputs);
 ///  - Micro/<s>/<N>: reference scenario (a 6-state p, v body at 100 Hz, N stationary 3-state
@@ -175,11 +177,18 @@ void Propagate(benchmark::State& state, std::string strategy, int n) {
   state.counters["state_dim"] = f->layout().dim();
 }
 
-void Update(benchmark::State& state, std::string strategy, int n, bool anchor_anchor, bool anchor_gammas) {
+void Update(benchmark::State& state, std::string strategy, int n, bool anchor_anchor, bool anchor_gammas,
+            int joint_set) {
   Warm w = warmFilter(strategy, n, anchor_gammas);
-  auto f = w.filter->clone();
   const auto& ids = w.stream->anchorIds();
   std::vector<SensorId> est(ids.end() - n, ids.end());  // the estimated anchors 106…
+  if (joint_set > 0) {  // the IMU and the first `joint_set` estimated anchors; ranges to those only
+    est.resize(static_cast<size_t>(std::min(joint_set, n)));
+    std::vector<SensorId> set = est;
+    set.push_back(w.filter->state().imu_id);
+    w.filter->joinJointSet(set);
+  }
+  auto f = w.filter->clone();
   std::mt19937 rng(3);
   std::normal_distribution<double> n01(0.0, 0.05);
   int64_t k = 0;
@@ -349,12 +358,15 @@ void registerAll() {
     for (int n : kAnchorCounts) {
       const std::string tail = std::string(s) + "/" + std::to_string(n);
       benchmark::RegisterBenchmark(("Propagate/" + tail).c_str(), Propagate, s, n);
-      benchmark::RegisterBenchmark(("RangeUpdate/" + tail).c_str(), Update, s, n, false, false);
-      benchmark::RegisterBenchmark(("AnchorRangeUpdate/" + tail).c_str(), Update, s, n, true, false);
+      benchmark::RegisterBenchmark(("RangeUpdate/" + tail).c_str(), Update, s, n, false, false, 0);
+      benchmark::RegisterBenchmark(("AnchorRangeUpdate/" + tail).c_str(), Update, s, n, true, false, 0);
       benchmark::RegisterBenchmark(("DelayedRangeUpdate/" + tail).c_str(), DelayedRangeUpdate, s, n);
     }
   for (int n : kAnchorCounts)
-    benchmark::RegisterBenchmark(("RangeUpdateGamma/dah/" + std::to_string(n)).c_str(), Update, "dah", n, false, true);
+    benchmark::RegisterBenchmark(("RangeUpdateGamma/dah/" + std::to_string(n)).c_str(), Update, "dah", n, false, true, 0);
+  for (int n : kAnchorCounts)
+    benchmark::RegisterBenchmark(("RangeUpdateJointSet/dah/" + std::to_string(n)).c_str(), Update, "dah", n, false,
+                                 false, 5);
   for (const char* s : kStrategies)
     for (int N : {2, 5, 10, 20})
       benchmark::RegisterBenchmark(("Micro/" + std::string(s) + "/" + std::to_string(N)).c_str(), Micro, s, N);

@@ -104,6 +104,12 @@ void forEachUwbField(Opt& o, Visitor& v) {
     "fuse ranges between two calibrated anchors (their correlated calibration errors are not known)");
   v("uwb.dah_fuse_estimated_anchor_pairs", o.uwb.dah_fuse_estimated_anchor_pairs,
     "dah only: fuse ranges between two estimated anchors (overconfident, see docs)");
+  v("uwb.dah_joint_anchors", o.uwb.dah_joint_anchors,
+    "dah only: anchors updated jointly: none | batch (added together, e.g. by a re-run) | all");
+  v("uwb.dah_joint_tag_biases", o.uwb.dah_joint_tag_biases,
+    "dah only: the tags' gamma instances join the anchors' joint set (merges the batches into one)");
+  v("uwb.dah_joint_imu", o.uwb.dah_joint_imu,
+    "dah only: the IMU joins that set too (every pose update also corrects its anchors)");
   v("uwb.reentry_gap_s", o.uwb.reentry_gap_s, "no tag range accepted for this long: hold and cross-check the next ones, 0 = off [s]");
   v("uwb.reentry_hold_s", o.uwb.reentry_hold_s, "longest hold after a gap, at most window_s [s]");
   v("uwb.reentry_min_ranges", o.uwb.reentry_min_ranges, "held ranges needed to test them against each other [-]");
@@ -172,7 +178,7 @@ void forEachRefineField(Opt& o, Visitor& v) {
   v("refine.rerun_gamma_from_calibration", o.refine.rerun_gamma_from_calibration,
     "gamma means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false)");
   v("refine.rerun_with_dah", o.refine.rerun_with_dah,
-    "strategy dah too (off: its factorization loses the anchor-anchor correlations, see docs)");
+    "strategy dah too (with its joint sets, uwb.dah_joint_anchors; see docs)");
   v("refine.rerun_mode", o.refine.rerun_mode,
     "auto | sync | async: re-run inline, or on a worker while the node keeps publishing; auto = async in the LCM process");
 }
@@ -233,6 +239,8 @@ void EstimatorOptions::validate() const {
   };
   need(strategy == "centralized" || strategy == "dp" || strategy == "dah", "strategy must be centralized, dp or dah");
   need(gravity_m_s2 > 0.0, "gravity_m_s2 > 0");
+  need(uwb.dah_joint_anchors == "none" || uwb.dah_joint_anchors == "batch" || uwb.dah_joint_anchors == "all",
+       "uwb.dah_joint_anchors must be none, batch or all");
   need(window_s >= 0.0, "window_s >= 0");
   need(uwb.reentry_gap_s >= 0.0 && (uwb.reentry_gap_s == 0.0 || (uwb.reentry_hold_s > 0.0 && uwb.reentry_hold_s <= window_s)),
        "uwb.reentry_gap_s >= 0; with a gap, 0 < uwb.reentry_hold_s <= window_s");

@@ -141,6 +141,20 @@ struct UwbOptions {
   /// filter overconfident (docs/modular_estimator.md, "DAH and anchor–anchor ranges"). Ranges
   /// between an estimated and an exactly known anchor are private updates and always fused.
   bool dah_fuse_estimated_anchor_pairs = false;
+  /// Strategy `dah` only: which estimated anchors form a joint set (FactorizedCovariance::joinSet),
+  /// i.e. are always updated together so that their mutual correlation is exact (issue 10):
+  /// `none`; `batch`: the anchors added together (one batch of ANCHOR_INITs between two other
+  /// inputs, and the anchors a re-run adds at its start); `all`: every anchor added at run time.
+  std::string dah_joint_anchors = "batch";
+  /// Strategy `dah` only: the tags' γ instances (TagBiasKind) join that set too. A tag range to an
+  /// exactly known anchor updates {IMU, tag}; the tag's γ and the anchors become correlated through
+  /// the pose, and DAH without this drops that correlation. Since every set then holds the tags,
+  /// the batches merge into one set with them.
+  bool dah_joint_tag_biases = true;
+  /// Strategy `dah` only: the IMU joins that set too, so that every update of the pose (baro,
+  /// ZUPT, ranges to exactly known anchors) also corrects the set's anchors through their
+  /// correlation with the pose, as the exact filter does.
+  bool dah_joint_imu = true;
   /// Ranges after an aiding gap (issue 8, docs/robustness.md "Range gaps"): when no tag–anchor
   /// range was accepted for `reentry_gap_s`, the tag ranges of the next `reentry_hold_s` are held,
   /// tested against each other (ReentryCheck; with at least `reentry_min_ranges` from
@@ -199,10 +213,10 @@ struct RefineOptions {
   double rerun_gamma_sigma_m = 0.25;     ///< σ of its γ in a re-run (no joint covariance) [m]
   /// The γ means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false).
   bool rerun_gamma_from_calibration = false;
-  /// Strategy `dah` too. Off by default: DAH's factorization loses the anchor–anchor correlations
-  /// the joint estimation builds through the pose (S2: 0.118 → 0.114 m as without it, but final
-  /// NEES ≤ 13.93 for 45 instead of 52 of 60 anchors, pose ANEES 4.26 vs 3.81; docs/results.md).
-  bool rerun_with_dah = false;
+  /// Strategy `dah` too. With the joint set of the re-run's anchors and the tags' γ
+  /// (uwb.dah_joint_anchors, uwb.dah_joint_tag_biases) DAH reaches DP's refinement (S2: 0.115 →
+  /// 0.063 m, DP 0.061 m); without the sets it did not gain (0.116 m; docs/results.md).
+  bool rerun_with_dah = true;
   /// Where a re-run is computed: `sync` inline in the input handler (the node publishes nothing
   /// meanwhile: 0.1–0.4 s on S2, seconds under ASan), `async` on a worker thread from immutable
   /// copies while the node keeps publishing, swapped in at the first input after it is done (wall

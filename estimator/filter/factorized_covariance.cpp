@@ -73,6 +73,7 @@ bool FactorizedCovariance::remove(SensorId id) {
   }
   inst_.erase(inst_.begin() + k);
   layout_.remove(id);
+  dropFromSet(id);
   return true;
 }
 
@@ -155,21 +156,15 @@ MatrixXd FactorizedCovariance::full() const {
 }
 
 FactorizedCovariance::Result FactorizedCovariance::update(const Linearization& lin, double nis_gate, Timestamp t) {
-  if (mode_ == Mode::DAH) {
-    Result res;
-    if (updateDahScalar(lin, nis_gate, t, &res)) return res;
-  }
   // Participants (indices into the layout, in layout order).
   std::vector<int> part;
   if (mode_ == Mode::DP) {
     for (int k = 0; k < static_cast<int>(inst_.size()); ++k) part.push_back(k);
   } else {
-    for (const JacobianBlock& jb : lin.blocks) {
-      if (!has(jb.id)) throw std::logic_error("FactorizedCovariance::update: no instance " + std::to_string(jb.id));
-      part.push_back(index(jb.id));
-    }
-    std::sort(part.begin(), part.end());
-    part.erase(std::unique(part.begin(), part.end()), part.end());
+    // A member of a joint set takes the general path with its whole set (the fast path stacks ≤ 4).
+    Result res;
+    if (!namesJointSet(lin) && updateDahScalar(lin, nis_gate, t, &res)) return res;
+    part = dahParticipants(lin);
   }
   StateLayout sub;
   for (int k : part) {

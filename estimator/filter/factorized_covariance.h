@@ -11,7 +11,8 @@
 ///    updates Σ_PP exactly, writes the pair factors within P (S̄_ij = L_i'⁻¹ Σ_ij',
 ///    S̄_ji = L_j'⁻¹) and folds the correction of the other pairs into the pending factor:
 ///    Σ_ik' = Σ_ii' Σ_ii⁻¹ Σ_ik for k ∉ P, i.e. L_i ← Σ_ii' Σ_ii⁻¹ L_i (|P| = 1: L_i ← (I − K H) L_i,
-///    exact). Cost O(|P|³ + log #partners), independent of the number of instances.
+///    exact). Cost O(|P|³ + log #partners), independent of the number of instances. P includes
+///    the joint sets (joinSet) of the named instances: the pairs inside a set are never approximated.
 /// Only the instance a step concerns is written (copy-on-write, so snapshots stay valid).
 
 #include <Eigen/Core>
@@ -57,6 +58,15 @@ class FactorizedCovariance {
   Result update(const Linearization& lin, double nis_gate, Timestamp t);
   /// S̄_ij ← L_i S̄_ij for every partner j, L_i ← I (exact, O(#partners)).
   void renormalize(SensorId id);
+  /// DAH joint set (issue 10; docs/modular_estimator.md, "Joint sets"): merges the instances `ids`
+  /// (and the sets they already belong to) into one set whose members always take part together:
+  /// a DAH update naming any member stacks all of them, so the correlations among the members
+  /// (e.g. the common-mode error of anchors estimated from the same trajectory) are updated exactly
+  /// and only the pairs with instances outside the update are approximated. Ids without an instance
+  /// are ignored; fewer than two: nothing. DP ignores sets (its updates are full anyway).
+  void joinSet(const std::vector<SensorId>& ids);
+  /// The members of the joint set holding `id` in ascending id order (empty: none).
+  std::vector<SensorId> jointSet(SensorId id) const;
 
   const StateLayout& layout() const { return layout_; }
   bool has(SensorId id) const { return layout_.find(id) != nullptr; }
@@ -91,8 +101,17 @@ class FactorizedCovariance {
   /// Its steps on stack storage (factorized_covariance_dah_scalar.cpp).
   friend class DahScalarUpdate;
 
+  /// True when `lin` names a member of a joint set (O(1) without sets: the fast path's cost).
+  bool namesJointSet(const Linearization& lin) const;
+  /// The participants of a DAH update: the instances named by `lin` and their joint sets'
+  /// members (indices in layout order).
+  std::vector<int> dahParticipants(const Linearization& lin) const;
+  void dropFromSet(SensorId id);
+
+  using JointSets = std::vector<std::vector<SensorId>>;  ///< each sorted, ≥ 2 members
   Mode mode_;
   bool joseph_;
+  std::shared_ptr<const JointSets> sets_;  ///< null: none (copy-on-write, shared by clones)
   StateLayout layout_;
   std::vector<std::shared_ptr<InstanceBelief>> inst_;  ///< parallel to layout_.blocks()
   int64_t renormalizations_ = 0;

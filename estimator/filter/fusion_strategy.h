@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "estimator/core/linearization.h"
 #include "estimator/core/nominal_state.h"
@@ -43,6 +44,10 @@ class FusionStrategy {
   }
   /// Removes an instance with state (not the IMU). False if absent.
   virtual bool removeInstance(SensorId id) = 0;
+  /// Declares that the instances `ids` are updated jointly from now on (DAH joint set, issue 10:
+  /// anchors calibrated together; FactorizedCovariance::joinSet). The exact strategies
+  /// (centralized, dp) update every instance jointly anyway: nothing to do.
+  virtual void joinJointSet(const std::vector<SensorId>& ids) { (void)ids; }
 
   /// Propagates to `t_to` with IMU readings held constant since the state's time.
   virtual void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) = 0;

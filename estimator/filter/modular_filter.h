@@ -12,7 +12,8 @@
 ///   instances correlated with the IMU (K_k = Σ_kI Hᵀ S⁻¹ ≠ 0).
 /// - DAH: an update stacks the instances named by the measurement (ZUPT: {IMU}; baro: {IMU, baro};
 ///   tag–anchor range: {IMU, anchor} or {IMU, tag} for an estimated γ; anchor–anchor: {a, b}); the
-///   others' means are not corrected and their correlations are approximated.
+///   others' means are not corrected and their correlations are approximated. A joint set
+///   (joinJointSet) takes part as a whole whenever a member is named.
 /// clone() copies pointers only (copy-on-write instances): cheap snapshots for the node's rewinds.
 
 #include "estimator/filter/factorized_covariance.h"
@@ -32,6 +33,9 @@ class ModularFilter final : public FusionStrategy {
 
   void reset(SensorId imu_id, const ImuState& x, const ImuMatrix& cov, Timestamp t) override;
   bool removeInstance(SensorId id) override;
+  void joinJointSet(const std::vector<SensorId>& ids) override {
+    if (cov_.mode() == Mode::DAH) cov_.joinSet(ids);
+  }
 
   void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) override;
   void addImuNoise(const ImuMatrix& Q) override;

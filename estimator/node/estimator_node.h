@@ -204,6 +204,8 @@ class EstimatorNode {
   /// Instance statistics, health and the "gated_<type>" counter of a scalar update (baro, height).
   void countScalarUpdate(Timestamp t, SensorId id, const std::string& type, const UpdateResult& r);
   void applyAnchorInit(const AnchorInit& a, bool first);
+  /// dah: puts the just added anchor `id` into its joint set (uwb.dah_joint_anchors).
+  void joinAnchorSet(SensorId id);
   void applyCommand(const EstimatorCommand& c, bool first);
   void propagateTo(Timestamp t);
   /// Propagation with held readings; the part beyond `imu.max_dt_s` after the last IMU sample
@@ -314,6 +316,9 @@ class EstimatorNode {
   double range_gate_ = 0.0, baro_gate_ = 0.0, height_gate_ = 0.0;
   /// dah without uwb.dah_fuse_estimated_anchor_pairs: ranges between two estimated anchors are left out.
   bool skip_estimated_anchor_pairs_ = false;
+  /// The anchors added at the filter time `anchor_batch_t_` (a batch: no other input between them).
+  std::vector<SensorId> anchor_batch_;
+  std::optional<Timestamp> anchor_batch_t_;
 
   MotionAligner aligner_;
   StillnessDetector still_detector_;

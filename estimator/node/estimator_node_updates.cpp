@@ -171,6 +171,7 @@ void EstimatorNode::applyAnchorInit(const AnchorInit& a, bool first) {
   for (size_t r = 0; r < rows.size(); ++r)
     for (size_t c = 0; c < rows.size(); ++c) cov(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = J(rows[r], rows[c]);
   cur_.filter->addInstance<AnchorKind>(a.id, AnchorState{a.p_AinG, biases}, cov);
+  joinAnchorSet(a.id);
   if (first) {
     diag_.count("anchor_init");
     spdlog::info("estimator: anchor {} added at t={} p_AinG=[{:.3f}, {:.3f}, {:.3f}] with {} pair biases, {} as states{}",
@@ -180,6 +181,23 @@ void EstimatorNode::applyAnchorInit(const AnchorInit& a, bool first) {
                  : a.hasJointCovariance() && options_.uwb.anchor_bias_joint_covariance ? " (joint covariance)"
                                                                                         : " (independent of the position)");
   }
+}
+
+void EstimatorNode::joinAnchorSet(SensorId id) {
+  const std::string& mode = options_.uwb.dah_joint_anchors;
+  if (options_.strategy != "dah" || mode == "none") return;
+  const Timestamp t = cur_.filter->state().t;
+  if (!anchor_batch_t_ || *anchor_batch_t_ != t) anchor_batch_.clear();
+  anchor_batch_t_ = t;
+  anchor_batch_.push_back(id);
+  std::vector<SensorId> set = anchor_batch_;
+  if (mode == "all")
+    for (const auto& [other, value] : cur_.filter->state().values<AnchorKind>())
+      if (cur_.network->isCalibrated(other)) set.push_back(other);
+  if (options_.uwb.dah_joint_tag_biases)  // merges every batch into one set with the tags' γ
+    for (const auto& [tag, value] : cur_.filter->state().values<TagBiasKind>()) set.push_back(tag);
+  if (options_.uwb.dah_joint_imu) set.push_back(cur_.filter->state().imu_id);
+  cur_.filter->joinJointSet(set);
 }
 
 }  // namespace meshnav::estimator

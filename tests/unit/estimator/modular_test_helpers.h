@@ -64,6 +64,31 @@ inline std::vector<EstimatorInput> shuffledArrival(const std::vector<EstimatorIn
   return out;
 }
 
+/// A linearized range between the IMU (id 1, tag at its origin) and anchor `a` of `x`, measured
+/// as `z` (σ 0.1 m).
+inline Linearization imuAnchorRange(const NominalState& x, SensorId a, double z) {
+  const Eigen::Vector3d d = x.values<AnchorKind>().at(a).p_AinG - x.imu.p_IinG;
+  Linearization lin;
+  lin.residual = Eigen::VectorXd::Constant(1, z - d.norm());
+  lin.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, 15);
+  H.block<1, 3>(0, ImuErr::kP) = -d.normalized().transpose();
+  lin.blocks.push_back({1, H});
+  lin.blocks.push_back({a, Eigen::MatrixXd(d.normalized().transpose())});
+  return lin;
+}
+
+/// A linearized range between anchors `a` and `b` of `x`, measured as `z` (σ 0.1 m).
+inline Linearization anchorPairRange(const NominalState& x, SensorId a, SensorId b, double z) {
+  const Eigen::Vector3d d = x.values<AnchorKind>().at(b).p_AinG - x.values<AnchorKind>().at(a).p_AinG;
+  Linearization lin;
+  lin.residual = Eigen::VectorXd::Constant(1, z - d.norm());
+  lin.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
+  lin.blocks.push_back({a, Eigen::MatrixXd(-d.normalized().transpose())});
+  lin.blocks.push_back({b, Eigen::MatrixXd(d.normalized().transpose())});
+  return lin;
+}
+
 inline EstimatorOptions strategyOptions(const std::string& strategy) {
   EstimatorOptions o;
   o.window_s = 1.0;

@@ -1,7 +1,7 @@
 // The second pass on an anchor join (issue 10, RefineOptions): when ANCHOR_INIT arrives the node
 // re-runs from its oldest stored input with the anchor uncertain from there (counted, inputs
 // replayed), which refines the anchor with every range it took part in; the history limit cuts
-// the stored inputs at a checkpoint and is counted; off (and for dah unless asked), no re-run.
+// the stored inputs at a checkpoint and is counted; off, no re-run (dah re-runs with its joint set).
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
@@ -86,18 +86,27 @@ TEST(AnchorRerun, JoinReRunsFromTheStartAndRefinesTheAnchorMore) {
   }
 }
 
-TEST(AnchorRerun, DahReRunsOnlyOnRequest) {
+TEST(AnchorRerun, DahReRunsByDefaultWithItsJointSetAndCanBeSwitchedOff) {
   const Case c = makeCase();
   const Outcome dflt = run(c, options("dah", true));
-  EXPECT_EQ(dflt.reruns, 0);  // refine.rerun_with_dah: false (docs/results.md)
+  EXPECT_EQ(dflt.reruns, 1);  // refine.rerun_with_dah: true since the joint sets (docs/results.md)
   EstimatorOptions o = options("dah", true);
-  o.refine.rerun_with_dah = true;
-  const Outcome on = run(c, o);
-  EXPECT_EQ(on.reruns, 1);
-  // It works (0.2 m → 0.031 m here) but does not gain for DAH (0.015 m without it; on S2 its
-  // beliefs get more overconfident), hence off by default.
-  EXPECT_LT(on.error_m, 0.05);
-  EXPECT_LT(dflt.error_m, 0.05);
+  o.refine.rerun_with_dah = false;
+  const Outcome off = run(c, o);
+  EXPECT_EQ(off.reruns, 0);
+  // The anchor is in one joint set with the IMU (uwb.dah_joint_imu), so every pose update also
+  // corrects it, as in DP: 0.2 m → 0.005 m, against 0.022 m without the re-run.
+  EXPECT_LT(dflt.error_m, 0.5 * off.error_m) << dflt.error_m << " vs " << off.error_m;
+  EXPECT_LT(dflt.error_m, 0.02);
+  EXPECT_LT(dflt.nees, 16.27);  // χ²(3) at 99.9 %
+  // Without the IMU in the set (this case has no tag γ states, so the set is the anchor alone)
+  // DAH does not correct the anchor on the updates of the pose by the known anchors, and the
+  // re-run gains nothing: 0.031 m.
+  EstimatorOptions no_imu = options("dah", true);
+  no_imu.uwb.dah_joint_imu = false;
+  const Outcome lone = run(c, no_imu);
+  EXPECT_EQ(lone.reruns, 1);
+  EXPECT_GT(lone.error_m, 2.0 * dflt.error_m) << lone.error_m << " vs " << dflt.error_m;
 }
 
 TEST(AnchorRerun, HistoryLimitCutsAtACheckpointAndIsCounted) {

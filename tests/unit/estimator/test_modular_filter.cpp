@@ -6,6 +6,7 @@
 #include "estimator/filter/centralized_ekf.h"
 #include "estimator/filter/modular_filter.h"
 #include "estimator/zupt/zupt_model.h"
+#include "modular_test_helpers.h"
 
 using namespace meshnav;
 using namespace meshnav::estimator;
@@ -28,29 +29,6 @@ void setUp(F& f) {
   f.template addInstance<AnchorKind>(107, AnchorState{Eigen::Vector3d(-2.021, 1.814, 1.732)}, Eigen::Matrix3d::Identity() * 0.09);
 }
 
-/// A linearized range between the IMU (tag at the origin of I) and anchor `a`.
-Linearization tagRange(const NominalState& x, SensorId a, double z) {
-  const Eigen::Vector3d d = x.values<AnchorKind>().at(a).p_AinG - x.imu.p_IinG;
-  Linearization lin;
-  lin.residual = Eigen::VectorXd::Constant(1, z - d.norm());
-  lin.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, 15);
-  H.block<1, 3>(0, ImuErr::kP) = -d.normalized().transpose();
-  lin.blocks.push_back({1, H});
-  lin.blocks.push_back({a, Eigen::MatrixXd(d.normalized().transpose())});
-  return lin;
-}
-
-Linearization anchorRange(const NominalState& x, SensorId a, SensorId b, double z) {
-  const Eigen::Vector3d d = x.values<AnchorKind>().at(b).p_AinG - x.values<AnchorKind>().at(a).p_AinG;
-  Linearization lin;
-  lin.residual = Eigen::VectorXd::Constant(1, z - d.norm());
-  lin.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
-  lin.blocks.push_back({a, Eigen::MatrixXd(-d.normalized().transpose())});
-  lin.blocks.push_back({b, Eigen::MatrixXd(d.normalized().transpose())});
-  return lin;
-}
-
 const Eigen::Vector3d kAcc(0.1, -0.2, 9.9), kGyro(0.02, -0.01, 0.1);
 
 }  // namespace
@@ -59,7 +37,7 @@ TEST(ModularFilter, SmallerIdStoresTheCrossCovarianceTheOtherTheIdentity) {
   ModularFilter f(ModularFilter::Mode::DP, propagator(), KindRandomWalks{}.set<BaroBiasKind>(0.02), true);
   setUp(f);
   f.propagate(kAcc, kGyro, Timestamp::fromSec(0.005));
-  ASSERT_TRUE(f.update(tagRange(f.state(), 106, 4.0), 0.0).accepted);
+  ASSERT_TRUE(f.update(test::imuAnchorRange(f.state(), 106, 4.0), 0.0).accepted);
   const auto& cov = f.instances();
   // DP writes every correlated pair: IMU (id 1) holds Σ_1,106 (15×3), anchor 106 the identity.
   const FactorEntry* e1 = cov.belief(1).factors->find(106);
@@ -80,8 +58,8 @@ TEST(ModularFilter, PropagationChangesOnlyTheImuBlockAndItsPendingFactor) {
   for (auto mode : {ModularFilter::Mode::DP, ModularFilter::Mode::DAH}) {
     ModularFilter f(mode, propagator(), KindRandomWalks{}, true);
     setUp(f);
-    f.update(tagRange(f.state(), 106, 4.0), 0.0);
-    f.update(anchorRange(f.state(), 106, 107, 1.8), 0.0);
+    f.update(test::imuAnchorRange(f.state(), 106, 4.0), 0.0);
+    f.update(test::anchorPairRange(f.state(), 106, 107, 1.8), 0.0);
     const auto before = f.clone();
     const auto& cb = static_cast<const ModularFilter&>(*before).instances();
     const Eigen::MatrixXd P0 = f.fullCovariance();
@@ -100,8 +78,8 @@ TEST(ModularFilter, PropagationChangesOnlyTheImuBlockAndItsPendingFactor) {
     // And the reconstruction equals the dense propagation Σ_Ij ← Φ Σ_Ij.
     CentralizedEkf ref(propagator(), KindRandomWalks{}, true);
     setUp(ref);
-    ref.update(tagRange(ref.state(), 106, 4.0), 0.0);
-    ref.update(anchorRange(ref.state(), 106, 107, 1.8), 0.0);
+    ref.update(test::imuAnchorRange(ref.state(), 106, 4.0), 0.0);
+    ref.update(test::anchorPairRange(ref.state(), 106, 107, 1.8), 0.0);
     if (mode == ModularFilter::Mode::DP) {
       ref.propagate(kAcc, kGyro, Timestamp::fromSec(0.005));
       ref.propagate(kAcc, kGyro, Timestamp::fromSec(0.010));
@@ -114,13 +92,13 @@ TEST(ModularFilter, PropagationChangesOnlyTheImuBlockAndItsPendingFactor) {
 TEST(ModularFilter, DahUpdateTouchesOnlyTheParticipants) {
   ModularFilter f(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}.set<BaroBiasKind>(0.02), true);
   setUp(f);
-  f.update(tagRange(f.state(), 106, 4.0), 0.0);
-  f.update(tagRange(f.state(), 107, 3.5), 0.0);
+  f.update(test::imuAnchorRange(f.state(), 106, 4.0), 0.0);
+  f.update(test::imuAnchorRange(f.state(), 107, 3.5), 0.0);
   const auto snap = f.clone();
   const auto& cs = static_cast<const ModularFilter&>(*snap).instances();
   const NominalState x0 = f.state();
   // Anchor–anchor range: P = {106, 107}; the IMU and the baro are not touched.
-  ASSERT_TRUE(f.update(anchorRange(f.state(), 106, 107, 1.9), 0.0).accepted);
+  ASSERT_TRUE(f.update(test::anchorPairRange(f.state(), 106, 107, 1.9), 0.0).accepted);
   EXPECT_EQ(f.instances().beliefPtr(1), cs.beliefPtr(1));
   EXPECT_EQ(f.instances().beliefPtr(2), cs.beliefPtr(2));
   EXPECT_EQ(f.state().imu.p_IinG, x0.imu.p_IinG);
@@ -144,7 +122,7 @@ TEST(ModularFilter, PrivateUpdateIsExactForTheCrossCovariancesAndIsolated) {
   setUp(dah);
   setUp(ref);
   for (FusionStrategy* f : {static_cast<FusionStrategy*>(&dah), static_cast<FusionStrategy*>(&ref)}) {
-    f->update(tagRange(f->state(), 106, 4.0), 0.0);
+    f->update(test::imuAnchorRange(f->state(), 106, 4.0), 0.0);
     f->propagate(kAcc, kGyro, Timestamp::fromSec(0.005));
   }
   const auto snap = dah.clone();
@@ -167,8 +145,8 @@ TEST(ModularFilter, RemovingAnInstanceDropsThePartnersFactors) {
   for (auto mode : {ModularFilter::Mode::DP, ModularFilter::Mode::DAH}) {
     ModularFilter f(mode, propagator(), KindRandomWalks{}.set<BaroBiasKind>(0.02), true);
     setUp(f);
-    f.update(tagRange(f.state(), 106, 4.0), 0.0);
-    f.update(anchorRange(f.state(), 106, 107, 1.9), 0.0);
+    f.update(test::imuAnchorRange(f.state(), 106, 4.0), 0.0);
+    f.update(test::anchorPairRange(f.state(), 106, 107, 1.9), 0.0);
     const Eigen::MatrixXd P = f.fullCovariance();
     const auto snap = f.clone();
     ASSERT_TRUE(f.removeInstance(106));
@@ -190,8 +168,8 @@ TEST(ModularFilter, RemovingAnInstanceDropsThePartnersFactors) {
 TEST(ModularFilter, LazyFactorRenormalizationIsExact) {
   ModularFilter f(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}.set<BaroBiasKind>(0.02), true);
   setUp(f);
-  f.update(tagRange(f.state(), 106, 4.0), 0.0);
-  f.update(tagRange(f.state(), 107, 3.5), 0.0);
+  f.update(test::imuAnchorRange(f.state(), 106, 4.0), 0.0);
+  f.update(test::imuAnchorRange(f.state(), 107, 3.5), 0.0);
   for (int k = 1; k <= 50; ++k) f.propagate(kAcc, kGyro, Timestamp::fromSec(0.005 * k));
   ModularFilter g = f;
   const Eigen::MatrixXd P = f.fullCovariance();
