@@ -36,6 +36,9 @@ class ModularFilter final : public FusionStrategy {
   void joinJointSet(const std::vector<SensorId>& ids) override {
     if (cov_.mode() == Mode::DAH) cov_.joinSet(ids);
   }
+  std::vector<SensorId> jointSetOf(SensorId id) const override {
+    return cov_.mode() == Mode::DAH ? cov_.jointSet(id) : std::vector<SensorId>{};
+  }
 
   void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) override;
   void addImuNoise(const ImuMatrix& Q) override;

@@ -404,6 +404,12 @@ void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp 
       for (const auto& [id, value] : s.values<K>())
         f->addInstance<K>(id, value, K::keptCovariance(old.covariance(id, id), options_));
   });
+  // DAH joint sets stay together (their members' cross-covariances restart from zero like all others).
+  forEachKind([&]<class K>() {
+    if constexpr (!K::kBody)
+      for (const auto& [id, value] : s.values<K>())
+        if (const std::vector<SensorId> set = old.jointSetOf(id); !set.empty()) f->joinJointSet(set);
+  });
   cur_.filter = std::move(f);
   cur_.last_imu = last_imu;
   cur_.last_zupt = t;

@@ -175,5 +175,14 @@ TEST(DahJointSets, NodePutsAnchorsAddedTogetherIntoOneSetWithTheImu) {
     EXPECT_NE(std::find(set.begin(), set.end(), imu), set.end()) << "uwb.dah_joint_imu";
     EXPECT_EQ(set.size(), 3u);  // the synthetic setup has no tag γ states (uwb.dah_joint_tag_biases)
     f->checkInvariants();
+    // A re-initialization (here the test hook's pose fault) keeps the set together.
+    node.injectPoseError(Eigen::Vector3d(1.0, 0.0, 0.0), 0.3);
+    const auto* g = dynamic_cast<const ModularFilter*>(node.filter());
+    ASSERT_NE(g, nullptr);
+    std::vector<SensorId> after = g->instances().jointSet(201), before = set;
+    std::sort(after.begin(), after.end());
+    std::sort(before.begin(), before.end());
+    EXPECT_EQ(after, before);
+    g->checkInvariants();
   }
 }
