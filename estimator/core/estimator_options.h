@@ -64,7 +64,7 @@ struct InitOptions {
   /// constraint (not with a carried height): nearly coplanar anchors then cannot mirror the height.
   bool motion_use_baro = true;
   double resume_max_age_s = 5.0;           ///< a checkpoint (resumeFrom) older than this is not used [s]
-  double resume_max_outage_s = 0.3;        ///< longer outages re-initialize the pose (anchors still kept) [s]
+  double resume_max_outage_s = 0.5;        ///< longer outages re-initialize the pose (anchors still kept) [s]
   double resume_max_acc_m_s2 = 3.0;        ///< largest acceleration assumed during the outage [m/s²]
   double resume_max_rate_deg_s = 30.0;     ///< largest rotation rate assumed during the outage [deg/s]
 };

@@ -22,7 +22,7 @@ using namespace meshnav;
 /// The process's own options (--lcm-url, --log-level come from transport::ProcessMain).
 struct EstimatorProcessOptions {
   std::string setup_path, config_path, strategy, state_dir;
-  double heartbeat_s = 1.0, state_period_s = 0.5;
+  double heartbeat_s = 1.0, state_period_s = 0.1;
   bool print_config = false;
 };
 

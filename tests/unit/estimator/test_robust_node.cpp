@@ -301,6 +301,18 @@ TEST(RobustNode, CheckpointFilesRoundTrip) {
   }
 }
 
+TEST(RobustNode, RestartAfterTheRespawnTimeStillResumesThePose) {
+  // A supervisor's respawn (0.2 s delay, about 0.2 s start) plus the checkpoint's age
+  // (--state-period 0.1 s): outages up to init.resume_max_outage_s (0.5 s) resume the pose.
+  const auto r = uncertainAnchorFlight();
+  ASSERT_GE(EstimatorOptions{}.init.resume_max_outage_s, 0.45);
+  const RestartResult res = restart(r, 0.45, true);
+  EXPECT_EQ(res.resumed, 1);
+  EXPECT_LE(res.first_pose_s, 60.45 + 0.01);  // the first IMU sample
+  EXPECT_LT(res.run.max_error_after_m, 0.3);
+  EXPECT_NE(res.run.final_health, Health::Lost);
+}
+
 TEST(RobustNode, RestartAfterAShortOutageResumesThePoseAtOnce) {
   const auto r = uncertainAnchorFlight();
   const RestartResult res = restart(r, 0.1, true);
