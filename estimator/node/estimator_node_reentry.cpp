@@ -20,8 +20,11 @@ bool EstimatorNode::reentryAdmit(const RangeSample& s, SensorId anchor, const Li
                                  bool* count) {
   const UwbOptions& o = options_.uwb;
   if (o.reentry_gap_s <= 0.0) return true;
-  const InputOrder key = inputOrder(EstimatorInput{s});
-  if (auto d = reentry_.decided.find(key); d != reentry_.decided.end()) {
+  // The per-range path: nothing to look up unless a hold is running or has decided fates.
+  const bool any_fate = !reentry_.decided.empty() || !reentry_.held.empty();
+  if (!first && !any_fate) return true;
+  const InputOrder key{s.t.us, InputKind<RangeSample>::rank, s.id_initiator, s.id_responder};  // = inputOrder(s)
+  if (auto d = reentry_.decided.find(key); any_fate && d != reentry_.decided.end()) {
     if (d->second == HeldFate::kRejected) return false;
     if (d->second == HeldFate::kAcceptedUncounted) {
       *count = true;  // its first fusion: counters and health were deferred by the hold
