@@ -155,6 +155,12 @@ void forEachAdaptationField(Opt& o, Visitor& v) {
   v("process_noise.max_scale", o.process_noise.max_scale, "largest variance scale [-]");
   v("process_noise.max_prior_ratio", o.process_noise.max_prior_ratio,
     "no growth while the median predicted range variance HPH'/R exceeds this [-]");
+  v("process_noise.confirm_batches", o.process_noise.confirm_batches,
+    "consecutive batches above upper_ratio before the scale grows (by the smallest of their ratios) [-]");
+  v("process_noise.grow_at_once_ratio", o.process_noise.grow_at_once_ratio,
+    "a batch whose median NIS ratio exceeds this grows the scale without confirmation [-]");
+  v("process_noise.min_accepted_fraction", o.process_noise.min_accepted_fraction,
+    "median over the accepted ranges while this share of the batch was accepted, else over all [-]");
   v("recovery.enabled", o.recovery.enabled, "re-initialize from ranges and IMU when lost");
   v("recovery.retry_s", o.recovery.retry_s, "between two attempts while lost or degraded [s]");
   v("recovery.degraded_disagreement_chi2", o.recovery.degraded_disagreement_chi2,
@@ -284,8 +290,10 @@ void EstimatorOptions::validate() const {
   need(uwb.gate_probability >= 0 && uwb.gate_probability < 1, "uwb.gate_probability in [0, 1)");
   need(process_noise.batch >= 5 && process_noise.upper_ratio > 1.0 && process_noise.lower_ratio > 0.0 &&
            process_noise.lower_ratio < 1.0 && process_noise.max_grow > 1.0 && process_noise.max_shrink > 1.0 &&
-           process_noise.max_scale >= 1.0 && process_noise.max_prior_ratio > 0.0,
-       "process_noise: batch >= 5, lower_ratio in (0, 1), upper_ratio > 1, max_grow > 1, max_shrink > 1, max_scale >= 1, max_prior_ratio > 0");
+           process_noise.max_scale >= 1.0 && process_noise.max_prior_ratio > 0.0 &&
+           process_noise.min_accepted_fraction > 0.0 && process_noise.min_accepted_fraction <= 1.0 &&
+           process_noise.confirm_batches >= 1 && process_noise.grow_at_once_ratio >= process_noise.upper_ratio,
+       "process_noise: batch >= 5, lower_ratio in (0, 1), upper_ratio > 1, max_grow > 1, max_shrink > 1, max_scale >= 1, max_prior_ratio > 0, min_accepted_fraction in (0, 1], confirm_batches >= 1, grow_at_once_ratio >= upper_ratio");
   need(time.max_offset_s >= window_s && time.max_offset_s <= kMaxTimeSeconds && time.rebase_after >= 1,
        "time.max_offset_s >= window_s, time.rebase_after >= 1");
   need(refine.max_history_s >= window_s && refine.rerun_prior_sigma_m > 0 && refine.rerun_gamma_sigma_m > 0,

@@ -114,7 +114,7 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
   // H P Hᵀ / R from NIS = ν²/S, S = H P Hᵀ + R (scalar range).
   const double nu2 = lin.residual(0) * lin.residual(0), R = lin.R(0, 0);
   const double prior_ratio = r.nis > 0.0 && R > 0.0 ? std::max(0.0, nu2 / r.nis - R) / R : 0.0;
-  if (tag_range && cur_.noise_adapter.onRangeNis(r.nis, prior_ratio) && first) {
+  if (tag_range && cur_.noise_adapter.onRangeNis(r.nis, prior_ratio, r.accepted) && first) {
     diag_.count("process_noise_scale_change");
     spdlog::info("estimator: IMU noise scale {:.3g} at t={} (median range NIS {:.2f} of its expected value)",
                  cur_.noise_adapter.scale(), formatSeconds(s.t), cur_.noise_adapter.lastRatio());

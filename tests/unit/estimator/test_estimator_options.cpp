@@ -81,6 +81,13 @@ TEST(EstimatorOptions, UnknownKeysAndBadValuesNameFileAndKey) {
   e = loadError("opts_rerun_mode.yaml", "refine:\n  rerun_mode: threaded\n");
   EXPECT_NE(e.find("refine.rerun_mode must be auto, sync or async"), std::string::npos) << e;
   EXPECT_EQ(loadError("opts_rerun_async.yaml", "refine:\n  rerun_mode: async\n"), "");
+  e = loadError("opts_pn_fraction.yaml", "process_noise:\n  min_accepted_fraction: 0\n");
+  EXPECT_NE(e.find("min_accepted_fraction in (0, 1]"), std::string::npos) << e;
+  e = loadError("opts_pn_confirm.yaml", "process_noise:\n  confirm_batches: 0\n");
+  EXPECT_NE(e.find("confirm_batches >= 1"), std::string::npos) << e;
+  e = loadError("opts_pn_at_once.yaml", "process_noise:\n  grow_at_once_ratio: 2.0\n");  // below upper_ratio
+  EXPECT_NE(e.find("grow_at_once_ratio >= upper_ratio"), std::string::npos) << e;
+  EXPECT_EQ(loadError("opts_pn_no_ratchet.yaml", "process_noise:\n  min_accepted_fraction: 0.5\n  confirm_batches: 2\n"), "");
 }
 
 TEST(EstimatorOptions, InvalidValuesAndFilesAreRejected) {
