@@ -31,6 +31,16 @@ MatrixXd trueFactor(const InstanceBelief& b, const FactorEntry& e) {
   return b.L.size() ? MatrixXd(b.L * *e.S_bar) : *e.S_bar;
 }
 
+/// True when every partner of `b` is among `sorted_ids` (a closed participant: no pair of it
+/// with an instance outside the update). O(min(#partners, |ids|) log |ids|).
+bool partnersWithin(const InstanceBelief& b, const std::vector<SensorId>& sorted_ids) {
+  const auto& entries = b.factors->entries();
+  if (entries.size() >= sorted_ids.size()) return false;  // partners are other instances than b
+  return std::all_of(entries.begin(), entries.end(), [&](const FactorEntry& e) {
+    return std::binary_search(sorted_ids.begin(), sorted_ids.end(), e.partner);
+  });
+}
+
 }  // namespace
 
 int FactorizedCovariance::index(SensorId id) const {
@@ -122,14 +132,40 @@ void FactorizedCovariance::renormalize(SensorId id) {
 }
 
 MatrixXd FactorizedCovariance::pairCov(int ki, int kj) const {
+  MatrixXd C(inst_[static_cast<size_t>(ki)]->dim, inst_[static_cast<size_t>(kj)]->dim);
+  pairCovInto(ki, kj, C);
+  return C;
+}
+
+void FactorizedCovariance::pairCovInto(int ki, int kj, Eigen::Ref<MatrixXd> out) const {
   const InstanceBelief& bi = *inst_[static_cast<size_t>(ki)];
   const InstanceBelief& bj = *inst_[static_cast<size_t>(kj)];
   const FactorEntry* eij = bi.factors->find(bj.id);
-  if (!eij) return MatrixXd::Zero(bi.dim, bj.dim);
+  if (!eij) {
+    out.setZero();
+    return;
+  }
   const FactorEntry* eji = bj.factors->find(bi.id);
   if (!eji) throw std::logic_error("FactorizedCovariance: factor of pair (" + std::to_string(bi.id) + ", " +
                                    std::to_string(bj.id) + ") present on one side only");
-  return trueFactor(bi, *eij) * trueFactor(bj, *eji).transpose();
+  // S_ij S_jiᵀ without multiplying identities (S = L S̄; a null S̄ or an empty L is the identity).
+  MatrixXd scratch_i, scratch_j;
+  auto factor = [](const InstanceBelief& b, const FactorEntry& e, MatrixXd& scratch) -> const MatrixXd* {
+    if (!e.S_bar) return b.L.size() ? &b.L : nullptr;
+    if (!b.L.size()) return e.S_bar.get();
+    scratch.noalias() = b.L * *e.S_bar;
+    return &scratch;
+  };
+  const MatrixXd* Si = factor(bi, *eij, scratch_i);
+  const MatrixXd* Sj = factor(bj, *eji, scratch_j);
+  if (Si && Sj)
+    out.noalias() = *Si * Sj->transpose();
+  else if (Si)
+    out = *Si;
+  else if (Sj)
+    out = Sj->transpose();
+  else
+    out.setIdentity();
 }
 
 MatrixXd FactorizedCovariance::block(SensorId a, SensorId b) const {
@@ -177,8 +213,8 @@ FactorizedCovariance::Result FactorizedCovariance::update(const Linearization& l
   for (size_t a = 0; a < part.size(); ++a) {
     P.block(sb[a].offset, sb[a].offset, sb[a].dim, sb[a].dim) = inst_[static_cast<size_t>(part[a])]->Sigma;
     for (size_t c = a + 1; c < part.size(); ++c) {
-      const MatrixXd C = pairCov(part[a], part[c]);
-      P.block(sb[a].offset, sb[c].offset, sb[a].dim, sb[c].dim) = C;
+      auto C = P.block(sb[a].offset, sb[c].offset, sb[a].dim, sb[c].dim);
+      pairCovInto(part[a], part[c], C);
       P.block(sb[c].offset, sb[a].offset, sb[c].dim, sb[a].dim) = C.transpose();
     }
   }
@@ -232,9 +268,25 @@ void FactorizedCovariance::writeBackDah(const std::vector<int>& part, const Stat
                                         const MatrixXd& K, const Linearization& lin, Timestamp t) {
   const auto& sb = sub.blocks();
   const size_t np = part.size();
+  std::vector<SensorId> ids;  // the participants' ids, sorted
+  if (np > 1) {
+    ids.reserve(np);
+    for (const StateBlock& b : sb) ids.push_back(b.id);
+    std::sort(ids.begin(), ids.end());
+  }
   // 1. Σ_ii' and the correction of the pairs with non-participants, folded into L_i.
   for (size_t a = 0; a < np; ++a) {
-    const MatrixXd Sigma_new = P.block(sb[a].offset, sb[a].offset, sb[a].dim, sb[a].dim);
+    const auto Sigma_new = P.block(sb[a].offset, sb[a].offset, sb[a].dim, sb[a].dim);
+    if (np > 1 && partnersWithin(*inst_[static_cast<size_t>(part[a])], ids)) {
+      // Every correlation of i is a pair within P, written exactly in step 3: no pair is left
+      // for the DAH correction, so L_i restarts as the identity (a DP write-back for i).
+      InstanceBelief& b = mut(part[a]);
+      b.Sigma = Sigma_new;
+      b.L.resize(0, 0);
+      b.lazy_steps = 0;
+      b.t = t;
+      continue;
+    }
     MatrixXd M;
     if (np == 1) {
       // Private update: Σ_ik' = (I − K H_i) Σ_ik exactly.

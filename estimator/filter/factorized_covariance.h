@@ -91,6 +91,9 @@ class FactorizedCovariance {
   static FactorDictionary& mutDict(InstanceBelief& b);
   /// Σ_ij for the instances at indices ki ≠ kj.
   Eigen::MatrixXd pairCov(int ki, int kj) const;
+  /// The same into `out` (dim_i × dim_j), e.g. a block of the stacked covariance: no temporaries
+  /// unless both sides have a pending factor and a stored S̄.
+  void pairCovInto(int ki, int kj, Eigen::Ref<Eigen::MatrixXd> out) const;
   void writeBackDp(const std::vector<int>& part, const StateLayout& sub, const Eigen::MatrixXd& P, Timestamp t);
   void writeBackDah(const std::vector<int>& part, const StateLayout& sub, const Eigen::MatrixXd& P,
                     const Eigen::MatrixXd& K, const Linearization& lin, Timestamp t);
