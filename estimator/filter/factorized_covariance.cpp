@@ -83,7 +83,7 @@ bool FactorizedCovariance::remove(SensorId id) {
   }
   inst_.erase(inst_.begin() + k);
   layout_.remove(id);
-  dropFromSet(id);
+  leaveSet(id);
   return true;
 }
 

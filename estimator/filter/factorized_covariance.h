@@ -67,6 +67,10 @@ class FactorizedCovariance {
   void joinSet(const std::vector<SensorId>& ids);
   /// The members of the joint set holding `id` in ascending id order (empty: none).
   std::vector<SensorId> jointSet(SensorId id) const;
+  /// `id` leaves its joint set (a set left with one member is no set). Its correlations with the
+  /// members stay and are DAH's from then on: updated exactly by an update that names it, else by
+  /// the DAH correction. Nothing when `id` is in no set.
+  void leaveSet(SensorId id);
 
   const StateLayout& layout() const { return layout_; }
   bool has(SensorId id) const { return layout_.find(id) != nullptr; }
@@ -109,7 +113,6 @@ class FactorizedCovariance {
   /// The participants of a DAH update: the instances named by `lin` and their joint sets'
   /// members (indices in layout order).
   std::vector<int> dahParticipants(const Linearization& lin) const;
-  void dropFromSet(SensorId id);
 
   using JointSets = std::vector<std::vector<SensorId>>;  ///< each sorted, ≥ 2 members
   Mode mode_;

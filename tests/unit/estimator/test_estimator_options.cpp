@@ -81,6 +81,8 @@ TEST(EstimatorOptions, UnknownKeysAndBadValuesNameFileAndKey) {
   e = loadError("opts_rerun_mode.yaml", "refine:\n  rerun_mode: threaded\n");
   EXPECT_NE(e.find("refine.rerun_mode must be auto, sync or async"), std::string::npos) << e;
   EXPECT_EQ(loadError("opts_rerun_async.yaml", "refine:\n  rerun_mode: async\n"), "");
+  e = loadError("opts_joint_max.yaml", "uwb:\n  dah_joint_max_anchors: -1\n");
+  EXPECT_NE(e.find("uwb.dah_joint_max_anchors >= 0"), std::string::npos) << e;
 }
 
 TEST(EstimatorOptions, InvalidValuesAndFilesAreRejected) {
