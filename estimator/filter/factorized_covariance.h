@@ -99,8 +99,9 @@ class FactorizedCovariance {
   /// unless both sides have a pending factor and a stored S̄.
   void pairCovInto(int ki, int kj, Eigen::Ref<Eigen::MatrixXd> out) const;
   void writeBackDp(const std::vector<int>& part, const StateLayout& sub, const Eigen::MatrixXd& P, Timestamp t);
+  /// `S`: the innovation covariance (a scalar update folds the DAH correction in rank-one form).
   void writeBackDah(const std::vector<int>& part, const StateLayout& sub, const Eigen::MatrixXd& P,
-                    const Eigen::MatrixXd& K, const Linearization& lin, Timestamp t);
+                    const Eigen::MatrixXd& K, const Eigen::MatrixXd& S, const Linearization& lin, Timestamp t);
   /// DAH update of a scalar measurement on at most 4 participants of dimension ≤ 15 (every range
   /// and baro update): the same steps as update() + writeBackDah() on stack storage, with the
   /// rank-one forms of the scalar update (see the .cpp). False: not applicable, use the general path.
