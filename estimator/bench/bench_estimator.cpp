@@ -11,6 +11,11 @@
 ///    101–104 as states (7-state anchors, issue 10; a-priori σ_γ 0.02 m in the setup);
 ///  - RangeUpdateJointSet/dah/<n>: RangeUpdate to the first 5 estimated anchors, which form one DAH
 ///    joint set with the IMU (issue 10, uwb.dah_joint_anchors): the cost of the set, not of <n>;
+///  - RangeUpdateJointSetAll/dah/<n>: every estimated anchor joined the set of the IMU and the
+///    baro bias one after the other, as the node joins calibrated anchors without a bound
+///    (`uwb.dah_joint_max_anchors: 0`); ranges cycle through all <n> anchors;
+///  - RangeUpdateJointSetBounded/dah/<n>: the same joins with the node's default bound
+///    (boundJointSetAnchors, `uwb.dah_joint_max_anchors`: the most refined anchors leave the set);
 ///  - DelayedRangeUpdate/<s>/<n>: through EstimatorNode, one IMU sample plus one range arriving
 ///    50 ms late (rewind to the snapshot before it, re-process 50 ms of inputs);
 ///  - Micro/<s>/<N>: reference scenario (a 6-state p, v body at 100 Hz, N stationary 3-state
@@ -26,6 +31,7 @@
 
 #include "estimator/filter/dense_ekf_update.h"
 #include "estimator/filter/factorized_covariance.h"
+#include "estimator/filter/joint_set_bound.h"
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/testing/synthetic_scenario.h"
@@ -177,8 +183,11 @@ void Propagate(benchmark::State& state, std::string strategy, int n) {
   state.counters["state_dim"] = f->layout().dim();
 }
 
+/// `joint_set` > 0: the IMU and the first `joint_set` estimated anchors form a set, ranges to those
+/// only. `grow_max_anchors` ≥ 0: every estimated anchor joins the set of the IMU and the baro bias
+/// in turn, as EstimatorNode::joinAnchorSet does, bounded to that many anchors (0: no bound).
 void Update(benchmark::State& state, std::string strategy, int n, bool anchor_anchor, bool anchor_gammas,
-            int joint_set) {
+            int joint_set, int grow_max_anchors) {
   Warm w = warmFilter(strategy, n, anchor_gammas);
   const auto& ids = w.stream->anchorIds();
   std::vector<SensorId> est(ids.end() - n, ids.end());  // the estimated anchors 106…
@@ -187,6 +196,14 @@ void Update(benchmark::State& state, std::string strategy, int n, bool anchor_an
     std::vector<SensorId> set = est;
     set.push_back(w.filter->state().imu_id);
     w.filter->joinJointSet(set);
+  }
+  if (grow_max_anchors >= 0) {
+    int in_set = 0;
+    for (SensorId a : est) {
+      w.filter->joinJointSet({a, w.filter->state().imu_id, w.stream->setup().baro_id});
+      in_set += 1 - boundJointSetAnchors(*w.filter, a, grow_max_anchors);
+    }
+    state.counters["anchors_in_set"] = in_set;
   }
   auto f = w.filter->clone();
   std::mt19937 rng(3);
@@ -358,15 +375,22 @@ void registerAll() {
     for (int n : kAnchorCounts) {
       const std::string tail = std::string(s) + "/" + std::to_string(n);
       benchmark::RegisterBenchmark(("Propagate/" + tail).c_str(), Propagate, s, n);
-      benchmark::RegisterBenchmark(("RangeUpdate/" + tail).c_str(), Update, s, n, false, false, 0);
-      benchmark::RegisterBenchmark(("AnchorRangeUpdate/" + tail).c_str(), Update, s, n, true, false, 0);
+      benchmark::RegisterBenchmark(("RangeUpdate/" + tail).c_str(), Update, s, n, false, false, 0, -1);
+      benchmark::RegisterBenchmark(("AnchorRangeUpdate/" + tail).c_str(), Update, s, n, true, false, 0, -1);
       benchmark::RegisterBenchmark(("DelayedRangeUpdate/" + tail).c_str(), DelayedRangeUpdate, s, n);
     }
   for (int n : kAnchorCounts)
-    benchmark::RegisterBenchmark(("RangeUpdateGamma/dah/" + std::to_string(n)).c_str(), Update, "dah", n, false, true, 0);
+    benchmark::RegisterBenchmark(("RangeUpdateGamma/dah/" + std::to_string(n)).c_str(), Update, "dah", n, false, true,
+                                 0, -1);
   for (int n : kAnchorCounts)
     benchmark::RegisterBenchmark(("RangeUpdateJointSet/dah/" + std::to_string(n)).c_str(), Update, "dah", n, false,
-                                 false, 5);
+                                 false, 5, -1);
+  for (int n : kAnchorCounts)
+    benchmark::RegisterBenchmark(("RangeUpdateJointSetAll/dah/" + std::to_string(n)).c_str(), Update, "dah", n, false,
+                                 false, 0, 0);
+  for (int n : kAnchorCounts)
+    benchmark::RegisterBenchmark(("RangeUpdateJointSetBounded/dah/" + std::to_string(n)).c_str(), Update, "dah", n,
+                                 false, false, 0, EstimatorOptions{}.uwb.dah_joint_max_anchors);
   for (const char* s : kStrategies)
     for (int N : {2, 5, 10, 20})
       benchmark::RegisterBenchmark(("Micro/" + std::string(s) + "/" + std::to_string(N)).c_str(), Micro, s, N);

@@ -109,7 +109,9 @@ void forEachUwbField(Opt& o, Visitor& v) {
   v("uwb.dah_joint_tag_biases", o.uwb.dah_joint_tag_biases,
     "dah only: the tags' gamma instances join the anchors' joint set (merges the batches into one)");
   v("uwb.dah_joint_imu", o.uwb.dah_joint_imu,
-    "dah only: the IMU joins that set too (every pose update also corrects its anchors)");
+    "dah only: the IMU (with the baro and height biases) joins that set too (every pose update also corrects its anchors)");
+  v("uwb.dah_joint_max_anchors", o.uwb.dah_joint_max_anchors,
+    "dah only: most estimated anchors in a joint set, the most refined leave first, 0 = no bound [-]");
   v("uwb.reentry_gap_s", o.uwb.reentry_gap_s, "no tag range accepted for this long: hold and cross-check the next ones, 0 = off [s]");
   v("uwb.reentry_hold_s", o.uwb.reentry_hold_s, "longest hold after a gap, at most window_s [s]");
   v("uwb.reentry_min_ranges", o.uwb.reentry_min_ranges, "held ranges needed to test them against each other [-]");
@@ -247,6 +249,7 @@ void EstimatorOptions::validate() const {
   need(gravity_m_s2 > 0.0, "gravity_m_s2 > 0");
   need(uwb.dah_joint_anchors == "none" || uwb.dah_joint_anchors == "batch" || uwb.dah_joint_anchors == "all",
        "uwb.dah_joint_anchors must be none, batch or all");
+  need(uwb.dah_joint_max_anchors >= 0, "uwb.dah_joint_max_anchors >= 0 (0: no bound)");
   need(window_s >= 0.0, "window_s >= 0");
   need(uwb.reentry_gap_s >= 0.0 && (uwb.reentry_gap_s == 0.0 || (uwb.reentry_hold_s > 0.0 && uwb.reentry_hold_s <= window_s)),
        "uwb.reentry_gap_s >= 0; with a gap, 0 < uwb.reentry_hold_s <= window_s");

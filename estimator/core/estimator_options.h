@@ -153,8 +153,18 @@ struct UwbOptions {
   bool dah_joint_tag_biases = true;
   /// Strategy `dah` only: the IMU joins that set too, so that every update of the pose (baro,
   /// ZUPT, ranges to exactly known anchors) also corrects the set's anchors through their
-  /// correlation with the pose, as the exact filter does.
+  /// correlation with the pose, as the exact filter does. The baro and height-sensor bias
+  /// instances come with it: ranges correlate them with every member through the pose, and
+  /// outside the set they left every member a pair for the DAH correction on every update (its
+  /// cost; docs/modular_estimator.md, "Joint sets", "Cost").
   bool dah_joint_imu = true;
+  /// Strategy `dah` only: at most this many estimated anchors in a joint set (0: no bound). A set
+  /// that holds the IMU is stacked by every update, so without a bound every anchor calibrated on
+  /// a long flight joins it and DAH's update grows with them. When a join exceeds the bound, the
+  /// anchors whose position covariance has the smallest trace (the most refined; ties: the smaller
+  /// id) leave the set, never the joining anchor: their correlations stay and are DAH's from then
+  /// on (updated exactly only by an update that names them).
+  int dah_joint_max_anchors = 8;
   /// Ranges after an aiding gap (issue 8, docs/robustness.md "Range gaps"): when no tag–anchor
   /// range was accepted for `reentry_gap_s`, the tag ranges of the next `reentry_hold_s` are held,
   /// tested against each other (ReentryCheck; with at least `reentry_min_ranges` from

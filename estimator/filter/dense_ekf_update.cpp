@@ -37,6 +37,7 @@ DenseUpdateOutput denseEkfUpdate(Eigen::MatrixXd& P, const StateLayout& layout, 
     P.noalias() -= out.K * U.transpose();
   }
   P = 0.5 * (P + P.transpose()).eval();
+  out.S = std::move(S);
   out.accepted = true;
   return out;
 }

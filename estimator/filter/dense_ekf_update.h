@@ -20,6 +20,7 @@ struct DenseUpdateOutput {
   double nis = 0.0;
   Eigen::VectorXd dx;  ///< δx in `layout` order (when accepted)
   Eigen::MatrixXd K;   ///< gain n × m (when accepted)
+  Eigen::MatrixXd S;   ///< innovation covariance H P Hᵀ + R, m × m (when accepted)
 };
 
 /// Updates `P` (laid out as `layout`) in place when the NIS passes `nis_gate` (≤ 0: no gate).

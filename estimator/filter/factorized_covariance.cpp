@@ -31,6 +31,37 @@ MatrixXd trueFactor(const InstanceBelief& b, const FactorEntry& e) {
   return b.L.size() ? MatrixXd(b.L * *e.S_bar) : *e.S_bar;
 }
 
+/// The true factor S = L_i S̄ of one side of a pair into `out` (dimensions ≤ kMaxInstanceDim;
+/// a fixed-size kernel for the IMU's factor towards a 3-state anchor); false when it is the identity.
+bool trueFactorInto(const InstanceBelief& b, const FactorEntry& e, factorized_internal::InstMat& out) {
+  if (!e.S_bar) {
+    if (!b.L.size()) return false;
+    out = b.L;
+  } else if (!b.L.size()) {
+    out = *e.S_bar;
+  } else if (b.dim == ImuErr::kDim && e.S_bar->cols() == 3) {
+    // Σ_IA factor of the IMU towards an anchor: fixed-size kernel.
+    using M15 = Eigen::Matrix<double, ImuErr::kDim, ImuErr::kDim>;
+    using M15x3 = Eigen::Matrix<double, ImuErr::kDim, 3>;
+    out.resize(ImuErr::kDim, 3);
+    Eigen::Map<M15x3>(out.data()).noalias() =
+        Eigen::Map<const M15>(b.L.data()).lazyProduct(Eigen::Map<const M15x3>(e.S_bar->data()));
+  } else {
+    out.noalias() = b.L * *e.S_bar;
+  }
+  return true;
+}
+
+/// True when every partner of `b` is among `sorted_ids` (a closed participant: no pair of it
+/// with an instance outside the update). O(min(#partners, |ids|) log |ids|).
+bool partnersWithin(const InstanceBelief& b, const std::vector<SensorId>& sorted_ids) {
+  const auto& entries = b.factors->entries();
+  if (entries.size() >= sorted_ids.size()) return false;  // partners are other instances than b
+  return std::all_of(entries.begin(), entries.end(), [&](const FactorEntry& e) {
+    return std::binary_search(sorted_ids.begin(), sorted_ids.end(), e.partner);
+  });
+}
+
 }  // namespace
 
 int FactorizedCovariance::index(SensorId id) const {
@@ -73,7 +104,7 @@ bool FactorizedCovariance::remove(SensorId id) {
   }
   inst_.erase(inst_.begin() + k);
   layout_.remove(id);
-  dropFromSet(id);
+  leaveSet(id);
   return true;
 }
 
@@ -122,14 +153,53 @@ void FactorizedCovariance::renormalize(SensorId id) {
 }
 
 MatrixXd FactorizedCovariance::pairCov(int ki, int kj) const {
+  MatrixXd C(inst_[static_cast<size_t>(ki)]->dim, inst_[static_cast<size_t>(kj)]->dim);
+  pairCovInto(ki, kj, C);
+  return C;
+}
+
+void FactorizedCovariance::pairCovInto(int ki, int kj, Eigen::Ref<MatrixXd> out) const {
   const InstanceBelief& bi = *inst_[static_cast<size_t>(ki)];
   const InstanceBelief& bj = *inst_[static_cast<size_t>(kj)];
   const FactorEntry* eij = bi.factors->find(bj.id);
-  if (!eij) return MatrixXd::Zero(bi.dim, bj.dim);
+  if (!eij) {
+    out.setZero();
+    return;
+  }
   const FactorEntry* eji = bj.factors->find(bi.id);
   if (!eji) throw std::logic_error("FactorizedCovariance: factor of pair (" + std::to_string(bi.id) + ", " +
                                    std::to_string(bj.id) + ") present on one side only");
-  return trueFactor(bi, *eij) * trueFactor(bj, *eji).transpose();
+  // S_ij S_jiᵀ without multiplying identities (S = L S̄; a null S̄ or an empty L is the identity).
+  if (bi.dim <= factorized_internal::kMaxInstanceDim && bj.dim <= factorized_internal::kMaxInstanceDim) {
+    factorized_internal::InstMat A, B;  // stack storage
+    const bool fa = trueFactorInto(bi, *eij, A), fb = trueFactorInto(bj, *eji, B);
+    if (fa && fb)
+      out.noalias() = A * B.transpose();
+    else if (fa)
+      out = A;
+    else if (fb)
+      out = B.transpose();
+    else
+      out.setIdentity();
+    return;
+  }
+  MatrixXd scratch_i, scratch_j;
+  auto factor = [](const InstanceBelief& b, const FactorEntry& e, MatrixXd& scratch) -> const MatrixXd* {
+    if (!e.S_bar) return b.L.size() ? &b.L : nullptr;
+    if (!b.L.size()) return e.S_bar.get();
+    scratch.noalias() = b.L * *e.S_bar;
+    return &scratch;
+  };
+  const MatrixXd* Si = factor(bi, *eij, scratch_i);
+  const MatrixXd* Sj = factor(bj, *eji, scratch_j);
+  if (Si && Sj)
+    out.noalias() = *Si * Sj->transpose();
+  else if (Si)
+    out = *Si;
+  else if (Sj)
+    out = Sj->transpose();
+  else
+    out.setIdentity();
 }
 
 MatrixXd FactorizedCovariance::block(SensorId a, SensorId b) const {
@@ -177,8 +247,8 @@ FactorizedCovariance::Result FactorizedCovariance::update(const Linearization& l
   for (size_t a = 0; a < part.size(); ++a) {
     P.block(sb[a].offset, sb[a].offset, sb[a].dim, sb[a].dim) = inst_[static_cast<size_t>(part[a])]->Sigma;
     for (size_t c = a + 1; c < part.size(); ++c) {
-      const MatrixXd C = pairCov(part[a], part[c]);
-      P.block(sb[a].offset, sb[c].offset, sb[a].dim, sb[c].dim) = C;
+      auto C = P.block(sb[a].offset, sb[c].offset, sb[a].dim, sb[c].dim);
+      pairCovInto(part[a], part[c], C);
       P.block(sb[c].offset, sb[a].offset, sb[c].dim, sb[a].dim) = C.transpose();
     }
   }
@@ -189,7 +259,7 @@ FactorizedCovariance::Result FactorizedCovariance::update(const Linearization& l
   if (mode_ == Mode::DP)
     writeBackDp(part, sub, P, t);
   else
-    writeBackDah(part, sub, P, out.K, lin, t);
+    writeBackDah(part, sub, P, out.K, out.S, lin, t);
   res.accepted = true;
   res.blocks = sub.blocks();
   res.dx = std::move(out.dx);
@@ -229,23 +299,46 @@ void FactorizedCovariance::writeBackDp(const std::vector<int>& part, const State
 }
 
 void FactorizedCovariance::writeBackDah(const std::vector<int>& part, const StateLayout& sub, const MatrixXd& P,
-                                        const MatrixXd& K, const Linearization& lin, Timestamp t) {
+                                        const MatrixXd& K, const MatrixXd& S, const Linearization& lin, Timestamp t) {
   const auto& sb = sub.blocks();
   const size_t np = part.size();
+  std::vector<SensorId> ids;  // the participants' ids, sorted
+  if (np > 1) {
+    ids.reserve(np);
+    for (const StateBlock& b : sb) ids.push_back(b.id);
+    std::sort(ids.begin(), ids.end());
+  }
   // 1. Σ_ii' and the correction of the pairs with non-participants, folded into L_i.
   for (size_t a = 0; a < np; ++a) {
-    const MatrixXd Sigma_new = P.block(sb[a].offset, sb[a].offset, sb[a].dim, sb[a].dim);
-    MatrixXd M;
-    if (np == 1) {
-      // Private update: Σ_ik' = (I − K H_i) Σ_ik exactly.
-      M = MatrixXd::Identity(sb[a].dim, sb[a].dim) - K * lin.find(sb[a].id)->H;
-    } else {
-      // DAH: Σ_ik' ≈ Σ_ii' Σ_ii⁻¹ Σ_ik = (Σ_ii⁻¹ Σ_ii')ᵀ Σ_ik.
-      M = inst_[static_cast<size_t>(part[a])]->Sigma.ldlt().solve(Sigma_new).transpose();
+    const auto Sigma_new = P.block(sb[a].offset, sb[a].offset, sb[a].dim, sb[a].dim);
+    if (np > 1 && partnersWithin(*inst_[static_cast<size_t>(part[a])], ids)) {
+      // Every correlation of i is a pair within P, written exactly in step 3: no pair is left
+      // for the DAH correction, so L_i restarts as the identity (a DP write-back for i).
+      InstanceBelief& b = mut(part[a]);
+      b.Sigma = Sigma_new;
+      b.L.resize(0, 0);
+      b.lazy_steps = 0;
+      b.t = t;
+      continue;
     }
     InstanceBelief& b = mut(part[a]);
+    if (np > 1 && S.size() == 1) {
+      // Scalar: Σ_ii' Σ_ii⁻¹ = I − u wᵀ / s with u = K_i s (rank-one form, as the fast path).
+      const double s = S(0, 0);
+      if (std::abs(s) > std::numeric_limits<double>::min())
+        factorized_internal::foldScalarCorrection(b, K.block(sb[a].offset, 0, sb[a].dim, 1) * s, s);
+    } else {
+      MatrixXd M;
+      if (np == 1) {
+        // Private update: Σ_ik' = (I − K H_i) Σ_ik exactly.
+        M = MatrixXd::Identity(sb[a].dim, sb[a].dim) - K * lin.find(sb[a].id)->H;
+      } else {
+        // DAH: Σ_ik' ≈ Σ_ii' Σ_ii⁻¹ Σ_ik = (Σ_ii⁻¹ Σ_ii')ᵀ Σ_ik.
+        M = b.Sigma.ldlt().solve(Sigma_new).transpose();
+      }
+      b.L = b.L.size() ? MatrixXd(M * b.L) : M;
+    }
     b.Sigma = Sigma_new;
-    b.L = b.L.size() ? MatrixXd(M * b.L) : M;
     b.t = t;
     ++b.lazy_steps;
   }
@@ -255,11 +348,13 @@ void FactorizedCovariance::writeBackDah(const std::vector<int>& part, const Stat
   }
   // 2. L_i'⁻¹ of the participants (re-normalize when L_i' is badly conditioned or old).
   std::vector<MatrixXd> Linv(np);
+  std::vector<std::shared_ptr<const MatrixXd>> Linv_shared(np);  // S̄_ji of the larger id: one per member
   for (size_t a = 0; a < np; ++a) {
     const InstanceBelief& b = *inst_[static_cast<size_t>(part[a])];
     if (b.L.size() == 0) continue;
-    Linv[a] = b.L.partialPivLu().inverse();
-    if (b.lazy_steps > kMaxLazySteps || !Linv[a].allFinite() || roughCondition(b.L, Linv[a]) > kMaxLazyCondition) {
+    if (factorized_internal::invertPendingFactor(b, Linv[a])) {
+      Linv_shared[a] = shared(Linv[a]);
+    } else {
       renormalize(sb[a].id);
       Linv[a].resize(0, 0);
     }
@@ -271,7 +366,7 @@ void FactorizedCovariance::writeBackDah(const std::vector<int>& part, const Stat
       const size_t s = a_small ? a : c, l = a_small ? c : a;
       const MatrixXd C = P.block(sb[s].offset, sb[l].offset, sb[s].dim, sb[l].dim);
       mutDict(mut(part[s])).set(sb[l].id, shared(Linv[s].size() ? MatrixXd(Linv[s] * C) : C));
-      mutDict(mut(part[l])).set(sb[s].id, Linv[l].size() ? shared(Linv[l]) : nullptr);
+      mutDict(mut(part[l])).set(sb[s].id, Linv_shared[l]);
     }
   }
 }

@@ -67,6 +67,10 @@ class FactorizedCovariance {
   void joinSet(const std::vector<SensorId>& ids);
   /// The members of the joint set holding `id` in ascending id order (empty: none).
   std::vector<SensorId> jointSet(SensorId id) const;
+  /// `id` leaves its joint set (a set left with one member is no set). Its correlations with the
+  /// members stay and are DAH's from then on: updated exactly by an update that names it, else by
+  /// the DAH correction. Nothing when `id` is in no set.
+  void leaveSet(SensorId id);
 
   const StateLayout& layout() const { return layout_; }
   bool has(SensorId id) const { return layout_.find(id) != nullptr; }
@@ -91,9 +95,13 @@ class FactorizedCovariance {
   static FactorDictionary& mutDict(InstanceBelief& b);
   /// Σ_ij for the instances at indices ki ≠ kj.
   Eigen::MatrixXd pairCov(int ki, int kj) const;
+  /// The same into `out` (dim_i × dim_j), e.g. a block of the stacked covariance: no temporaries
+  /// unless both sides have a pending factor and a stored S̄.
+  void pairCovInto(int ki, int kj, Eigen::Ref<Eigen::MatrixXd> out) const;
   void writeBackDp(const std::vector<int>& part, const StateLayout& sub, const Eigen::MatrixXd& P, Timestamp t);
+  /// `S`: the innovation covariance (a scalar update folds the DAH correction in rank-one form).
   void writeBackDah(const std::vector<int>& part, const StateLayout& sub, const Eigen::MatrixXd& P,
-                    const Eigen::MatrixXd& K, const Linearization& lin, Timestamp t);
+                    const Eigen::MatrixXd& K, const Eigen::MatrixXd& S, const Linearization& lin, Timestamp t);
   /// DAH update of a scalar measurement on at most 4 participants of dimension ≤ 15 (every range
   /// and baro update): the same steps as update() + writeBackDah() on stack storage, with the
   /// rank-one forms of the scalar update (see the .cpp). False: not applicable, use the general path.
@@ -106,7 +114,6 @@ class FactorizedCovariance {
   /// The participants of a DAH update: the instances named by `lin` and their joint sets'
   /// members (indices in layout order).
   std::vector<int> dahParticipants(const Linearization& lin) const;
-  void dropFromSet(SensorId id);
 
   using JointSets = std::vector<std::vector<SensorId>>;  ///< each sorted, ≥ 2 members
   Mode mode_;

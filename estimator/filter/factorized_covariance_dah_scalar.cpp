@@ -28,33 +28,12 @@ using factorized_internal::shared;
 
 // ---- DAH scalar fast path (updateDahScalar): stack storage, fixed-size kernels per instance. ----
 constexpr int kMaxParticipants = 4;
-constexpr int kMaxInstanceDim = 15;  ///< the IMU
+using factorized_internal::kMaxInstanceDim;
 constexpr int kMaxStackedDim = 32;
 /// The stacked Σ_PP and vectors over it without heap allocation.
 using StackMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxStackedDim, kMaxStackedDim>;
 using StackVec = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxStackedDim, 1>;
-/// One instance's matrices (factors, L_i⁻¹) without heap allocation.
-using InstMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxInstanceDim, kMaxInstanceDim>;
-
-/// The true factor S = L_i S̄ of one side of a pair into `out`; false when it is the identity.
-bool trueFactorInto(const InstanceBelief& b, const FactorEntry& e, InstMat& out) {
-  if (!e.S_bar) {
-    if (!b.L.size()) return false;
-    out = b.L;
-  } else if (!b.L.size()) {
-    out = *e.S_bar;
-  } else if (b.dim == ImuErr::kDim && e.S_bar->cols() == 3) {
-    // Σ_IA factor of the IMU towards an anchor: fixed-size kernel.
-    using M15 = Eigen::Matrix<double, ImuErr::kDim, ImuErr::kDim>;
-    using M15x3 = Eigen::Matrix<double, ImuErr::kDim, 3>;
-    out.resize(ImuErr::kDim, 3);
-    Eigen::Map<M15x3>(out.data()).noalias() =
-        Eigen::Map<const M15>(b.L.data()).lazyProduct(Eigen::Map<const M15x3>(e.S_bar->data()));
-  } else {
-    out.noalias() = b.L * *e.S_bar;
-  }
-  return true;
-}
+using factorized_internal::InstMat;
 
 /// A⁻¹ of a fixed-size square matrix by Gauss elimination with partial pivoting on [A | I] (the
 /// pivots and the elimination of Eigen's unblocked PartialPivLU; whole contiguous rows of row-major
@@ -153,8 +132,8 @@ void foldDahCorrection(InstanceBelief& b, const UV& u, double s) {
 }
 
 /// L_i⁻¹ into `out`; false when L_i must be re-normalized instead (old, not finite, badly conditioned).
-template <int D>
-bool invertPending(const InstanceBelief& b, int max_lazy_steps, double max_condition, InstMat& out) {
+template <int D, typename Out>
+bool invertPending(const InstanceBelief& b, int max_lazy_steps, double max_condition, Out& out) {
   using Mat = Eigen::Matrix<double, D, D>;
   const Eigen::Map<const Mat> L(b.L.data(), b.dim, b.dim);
   Mat inv;
@@ -168,6 +147,29 @@ bool invertPending(const InstanceBelief& b, int max_lazy_steps, double max_condi
 }
 
 }  // namespace
+
+namespace factorized_internal {
+
+void foldScalarCorrection(InstanceBelief& b, const Eigen::Ref<const Eigen::VectorXd>& u, double s) {
+  if (b.dim == ImuErr::kDim)
+    foldDahCorrection<ImuErr::kDim>(b, u, s);
+  else if (b.dim == 3)
+    foldDahCorrection<3>(b, u, s);
+  else
+    foldDahCorrection<Eigen::Dynamic>(b, u, s);
+}
+
+template <typename Out>
+bool invertPendingFactor(const InstanceBelief& b, Out& out) {
+  constexpr int kSteps = FactorizedCovariance::kMaxLazySteps;
+  constexpr double kCond = FactorizedCovariance::kMaxLazyCondition;
+  return b.dim == ImuErr::kDim ? invertPending<ImuErr::kDim>(b, kSteps, kCond, out)
+         : b.dim == 3          ? invertPending<3>(b, kSteps, kCond, out)
+                               : invertPending<Eigen::Dynamic>(b, kSteps, kCond, out);
+}
+template bool invertPendingFactor(const InstanceBelief&, Eigen::MatrixXd&);
+
+}  // namespace factorized_internal
 
 /// The steps of updateDahScalar on its stack storage: the participants, Σ_PP, the scalar EKF
 /// update, then the DAH write-back (private: one participant; joint: the rank-one correction of
@@ -207,33 +209,13 @@ class DahScalarUpdate {
   /// Stacks Σ_PP: blocks Σ_ii and Σ_ij = S_ij S_jiᵀ (identity factors are not multiplied).
   void stackCovariance() {
     P_.resize(n_, n_);
-    InstMat A, B;
     for (int a = 0; a < np_; ++a) {
       const Part& pa = pp_[static_cast<size_t>(a)];
-      const InstanceBelief& ba = *fc_.inst_[static_cast<size_t>(pa.k)];
-      P_.block(pa.off, pa.off, pa.dim, pa.dim) = ba.Sigma;
+      P_.block(pa.off, pa.off, pa.dim, pa.dim) = fc_.inst_[static_cast<size_t>(pa.k)]->Sigma;
       for (int c = a + 1; c < np_; ++c) {
         const Part& pc = pp_[static_cast<size_t>(c)];
-        const InstanceBelief& bc = *fc_.inst_[static_cast<size_t>(pc.k)];
         auto C = P_.block(pa.off, pc.off, pa.dim, pc.dim);
-        const FactorEntry* eac = ba.factors->find(bc.id);
-        if (!eac) {
-          C.setZero();
-        } else {
-          const FactorEntry* eca = bc.factors->find(ba.id);
-          if (!eca)
-            throw std::logic_error("FactorizedCovariance: factor of pair (" + std::to_string(ba.id) + ", " +
-                                   std::to_string(bc.id) + ") present on one side only");
-          const bool fa = trueFactorInto(ba, *eac, A), fc = trueFactorInto(bc, *eca, B);
-          if (fa && fc)
-            C.noalias() = A * B.transpose();
-          else if (fa)
-            C = A;
-          else if (fc)
-            C = B.transpose();
-          else
-            C.setIdentity();
-        }
+        fc_.pairCovInto(pa.k, pc.k, C);  // instances ≤ kMaxInstanceDim: stack storage, as before
         P_.block(pc.off, pa.off, pc.dim, pa.dim) = C.transpose();
       }
     }
@@ -334,13 +316,7 @@ class DahScalarUpdate {
       const Part& p = pp_[static_cast<size_t>(a)];
       InstanceBelief& b = fc_.mut(p.k);
       if (invertible_) {  // else K = 0: nothing changed
-        const auto u = U_.segment(p.off, p.dim);
-        if (p.dim == ImuErr::kDim)
-          foldDahCorrection<ImuErr::kDim>(b, u, s_);
-        else if (p.dim == 3)
-          foldDahCorrection<3>(b, u, s_);
-        else
-          foldDahCorrection<Eigen::Dynamic>(b, u, s_);
+        factorized_internal::foldScalarCorrection(b, U_.segment(p.off, p.dim), s_);
       }
       b.Sigma = P_.block(p.off, p.off, p.dim, p.dim);
       b.t = t;
@@ -350,16 +326,11 @@ class DahScalarUpdate {
 
   /// 2. L_i'⁻¹ of the participants (re-normalize when L_i' is badly conditioned or old).
   void invertPendingFactors() {
-    constexpr int kSteps = FactorizedCovariance::kMaxLazySteps;
-    constexpr double kCond = FactorizedCovariance::kMaxLazyCondition;
     for (int a = 0; a < np_; ++a) {
       const Part& p = pp_[static_cast<size_t>(a)];
       const InstanceBelief& b = *fc_.inst_[static_cast<size_t>(p.k)];
       if (b.L.size() == 0) continue;
-      const bool ok = p.dim == ImuErr::kDim ? invertPending<ImuErr::kDim>(b, kSteps, kCond, Linv_[a])
-                      : p.dim == 3          ? invertPending<3>(b, kSteps, kCond, Linv_[a])
-                                            : invertPending<Eigen::Dynamic>(b, kSteps, kCond, Linv_[a]);
-      if (ok)
+      if (factorized_internal::invertPendingFactor(b, Linv_[static_cast<size_t>(a)]))
         has_inv_[static_cast<size_t>(a)] = true;
       else
         fc_.renormalize(p.id);

@@ -43,7 +43,7 @@ std::vector<SensorId> FactorizedCovariance::jointSet(SensorId id) const {
   return {};
 }
 
-void FactorizedCovariance::dropFromSet(SensorId id) {
+void FactorizedCovariance::leaveSet(SensorId id) {
   if (jointSet(id).empty()) return;
   auto sets = std::make_shared<JointSets>(*sets_);
   for (auto& s : *sets) std::erase(s, id);

@@ -50,6 +50,8 @@ class FusionStrategy {
   virtual void joinJointSet(const std::vector<SensorId>& ids) { (void)ids; }
   /// The DAH joint set `id` belongs to (itself included), empty when none or not DAH.
   virtual std::vector<SensorId> jointSetOf(SensorId id) const { (void)id; return {}; }
+  /// `id` leaves its DAH joint set (FactorizedCovariance::leaveSet); nothing for the exact strategies.
+  virtual void leaveJointSet(SensorId id) { (void)id; }
 
   /// Propagates to `t_to` with IMU readings held constant since the state's time.
   virtual void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) = 0;

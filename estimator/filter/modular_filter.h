@@ -39,6 +39,7 @@ class ModularFilter final : public FusionStrategy {
   std::vector<SensorId> jointSetOf(SensorId id) const override {
     return cov_.mode() == Mode::DAH ? cov_.jointSet(id) : std::vector<SensorId>{};
   }
+  void leaveJointSet(SensorId id) override { cov_.leaveSet(id); }
 
   void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) override;
   void addImuNoise(const ImuMatrix& Q) override;

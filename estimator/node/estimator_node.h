@@ -205,6 +205,7 @@ class EstimatorNode {
   void countScalarUpdate(Timestamp t, SensorId id, const std::string& type, const UpdateResult& r);
   void applyAnchorInit(const AnchorInit& a, bool first);
   /// dah: puts the just added anchor `id` into its joint set (uwb.dah_joint_anchors).
+  /// At most `uwb.dah_joint_max_anchors` anchors stay in it (boundJointSetAnchors).
   void joinAnchorSet(SensorId id);
   void applyCommand(const EstimatorCommand& c, bool first);
   void propagateTo(Timestamp t);

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "common/atmosphere.h"
+#include "estimator/filter/joint_set_bound.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/node/node_internals.h"
 #include "estimator/uwb/range_model.h"
@@ -196,8 +197,16 @@ void EstimatorNode::joinAnchorSet(SensorId id) {
       if (cur_.network->isCalibrated(other)) set.push_back(other);
   if (options_.uwb.dah_joint_tag_biases)  // merges every batch into one set with the tags' γ
     for (const auto& [tag, value] : cur_.filter->state().values<TagBiasKind>()) set.push_back(tag);
-  if (options_.uwb.dah_joint_imu) set.push_back(cur_.filter->state().imu_id);
+  if (options_.uwb.dah_joint_imu) {
+    // With the IMU the biases of its vertical aids (baro, height sensor): a range correlates them
+    // with every member through the pose, and left outside they would keep each member's DAH
+    // correction (and its cost) on every update of the set.
+    set.push_back(cur_.filter->state().imu_id);
+    for (const auto& [baro, value] : cur_.filter->state().values<BaroBiasKind>()) set.push_back(baro);
+    for (const auto& [height, value] : cur_.filter->state().values<HeightBiasKind>()) set.push_back(height);
+  }
   cur_.filter->joinJointSet(set);
+  boundJointSetAnchors(*cur_.filter, id, options_.uwb.dah_joint_max_anchors);
 }
 
 }  // namespace meshnav::estimator

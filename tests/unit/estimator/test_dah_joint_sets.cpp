@@ -3,10 +3,13 @@
 // every update names a member, DAH with the set equals the centralized EKF (state and the whole
 // covariance, including the anchor–anchor cross-covariances that plain DAH never builds); the sets
 // merge, forget removed members and are snapshot with the filter; DP ignores them; the node puts
-// anchors added together into one set with the tags' γ and the IMU.
+// anchors added together into one set with the tags' γ, the IMU and its baro bias. An update whose
+// stack holds every partner of a member leaves that member no pending factor; the bound
+// (boundJointSetAnchors, uwb.dah_joint_max_anchors) lets the most refined anchors leave.
 #include <gtest/gtest.h>
 
 #include "estimator/filter/centralized_ekf.h"
+#include "estimator/filter/joint_set_bound.h"
 #include "estimator/filter/modular_filter.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/testing/synthetic_scenario.h"
@@ -82,6 +85,27 @@ double maxAnchorDifference(const FusionStrategy& a, const FusionStrategy& b) {
   return d;
 }
 
+/// Feeds `ds` to `node` with one batch of calibrated anchors `ids` at t = 8 s (prior σ² 0.01 m²
+/// per axis, or 0.01 × (id − 200) when `growing_priors`). False when the batch was never sent.
+bool flyWithAnchorBatch(EstimatorNode& node, const Dataset& ds, const std::vector<SensorId>& ids, bool growing_priors) {
+  bool sent = false;
+  for (const auto& in : mergeInTimeOrder(ds)) {
+    if (!sent && node.initialized() && inputTime(in).sec() >= 8.0) {
+      for (SensorId id : ids) {
+        AnchorInit a;
+        a.id = id;
+        a.t = inputTime(in);
+        a.p_AinG = Eigen::Vector3d(1.0, 0.5 * id - 100.0, 1.0);
+        a.cov_p_m2 = Eigen::Matrix3d::Identity() * 0.01 * (growing_priors ? id - 200 : 1);
+        node.onAnchorInit(a);
+      }
+      sent = true;
+    }
+    node.onInput(in);
+  }
+  return sent;
+}
+
 }  // namespace
 
 TEST(DahJointSets, AnchorSetWithTagRangesEqualsCentralized) {
@@ -111,6 +135,46 @@ TEST(DahJointSets, SetWithTheImuKeepsAnchorPairUpdatesExact) {
   EXPECT_LT(maxRelative(with_imu->fullCovariance(), ref->fullCovariance()), 1e-9);
   EXPECT_LT(maxAnchorDifference(*with_imu, *ref), 1e-12);
   with_imu->checkInvariants();
+}
+
+TEST(DahJointSets, AnUpdateCoveringEveryPartnerLeavesNoPendingFactor) {
+  // Every instance is in the set: each update's stack holds every partner of every member, so
+  // no DAH correction is left to fold (L_i = I), and the result is still the exact one.
+  const auto ref = centralizedFlight(true);
+  const auto all = dahFlight({106, 107, 108, 1}, true);
+  for (SensorId id : {1, 106, 107, 108}) EXPECT_EQ(all->instances().belief(id).L.size(), 0) << id;
+  EXPECT_LT(maxRelative(all->fullCovariance(), ref->fullCovariance()), 1e-9);
+  // 108 outside: its pairs with the members are approximated, so the members keep a factor.
+  const auto part = dahFlight({106, 107, 1}, false);
+  EXPECT_GT(part->instances().belief(1).L.size(), 0);
+  part->checkInvariants();
+}
+
+TEST(DahJointSets, BoundLetsTheMostRefinedAnchorsLeave) {
+  auto f = dahFlight({106, 107, 108, 1}, false);
+  std::vector<std::pair<double, SensorId>> trace;
+  for (SensorId id : {106, 107, 108}) trace.emplace_back(f->covariance(id, id).trace(), id);
+  std::sort(trace.begin(), trace.end());
+  ASSERT_LT(trace[0].first, trace[2].first);
+  // A new anchor with a loose prior joins; at most two anchors may stay: the new one and the
+  // least refined of the others.
+  f->addInstance<AnchorKind>(109, AnchorState{Eigen::Vector3d(1.0, 2.0, 3.0)}, Eigen::Matrix3d::Identity() * 0.09);
+  f->joinJointSet({109, 1});
+  EXPECT_EQ(boundJointSetAnchors(*f, 109, 0), 0);  // 0: no bound
+  EXPECT_EQ(f->jointSetOf(1).size(), 5u);
+  const Eigen::MatrixXd C_before = f->covariance(trace[0].second, 1);
+  EXPECT_EQ(boundJointSetAnchors(*f, 109, 2), 2);
+  EXPECT_EQ(f->jointSetOf(1), (std::vector<SensorId>{1, trace[2].second, 109}));
+  EXPECT_TRUE(f->jointSetOf(trace[0].second).empty());
+  // The anchors that left keep their correlations (DAH's from now on), and ranges to them work.
+  EXPECT_EQ(f->covariance(trace[0].second, 1), C_before);
+  EXPECT_GT(C_before.cwiseAbs().maxCoeff(), 1e-6);
+  ASSERT_TRUE(f->update(test::imuAnchorRange(f->state(), trace[0].second,
+                                             (kTruth.at(trace[0].second) - Eigen::Vector3d(0.5, -0.2, 1.5)).norm()),
+                        0.0)
+                  .accepted);
+  EXPECT_EQ(boundJointSetAnchors(*f, 109, 2), 0);  // already within the bound
+  f->checkInvariants();
 }
 
 TEST(DahJointSets, SetsMergeForgetRemovedMembersAndAreSnapshotWithTheFilter) {
@@ -147,22 +211,7 @@ TEST(DahJointSets, NodePutsAnchorsAddedTogetherIntoOneSetWithTheImu) {
     o.strategy = "dah";
     o.uwb.dah_joint_anchors = mode;
     EstimatorNode node(o, ds.setup);
-    bool sent = false;
-    for (const auto& in : mergeInTimeOrder(ds)) {
-      if (!sent && node.initialized() && inputTime(in).sec() >= 8.0) {
-        for (SensorId id : {201, 202}) {  // two calibrated anchors in one batch
-          AnchorInit a;
-          a.id = id;
-          a.t = inputTime(in);
-          a.p_AinG = Eigen::Vector3d(1.0, 0.5 * id - 100.0, 1.0);
-          a.cov_p_m2 = Eigen::Matrix3d::Identity() * 0.01;
-          node.onAnchorInit(a);
-        }
-        sent = true;
-      }
-      node.onInput(in);
-    }
-    ASSERT_TRUE(sent) << mode;
+    ASSERT_TRUE(flyWithAnchorBatch(node, ds, {201, 202}, false)) << mode;  // two calibrated anchors in one batch
     const auto* f = dynamic_cast<const ModularFilter*>(node.filter());
     ASSERT_NE(f, nullptr);
     const std::vector<SensorId> set = f->instances().jointSet(201);
@@ -173,7 +222,9 @@ TEST(DahJointSets, NodePutsAnchorsAddedTogetherIntoOneSetWithTheImu) {
     const SensorId imu = f->state().imu_id;
     EXPECT_NE(std::find(set.begin(), set.end(), 202), set.end());
     EXPECT_NE(std::find(set.begin(), set.end(), imu), set.end()) << "uwb.dah_joint_imu";
-    EXPECT_EQ(set.size(), 3u);  // the synthetic setup has no tag γ states (uwb.dah_joint_tag_biases)
+    // With the IMU its baro bias, else every member of the set keeps a pair outside it.
+    EXPECT_NE(std::find(set.begin(), set.end(), ds.setup.baro_id), set.end()) << "uwb.dah_joint_imu";
+    EXPECT_EQ(set.size(), 4u);  // the synthetic setup has no tag γ states (uwb.dah_joint_tag_biases)
     f->checkInvariants();
     // A re-initialization (here the test hook's pose fault) keeps the set together.
     node.injectPoseError(Eigen::Vector3d(1.0, 0.0, 0.0), 0.3);
@@ -184,5 +235,25 @@ TEST(DahJointSets, NodePutsAnchorsAddedTogetherIntoOneSetWithTheImu) {
     std::sort(before.begin(), before.end());
     EXPECT_EQ(after, before);
     g->checkInvariants();
+  }
+}
+
+TEST(DahJointSets, NodeBoundsTheAnchorsOfASet) {
+  synthetic::SyntheticOptions so;
+  so.duration_s = 10.0;
+  so.seed = 2;
+  const Dataset ds = synthetic::makeSyntheticDataset(so);
+  for (const int max_anchors : {0, 2}) {
+    EstimatorOptions o = test::testOptions();
+    o.strategy = "dah";
+    o.uwb.dah_joint_max_anchors = max_anchors;
+    EstimatorNode node(o, ds.setup);
+    ASSERT_TRUE(flyWithAnchorBatch(node, ds, {201, 202, 203}, true));  // one batch, the last with the loosest prior
+    const std::vector<SensorId> set = node.filter()->jointSetOf(203);
+    const auto in_set = [&](SensorId id) { return std::find(set.begin(), set.end(), id) != set.end(); };
+    EXPECT_TRUE(in_set(203)) << max_anchors;
+    EXPECT_TRUE(in_set(202)) << max_anchors;  // the loosest of the others stays
+    EXPECT_EQ(in_set(201), max_anchors == 0) << max_anchors;  // the most refined leaves under the bound
+    node.filter()->checkInvariants();
   }
 }
