@@ -31,7 +31,8 @@ struct InputIds {
 /// order at equal time (`rank`), its channel name (`name`; counter prefix "RANGE:duplicate",
 /// "IMU:time_ahead"; the estimator process subscribes the channel constant of that name and type,
 /// transport/channels.h), and optionally `kDataset` (the Dataset member mergeInTimeOrder takes it
-/// from) and `ids` (InputIds of a sample). An explicit table, not the variant's index: adding or
+/// from), `ids` (InputIds of a sample) and `kDatasetOnly` (no channel: not subscribed by the
+/// process, which the channels test checks otherwise). An explicit table, not the variant's index: adding or
 /// moving an alternative of EstimatorInput changes no order (test_estimator_input.cpp).
 template <class T>
 struct InputKind;
