@@ -22,7 +22,6 @@ struct Dataset {
   std::vector<RangeSample> ranges;
   std::vector<FlightStateSample> flight_states;
   std::vector<HeightSample> heights;  ///< optional height.csv
-  std::vector<AirspeedSample> airspeeds;  ///< optional airspeed.csv (SCRATCH)
   std::vector<PoseSample> ground_truth;
   SystemSetup setup;
   std::optional<Truth> truth;
@@ -44,7 +43,6 @@ std::vector<RangeSample> readRangesCsv(const std::string& path, Diagnostics& dia
 std::vector<FlightStateSample> readFlightStateCsv(const std::string& path, Diagnostics& diag);
 /// `t,range_m`; a range that is not finite, negative or beyond 100 m is reported and dropped.
 std::vector<HeightSample> readHeightCsv(const std::string& path, Diagnostics& diag);
-std::vector<AirspeedSample> readAirspeedCsv(const std::string& path, Diagnostics& diag);
 /// TUM format `#t,tx,ty,tz,qx,qy,qz,qw` (comma or space separated).
 std::vector<PoseSample> readTumCsv(const std::string& path, Diagnostics& diag);
 

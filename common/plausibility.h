@@ -19,7 +19,5 @@ constexpr double kMinRange_m = -0.5;
 constexpr double kMaxRange_m = 500.0;
 /// Laser height above the floor [m].
 constexpr double kMaxHeight_m = 100.0;
-/// Airspeed [m/s] (SCRATCH).
-constexpr double kMaxAirspeed_m_s = 100.0;
 
 }  // namespace meshnav::plausible

@@ -58,12 +58,6 @@ struct HeightSample {
   double range_m = 0.0;  ///< measured distance [m]
 };
 
-/// SCRATCH (issue 11 recipe check): pitot airspeed reading (dataset file airspeed.csv).
-struct AirspeedSample {
-  Timestamp t;
-  double airspeed_m_s = 0.0;  ///< measured airspeed [m/s]
-};
-
 /// Landed / flying state from the flight controller.
 struct FlightStateSample {
   Timestamp t;

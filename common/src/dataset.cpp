@@ -212,11 +212,6 @@ std::vector<HeightSample> readHeightCsv(const std::string& path, Diagnostics& di
   return readTimeValueCsv<HeightSample>(path, "range_m", 0.0, plausible::kMaxHeight_m, "a height in [0, 100] m", diag);
 }
 
-std::vector<AirspeedSample> readAirspeedCsv(const std::string& path, Diagnostics& diag) {
-  return readTimeValueCsv<AirspeedSample>(path, "airspeed_m_s", 0.0, plausible::kMaxAirspeed_m_s,
-                                          "an airspeed in [0, 100] m/s", diag);
-}
-
 std::vector<PoseSample> readTumCsv(const std::string& path, Diagnostics& diag) {
   const std::vector<std::string> cols = {"t", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
   CsvReader reader(path, cols);
@@ -321,7 +316,6 @@ Dataset readDataset(const std::string& dir, Diagnostics& diag, bool with_truth) 
   else throw std::runtime_error((d / "ranges.csv").string() + ": missing (a dataset needs ranges)");
   if (auto p = opt("flight_state.csv")) ds.flight_states = readFlightStateCsv(*p, diag);
   if (auto p = opt("height.csv")) ds.heights = readHeightCsv(*p, diag);
-  if (auto p = opt("airspeed.csv")) ds.airspeeds = readAirspeedCsv(*p, diag);
   if (auto p = opt("groundtruth.csv")) ds.ground_truth = readTumCsv(*p, diag);
   if (with_truth) {
     if (auto p = opt("truth.yaml")) ds.truth = loadTruth(*p);

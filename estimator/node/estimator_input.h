@@ -19,8 +19,7 @@
 namespace meshnav::estimator {
 
 using EstimatorInput =
-    std::variant<FlightStateSample, ImuSample, BaroSample, RangeSample, AnchorInit, EstimatorCommand, HeightSample,
-                 AirspeedSample>;
+    std::variant<FlightStateSample, ImuSample, BaroSample, RangeSample, AnchorInit, EstimatorCommand, HeightSample>;
 
 /// Ids of an input that order it among inputs of its kind at equal time (0: none).
 struct InputIds {
@@ -52,7 +51,6 @@ template <> struct InputKind<EstimatorCommand> {
   static constexpr int rank = 5; static constexpr const char* name = "ESTIMATOR_CMD";
   static InputIds ids(const EstimatorCommand& c) { return {c.id, 0}; }
 };
-template <> struct InputKind<AirspeedSample> { static constexpr int rank = 7; static constexpr const char* name = "AIRSPEED"; static constexpr auto kDataset = &Dataset::airspeeds; static constexpr bool kDatasetOnly = true; };
 template <> struct InputKind<HeightSample> { static constexpr int rank = 6; static constexpr const char* name = "HEIGHT"; static constexpr auto kDataset = &Dataset::heights; };
 
 /// Calls `f.template operator()<T>()` for every input kind T, in the variant's order.

@@ -308,7 +308,6 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
           noteAnchorJoin(m, first);
         }
         if constexpr (std::is_same_v<T, EstimatorCommand>) applyCommand(m, first);
-        if constexpr (std::is_same_v<T, AirspeedSample>) processAirspeed(m, first);
       },
       in);
 }

@@ -72,11 +72,6 @@ void EstimatorNode::processHeight(const HeightSample& s, bool first) {
   if (first) countScalarUpdate(s.t, setup_.height_id, carried_height_ ? "carried_height" : "height", r);
 }
 
-void EstimatorNode::processAirspeed(const AirspeedSample& s, bool first) {
-  propagateTo(s.t);
-  event(first, "airspeed");
-}
-
 void EstimatorNode::processRange(const RangeSample& s, bool first) {
   if (!options_.uwb.enabled) return;
   RangeMeasurement z;

@@ -3,8 +3,6 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 
 #include "node_test_helpers.h"
 
@@ -279,32 +277,4 @@ TEST(EstimatorNode, HeightsAddABiasInstanceThatConvergesAndBadHeightsAreCounted)
   bool listed = false;
   for (const auto& is : node.status().instances) listed |= is.id == ds.setup.height_id && is.type == "height";
   EXPECT_TRUE(listed);
-}
-
-// SCRATCH (issue 11, the input recipe followed once): a new sample type read from airspeed.csv
-// reaches the node through the InputKind table alone (merge, order, dispatch).
-TEST(EstimatorNode, ScratchAirspeedInputIsMergedAndProcessed) {
-  synthetic::SyntheticOptions o;
-  o.duration_s = 8.0;
-  Dataset ds = synthetic::makeSyntheticDataset(o);
-  const std::string dir = ::testing::TempDir() + "/meshnav_scratch_airspeed";
-  std::filesystem::create_directories(dir);
-  {
-    std::ofstream f(dir + "/airspeed.csv");
-    f << "t,airspeed_m_s\n";
-    for (int i = 0; i < 40; ++i) f << 4.0 + 0.1 * i << "," << 1.0 + 0.01 * i << "\n";
-    f << "8.1,-3\n";  // implausible: skipped and counted by the reader
-  }
-  Diagnostics diag;
-  ds.airspeeds = readAirspeedCsv(dir + "/airspeed.csv", diag);
-  EXPECT_EQ(ds.airspeeds.size(), 40u);
-  EXPECT_EQ(diag.get("airspeed.csv:bad_value"), 1);
-  const auto inputs = mergeInTimeOrder(ds);
-  EXPECT_EQ(std::count_if(inputs.begin(), inputs.end(),
-                          [](const EstimatorInput& in) { return std::holds_alternative<AirspeedSample>(in); }),
-            40);
-  EstimatorNode node(test::testOptions(), ds.setup);
-  for (const auto& in : inputs) node.onInput(in);
-  ASSERT_TRUE(node.initialized());
-  EXPECT_EQ(node.diagnostics().get("airspeed"), 40);
 }
