@@ -12,6 +12,10 @@
 /// A plain string is left only where a name is really dynamic: the logger's raw regex, and the
 /// mission's --time-channels, which it matches against these constants.
 
+#include <array>
+#include <string_view>
+#include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include "common/messages.h"
@@ -44,10 +48,33 @@ inline constexpr Channel<MissionStatus> kMissionStatus{"MISSION_STATUS"};     //
 inline constexpr Channel<time_sync_t> kTimeSyncRequest{"TIME_SYNC_REQUEST"};  ///< time_sync_t, bridges → estimator (clock reference)
 inline constexpr Channel<time_sync_t> kTimeSync{"TIME_SYNC"};                 ///< time_sync_t, estimator → bridges (replies)
 
+/// Every channel constant above, once: the list kAll and `find` are made from.
+inline constexpr auto kTyped =
+    std::tuple{kImu,  kBaro,           kRange,     kFlightState, kGroundTruth,   kAnchorInit,      kPose,     kAnchors,
+               kEstimatorStatus, kEstimatorCmd, kCalibCmd, kCalibStatus, kMissionStatus, kHeight, kTimeSyncRequest,
+               kTimeSync};
+
 /// The name of every channel above, for tools that list or record them.
-inline constexpr const char* kAll[] = {
-    kImu.name,         kBaro.name,        kRange.name,          kFlightState.name, kGroundTruth.name, kAnchorInit.name,
-    kPose.name,        kAnchors.name,     kEstimatorStatus.name, kEstimatorCmd.name, kCalibCmd.name,  kCalibStatus.name,
-    kMissionStatus.name, kHeight.name,   kTimeSyncRequest.name, kTimeSync.name};
+inline constexpr auto kAll =
+    std::apply([](const auto&... c) { return std::array<const char*, sizeof...(c)>{c.name...}; }, kTyped);
+
+/// The channel constant of message type `Msg` named `name`, found at compile time (a Channel with
+/// a null name when there is none): the estimator process subscribes every input kind of
+/// estimator/node/estimator_input.h through it, from the kind's type and channel name.
+template <class Msg>
+consteval Channel<Msg> find(std::string_view name) {
+  Channel<Msg> found{nullptr};
+  std::apply(
+      [&](const auto&... c) {
+        (
+            [&] {
+              if constexpr (std::is_same_v<std::decay_t<decltype(c)>, Channel<Msg>>)
+                if (std::string_view(c.name) == name) found = c;
+            }(),
+            ...);
+      },
+      kTyped);
+  return found;
+}
 
 }  // namespace meshnav::channels

@@ -14,19 +14,35 @@
 ///   - `randomWalk(options)`       σ [unit/√s] of a random walk on every error state (Σ += σ² Δt I
 ///                                 per propagation; 0: constant),
 ///   - `keptCovariance(Σ, options)` its covariance when a recovery re-creates the filter around a
-///                                 new IMU state (keeps the mean; may widen Σ).
-/// A kind whose state is one number derives `kDim`, `kBody`, `Value`, `boxplus`, `boxminus` and
-/// `check` from ScalarStateKind (below). The strategies, NominalState and the node's recovery iterate over the
+///                                 new IMU state (keeps the mean; may widen Σ),
+///   - `restart(options)`          what a restart keeps of it (Restart below; docs/robustness.md
+///                                 "Restarts"),
+///   - `toVector(v)`, `peersOf(v)`, `fromVector(x, peers)`  its value as a list of numbers (and the
+///                                 peer ids of per-peer states) for the restart checkpoint
+///                                 (estimator/node/checkpoint.h); fromVector throws
+///                                 std::invalid_argument on a list that does not fit.
+/// A kind whose state is one number derives `kDim`, `kBody`, `Value`, `boxplus`, `boxminus`,
+/// `check` and the vector form from ScalarStateKind (below). The strategies, NominalState and the node's recovery iterate over the
 /// registry; none of them names a kind other than the IMU.
 
 #include <Eigen/Core>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "common/types.h"
 
 namespace meshnav::estimator {
+
+/// What a restart of the estimator process keeps of a kind's instances (K::restart(options)).
+enum class Restart {
+  kBody,         ///< the IMU: the pose across a short outage only (init.resume_max_outage_s)
+  kKept,         ///< value and marginal covariance, whatever the outage (Σ grown by the random walk)
+  kCalibration,  ///< kept as a calibration result and replayed through ANCHOR_INIT (the anchors:
+                 ///< the UWB network's side, calibrated flag and pair-bias dictionary, comes too)
+  kPrior,        ///< not kept: starts again from its prior
+};
 
 /// An ordered list of kinds (the order is the registry's: it fixes how a recovery re-adds them).
 template <class... K>
@@ -64,9 +80,17 @@ inline void requireBlockSize(const char* kind, SensorId id, const Eigen::MatrixX
                                 std::to_string(dim) + "x" + std::to_string(dim));
 }
 
+/// Throws std::invalid_argument unless a checkpoint's list of `n` numbers holds `expected` for a
+/// value of kind `kind`.
+inline void requireVectorSize(const char* kind, Eigen::Index n, Eigen::Index expected) {
+  if (n != expected)
+    throw std::invalid_argument(std::string(kind) + ": " + std::to_string(n) + " numbers, expected " +
+                                std::to_string(expected));
+}
+
 /// Base of a kind whose state is one number v = v̂ + δv (a bias, a scale factor): `kDim`, `kBody`,
-/// `Value`, `boxplus`, `boxminus` and `check`; the kind adds `kName`, `randomWalk` and
-/// `keptCovariance`.
+/// `Value`, `boxplus`, `boxminus`, `check` and the vector form [v]; the kind adds `kName`,
+/// `randomWalk`, `keptCovariance` and `restart`.
 template <class Kind>
 struct ScalarStateKind {
   static constexpr int kDim = 1;
@@ -76,6 +100,13 @@ struct ScalarStateKind {
   static Eigen::VectorXd boxminus(const Value& v, const Value& ref) { return Eigen::VectorXd::Constant(1, v - ref); }
   static void check(SensorId id, const Value&, const Eigen::MatrixXd& cov) {
     requireBlockSize(Kind::kName, id, cov, kDim);
+  }
+  static Eigen::VectorXd toVector(const Value& v) { return Eigen::VectorXd::Constant(1, v); }
+  static std::vector<SensorId> peersOf(const Value&) { return {}; }
+  static Value fromVector(const Eigen::VectorXd& x, const std::vector<SensorId>& peers) {
+    requireVectorSize(Kind::kName, x.size(), 1);
+    if (!peers.empty()) throw std::invalid_argument(std::string(Kind::kName) + ": has no peers");
+    return x(0);
   }
 };
 

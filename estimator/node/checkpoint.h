@@ -1,21 +1,25 @@
 #pragma once
 /// @file checkpoint.h
 /// @brief What an estimator needs to resume after a restart without re-initializing: the IMU
-/// state with its covariance, the barometer's reference and bias, and every estimated anchor with
-/// its pair biases (docs/robustness.md, "Restarts").
+/// state with its covariance, every instance a kind keeps across a restart (K::restart,
+/// estimator/core/kind_traits.h) and every estimated anchor with its pair biases
+/// (docs/robustness.md, "Restarts").
 ///
 /// A restarted estimator process reads the checkpoint its predecessor wrote (`--state-dir`) and,
 /// when the first IMU sample is at most `init.resume_max_age_s` newer, starts from it at once:
 /// the position moved by v·Δt and the covariance grown by the IMU-gap noise over Δt (velocity
 /// random walk `imu.gap_sigma_acc_m_s2`, position its integral; attitude by the gyro density).
-/// Cross-covariances between the IMU and the anchors are not kept (marginals only), as in a
-/// recovery; tag γ states start again from the setup's a-priori values.
+/// The kept instances (Restart::kKept: baro bias, height bias, tag γ) come back with their value
+/// and marginal covariance grown by their random walk over Δt, whatever the outage.
+/// Cross-covariances between instances are not kept (marginals only), as in a recovery.
 ///
-/// Files in the state folder (written atomically: a temporary file, then rename):
-///   estimator_state.yaml   t [s], p_IinG [m], v_IinG [m/s], q_ItoG [x, y, z, w],
-///                          bias_gyro_rad_s, bias_acc_m_s2, cov_imu (15×15 row-major, error state
-///                          δp, δv, δθ, δb_ω, δb_a), landed, baro_reference_pa (null: none),
-///                          baro_bias_m, baro_bias_var_m2
+/// Files in the state folder (written atomically: a temporary file, then rename; docs/formats.md):
+///   estimator_state.yaml   layout 2: `format: meshnav_estimator_state`, `version: 2`, t [s],
+///                          landed, baro_reference_pa (null: none), `instances`: a list of
+///                          {kind, id, peers (per-peer kinds only), value, cov}, the IMU first
+///                          (value: the kind's toVector, cov: its error-state covariance
+///                          row-major). A file without `version` (layout 1, before issue 11) is
+///                          refused naming the file.
 ///   estimator_anchors.yaml the calibration results format (common/anchor_init_io.h)
 
 #include <optional>
@@ -28,21 +32,37 @@
 
 namespace meshnav::estimator {
 
+/// One instance in a checkpoint, in its kind's vector form (K::toVector / K::fromVector).
+struct InstanceRecord {
+  std::string kind;             ///< K::kName
+  SensorId id = 0;
+  std::vector<SensorId> peers;  ///< the peers of per-peer states (anchor, tag); empty otherwise
+  Eigen::VectorXd value;        ///< K::toVector of the nominal value
+  Eigen::MatrixXd cov;          ///< marginal covariance of its error state
+};
+
+/// Throws std::invalid_argument unless `r` is a valid instance of a registered kind (its name, the
+/// value's length for its peers, a covariance that fits (K::check) and is positive definite).
+void checkInstanceRecord(const InstanceRecord& r);
+
 struct EstimatorCheckpoint {
-  Timestamp t;                    ///< the instant the state is valid at (data time)
+  static constexpr int kVersion = 2;  ///< the estimator_state.yaml layout written and read
+  Timestamp t;                        ///< the instant the state is valid at (data time)
+  SensorId imu_id = 1;
   ImuState imu;
   ImuMatrix cov_imu = ImuMatrix::Identity();
   bool landed = false;
   std::optional<double> baro_reference_pa;
-  double baro_bias_m = 0.0;
-  double baro_bias_var_m2 = 1.0;
-  std::vector<AnchorInit> anchors;  ///< estimated anchors: marginal covariance, pair biases
+  std::vector<InstanceRecord> instances;  ///< the kept instances of every other kind (Restart::kKept)
+  std::vector<AnchorInit> anchors;        ///< estimated anchors: marginal covariance, pair biases
+  /// The record of instance `id` of kind `kind`, or nullptr.
+  const InstanceRecord* find(const std::string& kind, SensorId id) const;
 };
 
 /// Writes the two files into `dir` (created). Throws std::runtime_error naming the file.
 void writeCheckpoint(const EstimatorCheckpoint& c, const std::string& dir);
 /// Reads them back; nullopt when `dir` holds no checkpoint. Throws std::runtime_error naming the
-/// file and key on a malformed or non-finite one.
+/// file and key on a malformed or non-finite one, or on a file of another layout version.
 std::optional<EstimatorCheckpoint> readCheckpoint(const std::string& dir);
 
 }  // namespace meshnav::estimator

@@ -7,8 +7,8 @@
 
 #include <cstdint>
 #include <iterator>
-#include <tuple>
 #include <type_traits>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -21,18 +21,45 @@ namespace meshnav::estimator {
 using EstimatorInput =
     std::variant<FlightStateSample, ImuSample, BaroSample, RangeSample, AnchorInit, EstimatorCommand, HeightSample>;
 
-/// The canonical order of the kinds at equal time (`rank`) and each kind's channel name (counter
-/// prefix: "RANGE:duplicate", "IMU:time_ahead"). An explicit table, not the variant's index: adding
-/// or moving an alternative of EstimatorInput changes no order (test_estimator_input.cpp).
+/// Ids of an input that order it among inputs of its kind at equal time (0: none).
+struct InputIds {
+  SensorId a = 0;
+  SensorId b = 0;
+};
+
+/// THE table of input kinds, one entry per alternative of EstimatorInput: its rank in the canonical
+/// order at equal time (`rank`), its channel name (`name`; counter prefix "RANGE:duplicate",
+/// "IMU:time_ahead"; the estimator process subscribes the channel constant of that name and type,
+/// transport/channels.h), and optionally `kDataset` (the Dataset member mergeInTimeOrder takes it
+/// from), `ids` (InputIds of a sample) and `kDatasetOnly` (no channel: not subscribed by the
+/// process, which the channels test checks otherwise). An explicit table, not the variant's index: adding or
+/// moving an alternative of EstimatorInput changes no order (test_estimator_input.cpp).
 template <class T>
 struct InputKind;
-template <> struct InputKind<FlightStateSample> { static constexpr int rank = 0; static constexpr const char* name = "FLIGHT_STATE"; };
-template <> struct InputKind<ImuSample> { static constexpr int rank = 1; static constexpr const char* name = "IMU"; };
-template <> struct InputKind<BaroSample> { static constexpr int rank = 2; static constexpr const char* name = "BARO"; };
-template <> struct InputKind<RangeSample> { static constexpr int rank = 3; static constexpr const char* name = "RANGE"; };
-template <> struct InputKind<AnchorInit> { static constexpr int rank = 4; static constexpr const char* name = "ANCHOR_INIT"; };
-template <> struct InputKind<EstimatorCommand> { static constexpr int rank = 5; static constexpr const char* name = "ESTIMATOR_CMD"; };
-template <> struct InputKind<HeightSample> { static constexpr int rank = 6; static constexpr const char* name = "HEIGHT"; };
+template <> struct InputKind<FlightStateSample> { static constexpr int rank = 0; static constexpr const char* name = "FLIGHT_STATE"; static constexpr auto kDataset = &Dataset::flight_states; };
+template <> struct InputKind<ImuSample> { static constexpr int rank = 1; static constexpr const char* name = "IMU"; static constexpr auto kDataset = &Dataset::imu; };
+template <> struct InputKind<BaroSample> { static constexpr int rank = 2; static constexpr const char* name = "BARO"; static constexpr auto kDataset = &Dataset::baro; };
+template <> struct InputKind<RangeSample> {
+  static constexpr int rank = 3; static constexpr const char* name = "RANGE"; static constexpr auto kDataset = &Dataset::ranges;
+  static InputIds ids(const RangeSample& r) { return {r.id_initiator, r.id_responder}; }
+};
+template <> struct InputKind<AnchorInit> {
+  static constexpr int rank = 4; static constexpr const char* name = "ANCHOR_INIT";
+  static InputIds ids(const AnchorInit& a) { return {a.id, 0}; }
+};
+template <> struct InputKind<EstimatorCommand> {
+  static constexpr int rank = 5; static constexpr const char* name = "ESTIMATOR_CMD";
+  static InputIds ids(const EstimatorCommand& c) { return {c.id, 0}; }
+};
+template <> struct InputKind<HeightSample> { static constexpr int rank = 6; static constexpr const char* name = "HEIGHT"; static constexpr auto kDataset = &Dataset::heights; };
+
+/// Calls `f.template operator()<T>()` for every input kind T, in the variant's order.
+template <class F>
+void forEachInputKind(F&& f) {
+  [&]<size_t... I>(std::index_sequence<I...>) {
+    (f.template operator()<std::variant_alternative_t<I, EstimatorInput>>(), ...);
+  }(std::make_index_sequence<std::variant_size_v<EstimatorInput>>{});
+}
 
 /// Sort key of an input (time, kind = InputKind rank, ids).
 struct InputOrder {
@@ -61,18 +88,21 @@ inline InputOrder inputOrder(const EstimatorInput& in) {
   InputOrder o;
   o.t_us = inputTime(in).us;
   o.kind = inputKindRank(in);
-  if (const auto* r = std::get_if<RangeSample>(&in)) {
-    o.a = r->id_initiator;
-    o.b = r->id_responder;
-  } else if (const auto* a = std::get_if<AnchorInit>(&in)) {
-    o.a = a->id;
-  } else if (const auto* c = std::get_if<EstimatorCommand>(&in)) {
-    o.a = c->id;
-  }
+  std::visit(
+      [&](const auto& m) {
+        using K = InputKind<std::decay_t<decltype(m)>>;
+        if constexpr (requires { K::ids(m); }) {
+          const InputIds ids = K::ids(m);
+          o.a = ids.a;
+          o.b = ids.b;
+        }
+      },
+      in);
   return o;
 }
 
-/// All samples of a dataset merged into the canonical order (stable for equal keys).
+/// All samples of a dataset (every input kind with a `kDataset`) merged into the canonical order
+/// (stable for equal keys: within one time, kind and ids, in the dataset's order).
 std::vector<EstimatorInput> mergeInTimeOrder(const Dataset& ds);
 
 }  // namespace meshnav::estimator

@@ -24,12 +24,10 @@ using node_internal::where;
 
 std::vector<EstimatorInput> mergeInTimeOrder(const Dataset& ds) {
   std::vector<EstimatorInput> all;
-  all.reserve(ds.imu.size() + ds.baro.size() + ds.ranges.size() + ds.flight_states.size() + ds.heights.size());
-  for (const auto& s : ds.flight_states) all.emplace_back(s);
-  for (const auto& s : ds.imu) all.emplace_back(s);
-  for (const auto& s : ds.baro) all.emplace_back(s);
-  for (const auto& s : ds.ranges) all.emplace_back(s);
-  for (const auto& s : ds.heights) all.emplace_back(s);
+  forEachInputKind([&]<class T>() {
+    if constexpr (requires { InputKind<T>::kDataset; })
+      for (const auto& s : ds.*InputKind<T>::kDataset) all.emplace_back(s);
+  });
   std::stable_sort(all.begin(), all.end(),
                    [](const EstimatorInput& a, const EstimatorInput& b) { return inputOrder(a) < inputOrder(b); });
   return all;

@@ -301,9 +301,14 @@ class EstimatorNode {
   std::unique_ptr<StaticInitializer> initializer_;
   std::vector<AnchorInit> pending_anchor_inits_;
   std::optional<EstimatorCheckpoint> resume_;  ///< resumeFrom, until the first IMU sample
-  std::optional<EstimatorCheckpoint> resume_baro_;  ///< its baro reference and bias, until initialized
+  /// Its baro reference and kept instances (Restart::kKept), until initialized.
+  std::optional<EstimatorCheckpoint> resume_kept_;
   /// Initializes from resume_ at IMU sample `s` when it is fresh enough; true if it did.
   bool tryResume(const ImuSample& s);
+  /// Adds the checkpoint's kept instances (Restart::kKept) to `f` at `t`, replacing their priors:
+  /// each with its value and marginal covariance grown by its kind's random walk over t − c.t; a
+  /// baro bias only when the reference pressure is the checkpoint's. Counted "resumed_instances".
+  void restoreKeptInstances(FusionStrategy& f, const EstimatorCheckpoint& c, Timestamp t);
   BaroModel baro_model_;
   HeightModel height_model_;
   /// setup `carried_height` in use: the height model reads the carried height (CarriedHeightOptions).

@@ -18,14 +18,19 @@ EstimatorCheckpoint EstimatorNode::checkpoint() const {
   const NominalState& x = f.state();
   EstimatorCheckpoint c;
   c.t = x.t;
+  c.imu_id = x.imu_id;
   c.imu = x.imu;
   c.cov_imu = f.covariance(x.imu_id, x.imu_id);
   c.landed = cur_.landed;
   c.baro_reference_pa = baro_reference_pa_;
-  if (auto it = x.values<BaroBiasKind>().find(setup_.baro_id); it != x.values<BaroBiasKind>().end()) {
-    c.baro_bias_m = it->second;
-    c.baro_bias_var_m2 = f.covariance(setup_.baro_id, setup_.baro_id)(0, 0);
-  }
+  // Every instance whose kind a restart keeps (K::restart), in registry order.
+  forEachKind([&]<class K>() {
+    if constexpr (!K::kBody) {
+      if (K::restart(options_) != Restart::kKept) return;
+      for (const auto& [id, value] : x.values<K>())
+        c.instances.push_back({K::kName, id, K::peersOf(value), K::toVector(value), f.covariance(id, id)});
+    }
+  });
   // Every device an anchor may have a pair bias with.
   std::vector<SensorId> devices;
   for (const auto& [id, p] : cur_.network->tags()) devices.push_back(id);
@@ -85,16 +90,17 @@ bool EstimatorNode::tryResume(const ImuSample& s) {
                                        std::to_string(options_.init.resume_max_age_s) + " s); initializing anew");
     return false;
   }
-  // Anchors (through the ANCHOR_INIT path once the filter exists) and the baro's reference and
-  // bias come back whatever the outage; the pose only across a short one.
-  const size_t n_anchors = c.anchors.size();
+  // Anchors (through the ANCHOR_INIT path once the filter exists), the baro reference and the
+  // kept instances (Restart::kKept) come back whatever the outage; the pose only across a short one.
+  const size_t n_anchors = c.anchors.size(), n_kept = c.instances.size();
   for (auto& a : c.anchors) pending_anchor_inits_.push_back(std::move(a));
-  if (c.baro_reference_pa) resume_baro_ = c;
+  c.anchors.clear();
+  resume_kept_ = c;
   diag_.count("resumed");
   if (dt > options_.init.resume_max_outage_s) {
-    spdlog::warn("estimator: restart {:.3f} s after the checkpoint of t={}: {} anchors and the baro reference kept, "
-                 "the pose is initialized anew (outage longer than {} s)",
-                 dt, formatSeconds(c.t), n_anchors, options_.init.resume_max_outage_s);
+    spdlog::warn("estimator: restart {:.3f} s after the checkpoint of t={}: {} anchors, {} other instances and the "
+                 "baro reference kept, the pose is initialized anew (outage longer than {} s)",
+                 dt, formatSeconds(c.t), n_anchors, n_kept, options_.init.resume_max_outage_s);
     return false;
   }
   // Across the outage: position moved with the velocity (Φ_pv = I·dt); what the body did meanwhile
@@ -113,15 +119,34 @@ bool EstimatorNode::tryResume(const ImuSample& s) {
   b.cov.block<3, 3>(ImuErr::kP, ImuErr::kP) += I3 * std::pow(0.5 * a * dt * dt, 2);
   b.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) += I3 * std::pow(w * dt, 2);
   b.from_checkpoint = true;
-  b.baro_reference_pa = c.baro_reference_pa;
-  b.baro_bias_m = c.baro_bias_m;
-  b.baro_bias_var_m2 = c.baro_bias_var_m2;
+  b.baro_reference_pa = c.baro_reference_pa;  // the baro bias comes with the kept instances
   b.last_imu = s;
   b.landed = c.landed;
-  spdlog::warn("estimator: resuming from the checkpoint of t={} ({:.3f} s before the first IMU sample), {} anchors",
-               formatSeconds(c.t), dt, n_anchors);
+  spdlog::warn("estimator: resuming from the checkpoint of t={} ({:.3f} s before the first IMU sample), {} anchors, "
+               "{} other instances",
+               formatSeconds(c.t), dt, n_anchors, n_kept);
   initialize(b);
   return true;
+}
+
+void EstimatorNode::restoreKeptInstances(FusionStrategy& f, const EstimatorCheckpoint& c, Timestamp t) {
+  const double dt = std::max(0.0, (t - c.t).sec());
+  int n = 0;
+  forEachKind([&]<class K>() {
+    if constexpr (!K::kBody) {
+      if (K::restart(options_) != Restart::kKept) return;
+      for (const InstanceRecord& r : c.instances) {
+        if (r.kind != K::kName) continue;
+        // A baro bias is relative to its reference pressure: not used against another one.
+        if (r.id == setup_.baro_id && baro_reference_pa_ != c.baro_reference_pa) continue;
+        Eigen::MatrixXd cov = r.cov;  // grown by the kind's random walk over the outage
+        cov.diagonal().array() += std::pow(K::randomWalk(options_), 2) * dt;
+        f.addInstance<K>(r.id, K::fromVector(r.value, r.peers), cov);
+        ++n;
+      }
+    }
+  });
+  if (n > 0) diag_.count("resumed_instances", n);
 }
 
 }  // namespace meshnav::estimator

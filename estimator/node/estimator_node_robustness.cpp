@@ -115,15 +115,14 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   if (options_.baro.enabled && b.baro_reference_pa) {
     baro_reference_pa_ = b.baro_reference_pa;
     filter->addInstance<BaroBiasKind>(setup_.baro_id, b.baro_bias_m, Eigen::MatrixXd::Constant(1, 1, b.baro_bias_var_m2));
-  } else if (options_.baro.enabled && resume_baro_) {  // a restart in flight: the predecessor's reference
-    baro_reference_pa_ = resume_baro_->baro_reference_pa;
-    filter->addInstance<BaroBiasKind>(setup_.baro_id, resume_baro_->baro_bias_m,
-                                      Eigen::MatrixXd::Constant(1, 1, resume_baro_->baro_bias_var_m2));
-  }
-  resume_baro_.reset();
+  } else if (options_.baro.enabled && resume_kept_ && resume_kept_->baro_reference_pa) {
+    baro_reference_pa_ = resume_kept_->baro_reference_pa;  // a restart in flight: the predecessor's
+  }                                                        // reference (its bias: a kept instance)
   pending_height_bias_ = b.height_bias;  // the height instance is added at the first usable height
   addSetupAnchorStates(*filter);
   addTagBiasStates(*filter);
+  if (resume_kept_) restoreKeptInstances(*filter, *resume_kept_, b.t);  // replace the priors
+  resume_kept_.reset();
   cur_.filter = std::move(filter);
   cur_.last_imu = b.last_imu;
   cur_.landed = b.landed;

@@ -66,13 +66,12 @@ class EstimatorProcess {
   /// Subscribes the inputs, serves the time reference and starts the ESTIMATOR_STATUS heartbeat.
   void connect() {
     estimator::EstimatorNode& node = node_;
-    lcm_.subscribe(channels::kImu, [&node](const ImuSample& s) { node.onImu(s); });
-    lcm_.subscribe(channels::kBaro, [&node](const BaroSample& s) { node.onBaro(s); });
-    lcm_.subscribe(channels::kHeight, [&node](const HeightSample& s) { node.onHeight(s); });
-    lcm_.subscribe(channels::kRange, [&node](const RangeSample& s) { node.onRange(s); });
-    lcm_.subscribe(channels::kFlightState, [&node](const FlightStateSample& s) { node.onFlightState(s); });
-    lcm_.subscribe(channels::kAnchorInit, [&node](const AnchorInit& a) { node.onAnchorInit(a); });
-    lcm_.subscribe(channels::kEstimatorCmd, [&node](const EstimatorCommand& c) { node.onCommand(c); });
+    // Every input kind (estimator/node/estimator_input.h) from the channel of its name and type;
+    // a kind without such a channel (a dataset-only input) is not subscribed.
+    estimator::forEachInputKind([&]<class T>() {
+      constexpr auto channel = channels::find<T>(estimator::InputKind<T>::name);
+      if constexpr (channel.name != nullptr) lcm_.subscribe(channel, [&node](const T& m) { node.onInput(m); });
+    });
     // This host's clock is the reference of every stamp the estimator fuses: bridges on other
     // hosts estimate their offset to it (transport/time_sync.h, docs/deployment.md).
     transport::serveTimeSync(lcm_);

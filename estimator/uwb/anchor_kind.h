@@ -46,6 +46,20 @@ struct AnchorKind {
   }
   static double randomWalk(const EstimatorOptions&) { return 0.0; }
   static Eigen::MatrixXd keptCovariance(const Eigen::MatrixXd& cov, const EstimatorOptions&) { return cov; }
+  /// A restart replays the anchors as calibration results (ANCHOR_INIT), which also restores the
+  /// UWB network's side of them (calibrated, pair biases that are not states).
+  static Restart restart(const EstimatorOptions&) { return Restart::kCalibration; }
+  /// [p_AinG, γ_1 … γ_n] towards `peers`.
+  static Eigen::VectorXd toVector(const Value& a) {
+    Eigen::VectorXd x(3 + a.biases.gamma_m.size());
+    x << a.p_AinG, a.biases.gamma_m;
+    return x;
+  }
+  static std::vector<SensorId> peersOf(const Value& a) { return a.biases.peers; }
+  static Value fromVector(const Eigen::VectorXd& x, const std::vector<SensorId>& peers) {
+    requireVectorSize(kName, x.size(), 3 + static_cast<Eigen::Index>(peers.size()));
+    return AnchorState{x.head<3>(), BiasState{peers, x.tail(x.size() - 3)}};
+  }
 };
 
 }  // namespace meshnav::estimator

@@ -32,6 +32,17 @@ struct TagBiasKind {
   static Eigen::MatrixXd keptCovariance(const Eigen::MatrixXd& cov, const EstimatorOptions&) {
     return cov.diagonal().asDiagonal().toDenseMatrix();
   }
+  /// A restart keeps the estimated γ and their covariance (constant biases: what was learnt holds).
+  static Restart restart(const EstimatorOptions& o) {
+    return o.uwb.estimate_tag_biases ? Restart::kKept : Restart::kPrior;
+  }
+  /// [γ_1 … γ_n] towards `peers`.
+  static Eigen::VectorXd toVector(const Value& g) { return g.gamma_m; }
+  static std::vector<SensorId> peersOf(const Value& g) { return g.peers; }
+  static Value fromVector(const Eigen::VectorXd& x, const std::vector<SensorId>& peers) {
+    requireVectorSize(kName, x.size(), static_cast<Eigen::Index>(peers.size()));
+    return BiasState{peers, x};
+  }
 };
 
 }  // namespace meshnav::estimator

@@ -12,8 +12,9 @@
 
 namespace meshnav::estimator::test {
 
-/// Largest relative difference of the nominal states (|Δ| / (1 + |x|)) and of the marginal
-/// covariances Σ_ii of every instance with state (max|ΔΣ_ii| / max|Σ_ii|). Layouts must match.
+/// Largest relative difference of the nominal states (|Δ| / (1 + |x|), Δ = x ⊟ y per instance of
+/// every registered kind) and of the marginal covariances Σ_ii of every instance with state
+/// (max|ΔΣ_ii| / max|Σ_ii|). Layouts must match.
 inline double relativeDifference(const FusionStrategy& a, const FusionStrategy& b) {
   const NominalState &x = a.state(), &y = b.state();
   if (x.t != y.t || a.layout().blocks().size() != b.layout().blocks().size()) return 1e300;
@@ -27,17 +28,23 @@ inline double relativeDifference(const FusionStrategy& a, const FusionStrategy& 
     rel(dimu(ImuErr::kBg + i), y.imu.bias_gyro_rad_s(i));
     rel(dimu(ImuErr::kBa + i), y.imu.bias_acc_m_s2(i));
   }
-  for (const auto& [id, v] : x.values<BaroBiasKind>()) rel(v - y.values<BaroBiasKind>().at(id), v);
-  for (const auto& [id, a] : x.values<AnchorKind>()) {
-    const AnchorState& b = y.values<AnchorKind>().at(id);
-    for (int i = 0; i < 3; ++i) rel(a.p_AinG(i) - b.p_AinG(i), a.p_AinG(i));
-    if (a.biases.peers.size() != b.biases.peers.size()) return 1e300;
-    for (int i = 0; i < a.biases.gamma_m.size(); ++i)
-      rel(a.biases.gamma_m(i) - b.biases.gamma_m(i), a.biases.gamma_m(i));
-  }
-  for (const auto& [id, g] : x.values<TagBiasKind>())
-    for (int i = 0; i < g.gamma_m.size(); ++i)
-      rel(g.gamma_m(i) - y.values<TagBiasKind>().at(id).gamma_m(i), g.gamma_m(i));
+  // Every other registered kind: its ⊟ against its value's vector form (the same size as its
+  // error state for every kind but the body).
+  bool mismatch = false;
+  forEachKind([&]<class K>() {
+    if constexpr (!K::kBody) {
+      for (const auto& [id, v] : x.values<K>()) {
+        const auto it = y.values<K>().find(id);
+        if (it == y.values<K>().end() || K::peersOf(v) != K::peersOf(it->second)) {
+          mismatch = true;
+          continue;
+        }
+        const Eigen::VectorXd dv = K::boxminus(v, it->second), mag = K::toVector(v);
+        for (Eigen::Index i = 0; i < dv.size(); ++i) rel(dv(i), mag(i));
+      }
+    }
+  });
+  if (mismatch) return 1e300;
   for (const StateBlock& blk : a.layout().blocks()) {
     if (!b.layout().find(blk.id)) return 1e300;
     const Eigen::MatrixXd Pa = a.covariance(blk.id, blk.id), Pb = b.covariance(blk.id, blk.id);

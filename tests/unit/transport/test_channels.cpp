@@ -9,6 +9,7 @@
 #include <string>
 #include <type_traits>
 
+#include "estimator/node/estimator_input.h"
 #include "transport/channels.h"
 #include "transport/input_journal.h"
 #include "transport/lcm_node.h"
@@ -54,6 +55,27 @@ static_assert(!CanSubscribeExplicit<ImuSample, const char*>);
 static_assert(!CanSubscribeExplicit<ImuSample, std::string>);
 static_assert(!CanPublish<ImuSample, std::string>);
 static_assert(!std::is_convertible_v<Baro, Imu>);
+
+// channels::find: the constant of a type and a name, at compile time; none for a wrong type.
+static_assert(std::string_view(channels::find<HeightSample>("HEIGHT").name) == channels::kHeight.name);
+static_assert(channels::find<ImuSample>("BARO").name == nullptr);
+static_assert(channels::find<ImuSample>("NO_SUCH").name == nullptr);
+
+// Every input kind of the estimator (estimator/node/estimator_input.h) has a channel of its name
+// and type, unless its table entry says `kDatasetOnly`: the estimator process subscribes it from
+// that table.
+TEST(Channels, EveryEstimatorInputKindHasItsChannel) {
+  int n = 0;
+  estimator::forEachInputKind([&]<class T>() {
+    using K = estimator::InputKind<T>;
+    if constexpr (requires { K::kDatasetOnly; }) return;
+    constexpr auto c = channels::find<T>(K::name);
+    EXPECT_NE(c.name, nullptr) << K::name;
+    if (c.name) EXPECT_STREQ(c.name, K::name);
+    ++n;
+  });
+  EXPECT_GE(n, 7);
+}
 
 TEST(Channels, NamesAreDistinctAndUpperSnake) {
   std::set<std::string> names;
