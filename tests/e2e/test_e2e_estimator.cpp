@@ -2,6 +2,7 @@
 /// compare estimate.csv with the ground truth: seed 1 with the known anchors 101–104 only, and
 /// seed 10 with 106–110 given as known-but-uncertain (σ 0.3 m) and refined online.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -29,7 +30,9 @@ struct PoseMetrics {
 /// Simulates `seed` (extra meshnav_sim args), runs meshnav_run (extra args) and compares
 /// estimate.csv with the ground truth at every ground-truth sample.
 PoseMetrics runSequence(const std::string& name, int seed, const std::string& sim_args, const std::string& run_args) {
-  const fs::path dir = fs::path(::testing::TempDir()) / ("meshnav_e2e_estimator_" + name);
+  // The process id keeps two checkouts' test runs on one machine out of each other's folders.
+  const fs::path dir =
+      fs::path(::testing::TempDir()) / ("meshnav_e2e_estimator_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path data = dir / "data", out = dir / "run";
@@ -73,6 +76,7 @@ PoseMetrics runSequence(const std::string& name, int seed, const std::string& si
   m.anees_p = nees / m.n;
   std::cout << name << ", seed " << seed << ": position RMSE " << m.rmse_p_m << " m, orientation RMSE " << m.rmse_q_deg
             << " deg, position ANEES " << m.anees_p << " (" << m.n << " samples)" << std::endl;
+  if (!::testing::Test::HasFailure()) fs::remove_all(dir);  // kept on failure, to look at
   return m;
 }
 
