@@ -38,9 +38,8 @@ void declareOptions(Cli& cli, RunOptions& o) {
   cli.optional("out", o.out, "output folder (created): estimate.csv, anchors.csv, timings.csv, status.txt")
       ->type_name("DIR");
   cli.optional("strategy", o.strategy,
-               "fusion strategy: centralized (dense EKF), dp (modular, centralized-equivalent), dah (modular, updates "
-               "only the involved instances); default: the config's")
-      ->check(cli::oneOf(strategyImplemented, "centralized|dp|dah"));
+               "fusion strategy: " + strategySummaries() + "; default: the config's")
+      ->check(cli::oneOf(strategyImplemented, strategyNames()));
   cli.optional("config", o.config, "estimator options YAML (default: built-in defaults = config/estimator.yaml)")
       ->type_name("FILE");
   auto* mission = cli.optional("mission", o.mission,

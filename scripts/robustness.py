@@ -306,7 +306,7 @@ def parse_args(argv):
     p.add_argument("--scenarios", help="YAML file with a fixed list of scenarios (instead of --runs)")
     p.add_argument("--jobs", type=int, default=2, help="runs in parallel (default 2)")
     p.add_argument("--out", default=os.path.join(ROOT, "out", "robustness"), help="output folder (default out/robustness)")
-    p.add_argument("--strategy", choices=["centralized", "dp", "dah"], help="meshnav_run --strategy (default: its own)")
+    p.add_argument("--strategy", help="meshnav_run --strategy, checked by meshnav_run (default: its own)")
     p.add_argument("--config", help="estimator options YAML for meshnav_run --config (default: its built-in defaults)")
     p.add_argument("--duration", type=float, default=90.0, help="sequence length of drawn scenarios [s] (default 90)")
     p.add_argument("--bin", default=os.path.join(os.environ.get("MESHNAV_BUILD_DIR", os.path.join(ROOT, "build")), "bin"),
@@ -361,6 +361,12 @@ def main(argv):
     for b in ("meshnav_sim", "meshnav_run", "meshnav_eval"):
         if not os.access(os.path.join(a.bin, b), os.X_OK):
             print("robustness: %s is missing (build first: ./meshnav build)" % os.path.join(a.bin, b), file=sys.stderr)
+            return 2
+    if a.strategy:  # meshnav_run knows the strategies this build has; ask it once, not 200 times
+        probe = subprocess.run([os.path.join(a.bin, "meshnav_run"), "--strategy", a.strategy, "--print-config"],
+                               capture_output=True, text=True)
+        if probe.returncode != 0:
+            print("robustness: %s" % (probe.stderr.strip().splitlines() or ["bad --strategy"])[0], file=sys.stderr)
             return 2
     os.makedirs(a.out, exist_ok=True)
     print("robustness: %d scenarios, %d in parallel, results in %s" % (len(scenarios), a.jobs, a.out), flush=True)

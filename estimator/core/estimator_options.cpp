@@ -1,4 +1,5 @@
 #include "estimator/core/estimator_options.h"
+#include "estimator/core/strategy_list.h"
 
 #include "common/yaml_options.h"
 
@@ -14,7 +15,8 @@ namespace {
 /// forEachField, part: the top-level options and the IMU.
 template <typename Opt, typename Visitor>
 void forEachGeneralField(Opt& o, Visitor& v) {
-  v("strategy", o.strategy, "centralized | dp | dah");
+  static const std::string strategy_names = strategyNames(" | ");
+  v("strategy", o.strategy, strategy_names.c_str());
   v("gravity_m_s2", o.gravity_m_s2, "|g| [m/s^2]");
   v("window_s", o.window_s, "out-of-sequence window [s]");
   v("pose_output_rate_hz", o.pose_output_rate_hz, "POSE rate, 0 = every IMU step [Hz]");
@@ -245,7 +247,7 @@ void EstimatorOptions::validate() const {
   auto need = [](bool ok, const std::string& what) {
     if (!ok) throw std::invalid_argument("invalid option: " + what);
   };
-  need(strategy == "centralized" || strategy == "dp" || strategy == "dah", "strategy must be centralized, dp or dah");
+  need(strategyListed(strategy), "strategy must be one of " + strategyNames(", "));
   need(gravity_m_s2 > 0.0, "gravity_m_s2 > 0");
   need(uwb.dah_joint_anchors == "none" || uwb.dah_joint_anchors == "batch" || uwb.dah_joint_anchors == "all",
        "uwb.dah_joint_anchors must be none, batch or all");

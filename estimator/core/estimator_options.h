@@ -236,7 +236,7 @@ struct RefineOptions {
 };
 
 struct EstimatorOptions {
-  std::string strategy = "centralized";  ///< centralized | dp | dah
+  std::string strategy = "centralized";  ///< a name of kStrategyList (estimator/core/strategy_list.h)
   double gravity_m_s2 = 9.81;            ///< |g|, gravity is −g along z of G [m/s²]
   double window_s = 1.0;                 ///< out-of-sequence window [s]
   double pose_output_rate_hz = 0.0;      ///< POSE rate; 0: every IMU step [Hz]

@@ -2,12 +2,13 @@
 
 #include <stdexcept>
 
+#include "estimator/core/strategy_list.h"
 #include "estimator/filter/centralized_ekf.h"
 #include "estimator/filter/modular_filter.h"
 
 namespace meshnav::estimator {
 
-bool strategyImplemented(const std::string& name) { return name == "centralized" || name == "dp" || name == "dah"; }
+bool strategyImplemented(const std::string& name) { return strategyListed(name); }
 
 std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& o, double gravity_z_sign) {
   if (o.strategy == "centralized")

@@ -5,11 +5,12 @@
 #include <memory>
 
 #include "estimator/core/estimator_options.h"
+#include "estimator/core/strategy_list.h"
 #include "estimator/filter/fusion_strategy.h"
 
 namespace meshnav::estimator {
 
-/// True for strategies this build implements ("centralized", "dp", "dah").
+/// True for strategies this build implements (estimator/core/strategy_list.h).
 bool strategyImplemented(const std::string& name);
 /// Throws std::invalid_argument for unknown strategies. `gravity_z_sign`: see ImuPropagator.
 std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& options, double gravity_z_sign = -1.0);

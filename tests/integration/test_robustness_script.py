@@ -100,6 +100,19 @@ class UsageTest(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d:
             self.assertEqual(robustness.main(["--runs", "1", "--bin", d, "--out", d]), 2)
 
+    def test_a_strategy_meshnav_run_does_not_have_is_refused_before_any_run(self):
+        # The strategies are meshnav_run's (estimator/core/strategy_list.h): a stand-in binary that
+        # refuses every --strategy, as meshnav_run does for an unknown name, stops the sweep at once.
+        with tempfile.TemporaryDirectory() as d:
+            for b in ("meshnav_sim", "meshnav_run", "meshnav_eval"):
+                path = os.path.join(d, b)
+                with open(path, "w") as f:
+                    f.write("#!/bin/sh\necho \"$0: --strategy: 'ukf' is not one of centralized|dp|dah\" >&2\nexit 2\n")
+                os.chmod(path, 0o755)
+            out = os.path.join(d, "out")
+            self.assertEqual(robustness.main(["--runs", "1", "--bin", d, "--out", out, "--strategy", "ukf"]), 2)
+            self.assertFalse(os.path.exists(out))
+
 
 class RefusalTest(unittest.TestCase):
     """A run that never initialized is REFUSED with the estimator's reason, not a divergence."""
