@@ -29,6 +29,7 @@
 
 #include <random>
 
+#include "estimator/core/strategy_list.h"
 #include "estimator/filter/dense_ekf_update.h"
 #include "estimator/filter/factorized_covariance.h"
 #include "estimator/filter/joint_set_bound.h"
@@ -46,7 +47,13 @@ using namespace meshnav::estimator;
 namespace {
 
 constexpr int kAnchorCounts[] = {5, 10, 20, 50, 100};
-const char* kStrategies[] = {"centralized", "dp", "dah"};
+/// Every strategy of the build (estimator/core/strategy_list.h); the names are literals, so
+/// null-terminated.
+std::vector<const char*> listedStrategies() {
+  std::vector<const char*> names;
+  for (const auto& entry : kStrategyList) names.push_back(entry.name.data());
+  return names;
+}
 constexpr int kRestoreEvery = 1000;
 
 /// The warm-up flight as a stream of inputs (synthetic trajectory, exact readings + small range noise).
@@ -371,7 +378,7 @@ void Sequence(benchmark::State& state, std::string strategy) {
 #endif
 
 void registerAll() {
-  for (const char* s : kStrategies)
+  for (const char* s : listedStrategies())
     for (int n : kAnchorCounts) {
       const std::string tail = std::string(s) + "/" + std::to_string(n);
       benchmark::RegisterBenchmark(("Propagate/" + tail).c_str(), Propagate, s, n);
@@ -391,11 +398,11 @@ void registerAll() {
   for (int n : kAnchorCounts)
     benchmark::RegisterBenchmark(("RangeUpdateJointSetBounded/dah/" + std::to_string(n)).c_str(), Update, "dah", n,
                                  false, false, 0, EstimatorOptions{}.uwb.dah_joint_max_anchors);
-  for (const char* s : kStrategies)
+  for (const char* s : listedStrategies())
     for (int N : {2, 5, 10, 20})
       benchmark::RegisterBenchmark(("Micro/" + std::string(s) + "/" + std::to_string(N)).c_str(), Micro, s, N);
 #ifdef MESHNAV_BENCH_WITH_SIM
-  for (const char* s : kStrategies)
+  for (const char* s : listedStrategies())
     benchmark::RegisterBenchmark(("Sequence/" + std::string(s)).c_str(), Sequence, s)->Unit(benchmark::kMillisecond);
 #endif
 }
