@@ -21,7 +21,6 @@ inline constexpr std::array kStrategyList{
     StrategyListEntry{"centralized", "dense EKF"},
     StrategyListEntry{"dp", "modular, centralized-equivalent"},
     StrategyListEntry{"dah", "modular, updates only the involved instances"},
-    StrategyListEntry{"scratch", "SCRATCH: centralized under another name"},
 };
 
 /// True for a name in kStrategyList.

@@ -14,7 +14,7 @@
 
 namespace meshnav::estimator {
 
-class CentralizedEkf : public FusionStrategy {
+class CentralizedEkf final : public FusionStrategy {
  public:
   /// `random_walks`: σ of each kind's random walk (KindRandomWalks::fromOptions).
   CentralizedEkf(const ImuPropagator& propagator, const KindRandomWalks& random_walks, bool joseph_form);

@@ -5,7 +5,6 @@
 #include "estimator/core/strategy_list.h"
 #include "estimator/filter/centralized_ekf.h"
 #include "estimator/filter/modular_filter.h"
-#include "estimator/filter/scratch_ekf.h"
 
 namespace meshnav::estimator {
 
@@ -19,9 +18,6 @@ std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& o, double g
     return std::make_unique<ModularFilter>(o.strategy == "dp" ? ModularFilter::Mode::DP : ModularFilter::Mode::DAH,
                                            ImuPropagator(o.gravity_m_s2, o.imu, gravity_z_sign),
                                            KindRandomWalks::fromOptions(o), o.joseph_form);
-  if (o.strategy == "scratch")
-    return std::make_unique<ScratchEkf>(ImuPropagator(o.gravity_m_s2, o.imu, gravity_z_sign),
-                                        KindRandomWalks::fromOptions(o), o.joseph_form);
   throw std::invalid_argument("unknown strategy '" + o.strategy + "'");
 }
 
