@@ -19,6 +19,7 @@ if [[ "${MESHNAV_LCM_NETNS_INSIDE:-}" == 1 ]]; then
     exit 1
   fi
   export LCM_DEFAULT_URL="udpm://239.255.76.67:7667?ttl=0"
+  echo "lcm_netns.sh: running in a private network namespace ($LCM_DEFAULT_URL)" >&2
   exec "$@"
 fi
 if [[ "${MESHNAV_NO_NETNS:-}" != 1 ]]; then

@@ -24,11 +24,6 @@ if [[ -z "${MESHNAV_PIPELINE_INSIDE:-}" ]]; then
   export MESHNAV_PIPELINE_INSIDE=1
   exec bash "$(dirname "$0")/../../scripts/lcm_netns.sh" bash "$0" "$@"
 fi
-if [[ "$LCM_DEFAULT_URL" == "udpm://239.255.76.67:7667?ttl=0" ]]; then
-  echo "running in a private network namespace"
-else
-  echo "NOTE: network namespaces are not permitted here: falling back to $LCM_DEFAULT_URL on the host loopback"
-fi
 
 rm -rf "$WORK"
 mkdir -p "$WORK"
