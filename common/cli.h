@@ -79,7 +79,7 @@ namespace cli {
 CLI::Validator finite();       ///< a finite number
 CLI::Validator nonNegative();  ///< a finite number >= 0
 CLI::Validator positive();     ///< a finite number > 0
-/// A name accepted by `accepts` (e.g. estimator::strategyImplemented); `names` lists them for --help.
+/// A name accepted by `accepts` (e.g. estimator::strategyListed); `names` lists them for --help.
 CLI::Validator oneOf(std::function<bool(const std::string&)> accepts, const std::string& names);
 }  // namespace cli
 

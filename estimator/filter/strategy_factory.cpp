@@ -8,8 +8,6 @@
 
 namespace meshnav::estimator {
 
-bool strategyImplemented(const std::string& name) { return strategyListed(name); }
-
 std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& o, double gravity_z_sign) {
   if (o.strategy == "centralized")
     return std::make_unique<CentralizedEkf>(ImuPropagator(o.gravity_m_s2, o.imu, gravity_z_sign),

@@ -10,8 +10,6 @@
 
 namespace meshnav::estimator {
 
-/// True for strategies this build implements (estimator/core/strategy_list.h).
-bool strategyImplemented(const std::string& name);
 /// Throws std::invalid_argument for unknown strategies. `gravity_z_sign`: see ImuPropagator.
 std::unique_ptr<FusionStrategy> makeStrategy(const EstimatorOptions& options, double gravity_z_sign = -1.0);
 

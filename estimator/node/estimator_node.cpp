@@ -108,8 +108,6 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
   options_.validate();
   carried_height_ = carriedHeightUsed(options_, setup_);
   baro_aligns_ = baroAligns(options_, setup_);
-  if (!strategyImplemented(options_.strategy))
-    throw std::invalid_argument("strategy '" + options_.strategy + "' is not implemented yet (next issue)");
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
   skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
   rerun_enabled_ = options_.refine.rerun_on_anchor_join && (options_.strategy != "dah" || options_.refine.rerun_with_dah);

@@ -32,7 +32,7 @@ void declareOptions(Cli& cli, EstimatorProcessOptions& o) {
   cli.optional("config", o.config_path, "estimator options YAML (default: built-in = config/estimator.yaml)")
       ->type_name("FILE");
   cli.optional("strategy", o.strategy, "override the fusion strategy of --config: " + estimator::strategySummaries())
-      ->check(cli::oneOf(estimator::strategyImplemented, estimator::strategyNames()));
+      ->check(cli::oneOf(estimator::strategyListed, estimator::strategyNames()));
   cli.option("heartbeat", o.heartbeat_s, "wall seconds between heartbeat statuses")->type_name("S")->check(cli::positive());
   cli.flag("print-config", o.print_config, "print the estimator options and exit");
   cli.optional("state-dir", o.state_dir, "folder of the restart checkpoint: written while running, resumed from at start")

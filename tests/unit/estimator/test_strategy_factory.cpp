@@ -15,7 +15,7 @@ TEST(StrategyFactory, EveryListedStrategyIsBuiltUnderItsName) {
     EstimatorOptions o;
     o.strategy = std::string(entry.name);
     EXPECT_NO_THROW(o.validate()) << entry.name;
-    EXPECT_TRUE(strategyImplemented(o.strategy));
+    EXPECT_TRUE(strategyListed(o.strategy));
     const auto s = makeStrategy(o);
     ASSERT_NE(s, nullptr) << entry.name;
     EXPECT_EQ(s->name(), entry.name);
@@ -26,7 +26,7 @@ TEST(StrategyFactory, EveryListedStrategyIsBuiltUnderItsName) {
 TEST(StrategyFactory, UnlistedNamesAreRefusedEverywhere) {
   EstimatorOptions o;
   o.strategy = "ukf";
-  EXPECT_FALSE(strategyImplemented(o.strategy));
+  EXPECT_FALSE(strategyListed(o.strategy));
   try {
     o.validate();
     FAIL() << "an unlisted strategy passed validation";
