@@ -55,6 +55,8 @@ void forEachInitField(Opt& o, Visitor& v) {
   v("init.motion_min_ranges", o.init.motion_min_ranges, "in-motion alignment ranges needed [-]");
   v("init.motion_max_sigma_yaw_deg", o.init.motion_max_sigma_yaw_deg, "in-motion alignment refused above [deg]");
   v("init.motion_max_sigma_p_m", o.init.motion_max_sigma_p_m, "in-motion alignment refused above [m]");
+  v("init.motion_relinearize_rad", o.init.motion_relinearize_rad,
+    "in-motion alignment: re-integrate at the fitted gyro bias when it turns the attitude more than this over the window, 0 = never [rad]");
   v("init.motion_use_baro", o.init.motion_use_baro,
     "baro heights (setup reference pressure given) constrain the in-motion alignment's height");
   v("init.resume_max_age_s", o.init.resume_max_age_s, "a restart resumes from a checkpoint at most this old [s]");
@@ -268,6 +270,7 @@ void EstimatorOptions::validate() const {
            init.motion_max_sigma_p_m > 0 && init.resume_max_age_s >= 0 && init.resume_max_acc_m_s2 >= 0 &&
            init.resume_max_rate_deg_s >= 0 && init.resume_max_outage_s >= 0,
        "init.motion_* (window >= min span > 0, min_ranges >= 8, sigmas > 0)");
+  need(init.motion_relinearize_rad >= 0 && init.motion_relinearize_rad < M_PI, "init.motion_relinearize_rad in [0, pi)");
   need(health.window_s > 0 && health.min_ranges >= 1 && health.min_anchors >= 1 &&
            health.degraded_gated_fraction > 0 && health.degraded_gated_fraction <= health.lost_gated_fraction &&
            health.lost_gated_fraction <= 1 && health.degraded_mean_nis > 0 && health.degraded_no_aiding_s > 0 &&

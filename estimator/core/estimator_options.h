@@ -60,6 +60,9 @@ struct InitOptions {
   /// σ_yaw 15–24° left the filter heading errors of 25–60° it did not pull back (docs/robustness.md)
   double motion_max_sigma_yaw_deg = 15.0;
   double motion_max_sigma_p_m = 0.5;       ///< in-motion alignment: refuse above [m]
+  /// In-motion alignment: integrate the window again at the fitted gyro bias when its correction
+  /// turns the attitude by more than this over the window; 0 = never [rad]
+  double motion_relinearize_rad = 0.02;
   /// Baro heights against the setup's reference pressure as the in-motion alignment's vertical
   /// constraint (not with a carried height): nearly coplanar anchors then cannot mirror the height.
   bool motion_use_baro = true;

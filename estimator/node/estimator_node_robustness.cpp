@@ -211,7 +211,9 @@ bool EstimatorNode::landedAt(Timestamp t) const {
 void EstimatorNode::tryMotionInitialization(Timestamp t) {
   if (last_align_try_ && (t - *last_align_try_).sec() < 0.5) return;
   last_align_try_ = t;
+  const int relinearized_before = aligner_.relinearizations();
   const auto r = aligner_.solve(Eigen::Vector3d::Zero());
+  if (aligner_.relinearizations() > relinearized_before) diag_.count("init_motion_relinearized");
   if (!r) {
     diag_.count("init_motion_refused");
     return;

@@ -111,6 +111,7 @@ void MotionAligner::clear() {
   imu_.clear();
   ranges_.clear();
   heights_.clear();
+  last_fit_.reset();
 }
 
 double MotionAligner::spanSeconds() const { return imu_.size() < 2 ? 0.0 : (imu_.back().t - windowStart()).sec(); }

@@ -32,6 +32,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/types.h"
@@ -75,6 +76,11 @@ struct MotionAlignerOptions {
   int yaw_starts = 12;               ///< yaw grid of the multi-start [-]
   double sigma_bias_gyro_rad_s = 0.005;  ///< σ of the gyro bias in the result [rad/s]
   double max_imu_gap_s = 0.1;        ///< increments cannot span a longer IMU gap: the window restarts [s]
+  /// The increments are integrated with a gyro bias b̄ and corrected to first order in δb_ω. When
+  /// the best fit's |δb_ω| × window exceeds this rotation, they are integrated again at b̄ + δb_ω
+  /// and fitted anew (at most `max_relinearizations` times); 0 = never [rad]
+  double relinearize_rad = 0.02;
+  int max_relinearizations = 3;      ///< passes of re-integration per solve [-]
   Eigen::Vector3d p_IH = Eigen::Vector3d::Zero();  ///< rangefinder in the IMU frame [m]
   bool height_tilt_correction = true;  ///< h = s_z / cos(tilt) (else s_z)
   double sigma_bias_height_m = 0.3;   ///< prior σ of the rangefinder's bias around 0 [m]
@@ -127,6 +133,8 @@ class MotionAligner {
   std::optional<GravityCheck> checkGravityDirection(const Eigen::Vector3d& bias_gyro_rad_s);
   /// From now on `solve` fits gravity along +z of G (true) or −z (false, the default).
   void setGravityAlongPlusZ(bool plus_z) { gravity_z_sign_ = assumed_gravity_z_sign_ = plus_z ? 1.0 : -1.0; }
+  /// How often `solve` integrated the increments again at a corrected gyro bias (all calls).
+  int relinearizations() const { return relinearizations_; }
   /// Why the last `solve` refused.
   const std::string& reason() const { return reason_; }
   /// Data span currently held [s].
@@ -168,6 +176,24 @@ class MotionAligner {
     bool use = true;
   };
   using Info = Eigen::Matrix<double, 16, 16>;
+  /// A start of the multi-start after its fit.
+  struct Candidate {
+    Unknowns x;
+    double cost;
+    ImuState end;
+  };
+  /// The window's observations, integrated at the gyro bias `b_lin`, and the fitted starts (best first).
+  struct Window {
+    std::vector<Obs> obs;
+    std::vector<HeightObs> heights;
+    Increments end;
+    Eigen::Vector3d b_lin = Eigen::Vector3d::Zero();
+    std::vector<Candidate> cands;
+  };
+  /// Builds the observations and fits every start, integrating again at the best fit's gyro bias
+  /// while its correction turns the attitude by more than `relinearize_rad`; false (see `reason_`)
+  /// with too few ranges or no converged fit.
+  bool fitStarts(const Eigen::Vector3d& bias_gyro_rad_s, Window* w);
   std::vector<Obs> buildObservations(const Eigen::Vector3d& bias_gyro, Increments* end,
                                      std::vector<HeightObs>* heights) const;
   /// Levenberg–Marquardt with Huber weights; returns the cost (Huber terms and bias priors).
@@ -195,6 +221,13 @@ class MotionAligner {
 
   MotionAlignerOptions options_;
   double gravity_z_sign_ = -1.0, assumed_gravity_z_sign_ = -1.0;
+  /// Prior mean of δb_ω in `fit`: the caller's gyro bias minus the one the increments were
+  /// integrated with (nonzero after a re-integration) [rad/s]
+  Eigen::Vector3d dbg_prior_mean_ = Eigen::Vector3d::Zero();
+  int relinearizations_ = 0;  ///< re-integrations over this aligner's life
+  /// The caller's gyro bias (the prior's centre) and the bias the best fit of the last solve found
+  /// about it; the next solve with the same prior integrates at the latter [rad/s]
+  std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> last_fit_;
   std::map<SensorId, Eigen::Vector3d> tags_p_TinI_;
   std::deque<ImuSample> imu_;
   std::deque<AlignRange> ranges_;

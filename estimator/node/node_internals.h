@@ -29,6 +29,7 @@ inline MotionAlignerOptions alignerOptions(const EstimatorOptions& o, const Eige
   a.min_ranges = o.init.motion_min_ranges;
   a.max_sigma_yaw_deg = o.init.motion_max_sigma_yaw_deg;
   a.max_sigma_p_m = o.init.motion_max_sigma_p_m;
+  a.relinearize_rad = o.init.motion_relinearize_rad;
   a.sigma_bias_acc_m_s2 = o.init.sigma_bias_acc_m_s2;
   a.sigma_bias_gyro_rad_s = o.init.sigma_bias_gyro_rad_s;
   a.outlier_m = o.init.range_init_outlier_m;
