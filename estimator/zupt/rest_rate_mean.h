@@ -8,7 +8,7 @@
 /// so a 0.1 s ZUPT interval of a 200 Hz IMU measures b_ω √20 times better than its latest reading
 /// alone. Using one reading (σ_ω √rate) with a fixed σ left most of the landed phase's gyro-bias
 /// information unused; the yaw then drifts at the remaining gyro z-bias error in flight, where
-/// the heading is only weakly observable (docs/results.md, "Yaw on seed 8").
+/// the heading is only weakly observable (docs/results.md, "Yaw on seeds 8 and 11").
 /// An interval longer than `max_dt_s` (an IMU gap) counts as `max_dt_s`: held readings carry no
 /// new information.
 
