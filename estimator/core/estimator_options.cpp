@@ -129,7 +129,7 @@ void forEachRestAndHealthField(Opt& o, Visitor& v) {
   v("zupt.enabled", o.zupt.enabled, "");
   v("zupt.rate_hz", o.zupt.rate_hz, "pseudo-measurement rate while landed [Hz]");
   v("zupt.sigma_acc_m_s2", o.zupt.sigma_acc_m_s2, "sigma of a = 0 [m/s^2]");
-  v("zupt.sigma_gyro_rad_s", o.zupt.sigma_gyro_rad_s, "sigma of omega = 0 [rad/s]");
+  v("zupt.sigma_gyro_rad_s", o.zupt.sigma_gyro_rad_s, "rest rotation allowed while landed; the omega row fuses the mean gyro since the last ZUPT with sigma^2 = this^2 + gyro_noise_density^2/T [rad/s]");
   v("zupt.sigma_vel_m_s", o.zupt.sigma_vel_m_s, "sigma of v = 0 [m/s]");
   v("zupt.detect_stillness", o.zupt.detect_stillness, "without FLIGHT_STATE: ZUPT while the IMU shows rest");
   v("zupt.stillness_gate_probability", o.zupt.stillness_gate_probability, "chi^2 gate of those ZUPTs [-]");

@@ -183,7 +183,10 @@ struct ZuptOptions {
   bool enabled = true;
   double rate_hz = 10.0;                 ///< pseudo-measurement rate while landed [Hz]
   double sigma_acc_m_s2 = 0.2;           ///< σ of a = 0 [m/s²]
-  double sigma_gyro_rad_s = 0.01;        ///< σ of ω = 0 [rad/s]
+  /// σ of ω = 0 beyond the gyro noise: the rotation a body the flight state calls landed may still
+  /// have [rad/s]. The ω row fuses the mean reading since the last ZUPT with
+  /// σ² = sigma_gyro_rad_s² + σ_ω²/T (RestRateMean), σ_ω the gyro noise density, T the interval.
+  double sigma_gyro_rad_s = 0.001;
   double sigma_vel_m_s = 0.02;           ///< σ of v = 0 [m/s]
   /// Without FLIGHT_STATE: zero-velocity updates while the IMU itself shows rest (StillnessDetector).
   /// An IMU cannot tell rest from constant velocity, so these updates are χ²-gated against the

@@ -71,6 +71,7 @@
 #include "estimator/imu/process_noise_adapter.h"
 #include "estimator/node/motion_aligner.h"
 #include "estimator/node/static_initializer.h"
+#include "estimator/zupt/rest_rate_mean.h"
 #include "estimator/zupt/stillness_detector.h"
 #include "estimator/node/step_timings.h"
 #include "estimator/uwb/reentry_check.h"
@@ -154,6 +155,7 @@ class EstimatorNode {
     std::optional<ImuSample> last_imu;
     bool landed = true;
     Timestamp last_zupt;
+    RestRateMean rest_rate;  ///< gyro readings since last_zupt while landed (the ZUPT's ω row)
     Timestamp last_carried_height;  ///< last carried-height pseudo-reading (IMU time)
     ProcessNoiseAdapter noise_adapter;  ///< IMU noise scale from the range innovations
     Snapshot copy() const;

@@ -127,6 +127,7 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   cur_.last_imu = b.last_imu;
   cur_.landed = b.landed;
   cur_.last_zupt = b.t;
+  cur_.rest_rate.reset();
   init_time_ = b.t;
   health_.reset(b.t);
   newest_ = newest_ ? std::max(*newest_, b.t) : b.t;
@@ -414,6 +415,7 @@ void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp 
   cur_.filter = std::move(f);
   cur_.last_imu = last_imu;
   cur_.last_zupt = t;
+  cur_.rest_rate.reset();
   history_.clear();  // a rewind must not restore the state before the re-initialization
   clearRerunHistory();  // nor a re-run (it starts from the new pose, with the anchors it has)
   reentry_ = ReentryHold{};  // held ranges were in the history; the new pose comes from ranges

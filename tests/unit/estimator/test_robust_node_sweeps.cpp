@@ -57,7 +57,11 @@ TEST(RobustNode, StillnessZuptsLetASmoothHoverDrift) {
     return res;
   };
   const EstimatorOptions defaults;
-  EXPECT_GT(runWith(defaults.zupt.sigma_vel_m_s, defaults.zupt.sigma_gyro_rad_s).max_error_after_m, 0.5);
+  // The flight-state σ of the incident: v 0.02 m/s, ω 0.01 rad/s. Since the ω row fuses the mean
+  // reading, zupt.sigma_gyro_rad_s is a rest allowance (default 0.001 rad/s); with it this hover's
+  // tight ZUPTs happen to be χ²-gated nearly all (330) and the run ends 0.26 m off, with 0.003 rad/s
+  // 4.4 m off: the flight-state velocity σ on a drifting body stays wrong either way.
+  EXPECT_GT(runWith(defaults.zupt.sigma_vel_m_s, 0.01).max_error_after_m, 0.5);
   EXPECT_LT(runWith(defaults.zupt.stillness_sigma_vel_m_s, defaults.zupt.stillness_sigma_gyro_rad_s).max_error_after_m,
             0.3);
 }
