@@ -211,10 +211,10 @@ bool MotionAligner::fitStarts(const Eigen::Vector3d& bias_gyro_rad_s, Window* w)
   // for sparse ranges (MILUV, one range per 1.2 s) it let ifo002 start 27 s earlier from a right
   // pose that the filter could not hold with those ranges; the long lost stretch after it drifted
   // 166 m (ATE 3.3 → 54 m). Off there until a lost filter's drift is bounded (docs/robustness.md).
-  const bool dense = spanSeconds() <= options_.window_s + 1e-6;
+  const bool relinearize = options_.relinearize_rad > 0.0 && spanSeconds() <= options_.window_s + 1e-6;
   // Windows 0.5 s apart share most of their data: start at the gyro bias the previous solve
   // fitted about the same prior, so that repeated solves (while refused) rarely need a second pass.
-  w->b_lin = dense && last_fit_ && last_fit_->first == bias_gyro_rad_s ? last_fit_->second : bias_gyro_rad_s;
+  w->b_lin = relinearize && last_fit_ && last_fit_->first == bias_gyro_rad_s ? last_fit_->second : bias_gyro_rad_s;
   for (int pass = 0;; ++pass) {
     dbg_prior_mean_ = bias_gyro_rad_s - w->b_lin;
     w->obs = buildObservations(w->b_lin, &w->end, &w->heights);
@@ -237,9 +237,9 @@ bool MotionAligner::fitStarts(const Eigen::Vector3d& bias_gyro_rad_s, Window* w)
       return false;
     }
     std::sort(w->cands.begin(), w->cands.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
-    if (dense) last_fit_ = std::make_pair(bias_gyro_rad_s, Eigen::Vector3d(w->b_lin + w->cands.front().x.dbg));
+    if (relinearize) last_fit_ = std::make_pair(bias_gyro_rad_s, Eigen::Vector3d(w->b_lin + w->cands.front().x.dbg));
     const double turned_rad = w->cands.front().x.dbg.norm() * w->end.tau_s;
-    if (!dense || options_.relinearize_rad <= 0.0 || turned_rad <= options_.relinearize_rad ||
+    if (!relinearize || turned_rad <= options_.relinearize_rad ||
         pass >= options_.max_relinearizations)
       return true;
     w->b_lin += w->cands.front().x.dbg;
