@@ -5,10 +5,13 @@
 // merge, forget removed members and are snapshot with the filter; DP ignores them; the node puts
 // anchors added together into one set with the tags' γ, the IMU and its baro bias. An update whose
 // stack holds every partner of a member leaves that member no pending factor; the bound
-// (boundJointSetAnchors, uwb.dah_joint_max_anchors) lets the most refined anchors leave.
+// (boundJointSetAnchors, uwb.dah_joint_max_anchors) lets the most refined anchors leave. Every DAH
+// update (scalar and vector, with and without sets, members open or closed) follows DAH's rule on
+// the dense covariance.
 #include <gtest/gtest.h>
 
 #include "estimator/filter/centralized_ekf.h"
+#include "estimator/filter/dense_ekf_update.h"
 #include "estimator/filter/joint_set_bound.h"
 #include "estimator/filter/modular_filter.h"
 #include "estimator/node/estimator_node.h"
@@ -106,7 +109,81 @@ bool flyWithAnchorBatch(EstimatorNode& node, const Dataset& ds, const std::vecto
   return sent;
 }
 
+/// DAH's rule on the dense covariance `S` (docs/modular_estimator.md, "Strategies"): the exact
+/// EKF update (Joseph form) of the participants P (the named instances and their joint sets),
+/// Σ_ik' = Σ_ii' Σ_ii⁻¹ Σ_ik for i ∈ P and k ∉ P, every other block unchanged.
+Eigen::MatrixXd denseDahUpdate(const Eigen::MatrixXd& S, const FactorizedCovariance& cov, const Linearization& lin) {
+  std::vector<SensorId> P;
+  for (const JacobianBlock& jb : lin.blocks) {
+    P.push_back(jb.id);
+    for (SensorId m : cov.jointSet(jb.id)) P.push_back(m);
+  }
+  StateLayout sub;
+  std::vector<int> idx;
+  for (const StateBlock& b : cov.layout().blocks()) {
+    if (std::find(P.begin(), P.end(), b.id) == P.end()) continue;
+    sub.add(b.id, b.kind, b.dim);
+    for (int r = 0; r < b.dim; ++r) idx.push_back(b.offset + r);
+  }
+  Eigen::MatrixXd Spp = S(idx, idx);
+  EXPECT_TRUE(denseEkfUpdate(Spp, sub, lin, 0.0, true).accepted);
+  Eigen::MatrixXd out = S;
+  out(idx, idx) = Spp;
+  for (const StateBlock& i : cov.layout().blocks()) {
+    if (!sub.find(i.id)) continue;
+    const StateBlock& is = sub.at(i.id);
+    const Eigen::MatrixXd M = Spp.block(is.offset, is.offset, i.dim, i.dim) *
+                              S.block(i.offset, i.offset, i.dim, i.dim).inverse();
+    for (const StateBlock& k : cov.layout().blocks()) {
+      if (sub.find(k.id)) continue;
+      out.block(i.offset, k.offset, i.dim, k.dim) = M * S.block(i.offset, k.offset, i.dim, k.dim);
+      out.block(k.offset, i.offset, k.dim, i.dim) = out.block(i.offset, k.offset, i.dim, k.dim).transpose();
+    }
+  }
+  return out;
+}
+
+/// A ZUPT-like vector update of the IMU's velocity (3 rows).
+Linearization imuVelocityZero(const NominalState& x) {
+  Linearization lin;
+  lin.residual = -x.imu.v_IinG;
+  lin.R = Eigen::Matrix3d::Identity() * 1e-4;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(3, ImuErr::kDim);
+  H.middleCols<3>(ImuErr::kV).setIdentity();
+  lin.blocks.push_back({1, H});
+  return lin;
+}
+
 }  // namespace
+
+TEST(DahJointSets, EveryUpdateFollowsDahsRuleOnTheDenseCovariance) {
+  // 108 stays outside the set {IMU, 106, 107}: once it is correlated, the members' updates without
+  // it are open (DAH's correction folded into L_i, pair factors relative to L_i'⁻¹), a range to 108
+  // stacks everything (closed members). Checked after every step against the dense rule.
+  for (const bool with_set : {true, false}) {
+    ModularFilter f(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}, true);
+    setUp(f);
+    if (with_set) f.joinJointSet({1, 106, 107});
+    const Eigen::Vector3d acc(0.05, 0.0, 9.81), gyro(0.0, 0.01, 0.02), p_true(0.5, -0.2, 1.5);
+    int open_updates = 0;
+    for (int k = 1; k <= 40; ++k) {
+      f.propagate(acc, gyro, Timestamp::fromSec(0.02 * k));
+      std::vector<Linearization> updates;
+      const SensorId a = 106 + k % 3;
+      updates.push_back(test::imuAnchorRange(f.state(), a, (kTruth.at(a) - p_true).norm() + 0.01));
+      if (k % 4 == 0) updates.push_back(test::anchorPairRange(f.state(), 106 + k % 2, 108, 3.0));
+      if (k % 7 == 0) updates.push_back(imuVelocityZero(f.state()));
+      for (const Linearization& lin : updates) {
+        const Eigen::MatrixXd expected = denseDahUpdate(f.fullCovariance(), f.instances(), lin);
+        ASSERT_TRUE(f.update(lin, 0.0).accepted);
+        EXPECT_LT(maxRelative(f.fullCovariance(), expected), 1e-9) << "step " << k << ", set " << with_set;
+        open_updates += f.instances().belief(1).L.size() > 0 && with_set;
+      }
+    }
+    if (with_set) EXPECT_GT(open_updates, 10) << "the IMU must have been an open member";
+    f.checkInvariants();
+  }
+}
 
 TEST(DahJointSets, AnchorSetWithTagRangesEqualsCentralized) {
   const auto ref = centralizedFlight(false);
