@@ -397,8 +397,11 @@ class DahUpdate {
   void setPairFactors() {
     PerPart<std::shared_ptr<const MatrixXd>> inv_shared{};
     if constexpr (!kFixed) inv_shared.resize(static_cast<size_t>(np_));
+    SensorId smallest = part(0).id;
+    for (int a = 1; a < np_; ++a) smallest = std::min(smallest, part(a).id);
     for (int a = 0; a < np_; ++a) {
-      if (!has_inv_[static_cast<size_t>(a)]) continue;
+      // The smallest id is the larger one of no pair: its L⁻¹ is not stored.
+      if (!has_inv_[static_cast<size_t>(a)] || part(a).id == smallest) continue;
       inv_shared[static_cast<size_t>(a)] = shared(MatrixXd(Linv_[static_cast<size_t>(a)]));
       fc_.mut(part(a).k).L_inv = inv_shared[static_cast<size_t>(a)];
     }
@@ -430,8 +433,6 @@ class DahUpdate {
   int np_ = 0;  ///< participants
   int n_ = 0;   ///< stacked dimension
   Mat P_;       ///< Σ_PP, updated in place
-  /// A strip of Σ_PP times a pending factor (rows: one participant's dimension).
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kFixed ? kMaxInstanceDim : Eigen::Dynamic, MaxN> tmp_;
   Vec U_, Kv_;  ///< scalar update: Σ_PP hᵀ and the gain
   double s_ = 0.0;
   bool invertible_ = false;
