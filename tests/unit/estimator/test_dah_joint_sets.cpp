@@ -29,14 +29,15 @@ ImuPropagator propagator() { return ImuPropagator(9.81, ImuNoiseOptions{}); }
 const std::map<SensorId, Eigen::Vector3d> kTruth = {
     {106, {-1.7, 0.9, 3.2}}, {107, {-2.0, 1.8, 1.7}}, {108, {2.6, -0.2, 0.2}}};
 
-/// IMU and anchors 106–108, each 0.1–0.2 m off its truth with a matching prior (uncorrelated).
+/// IMU (id `imu_id`) and anchors 106–108, each 0.1–0.2 m off its truth with a matching prior
+/// (uncorrelated).
 template <typename F>
-void setUp(F& f) {
+void setUp(F& f, SensorId imu_id = 1) {
   ImuState x;
   x.p_IinG = {0.5, -0.2, 1.5};
   ImuMatrix P = ImuMatrix::Identity() * 0.01;
   P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) *= 0.1;
-  f.reset(1, x, P, Timestamp{});
+  f.reset(imu_id, x, P, Timestamp{});
   int k = 0;
   for (const auto& [id, p] : kTruth) {
     const Eigen::Vector3d off(0.1 + 0.05 * k, -0.1, 0.08);
@@ -150,7 +151,7 @@ Linearization imuVelocityZero(const NominalState& x) {
   lin.R = Eigen::Matrix3d::Identity() * 1e-4;
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(3, ImuErr::kDim);
   H.middleCols<3>(ImuErr::kV).setIdentity();
-  lin.blocks.push_back({1, H});
+  lin.blocks.push_back({x.imu_id, H});
   return lin;
 }
 
@@ -159,15 +160,28 @@ Linearization imuVelocityZero(const NominalState& x) {
 TEST(DahJointSets, EveryUpdateFollowsDahsRuleOnTheDenseCovariance) {
   // 108 stays outside the set {IMU, 106, 107}: once it is correlated, the members' updates without
   // it are open (DAH's correction folded into L_i, pair factors relative to L_i'⁻¹), a range to 108
-  // stacks everything (closed members). Checked after every step against the dense rule.
-  for (const bool with_set : {true, false}) {
+  // stacks everything (closed members). Checked after every step against the dense rule. The IMU
+  // as id 300 is the larger id of its pairs: its S̄ is its L⁻¹ (remembered as L_inv, read as the
+  // identity), which every propagation must invalidate.
+  for (const auto& [with_set, imu] : std::vector<std::pair<bool, SensorId>>{{true, 1}, {false, 1}, {true, 300}, {false, 300}}) {
     ModularFilter f(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}, true);
-    setUp(f);
-    if (with_set) f.joinJointSet({1, 106, 107});
+    setUp(f, imu);
+    if (with_set) f.joinJointSet({imu, 106, 107});
+    int identity_reads = 0;  // factors that are their instance's remembered L⁻¹, summed over the updates
     const Eigen::Vector3d acc(0.05, 0.0, 9.81), gyro(0.0, 0.01, 0.02), p_true(0.5, -0.2, 1.5);
     int open_updates = 0;
     for (int k = 1; k <= 40; ++k) {
+      // Propagation: Σ ← T Σ Tᵀ + Q on the IMU's rows and columns (T = Φ there, I elsewhere).
+      ImuState x = f.state().imu;
+      ImuMatrix Phi, Q;
+      propagator().propagate(x, acc, gyro, 0.02, &Phi, &Q);
+      const StateBlock& ib = f.instances().layout().at(imu);
+      Eigen::MatrixXd T = Eigen::MatrixXd::Identity(f.layout().dim(), f.layout().dim());
+      T.block(ib.offset, ib.offset, ib.dim, ib.dim) = Phi;
+      Eigen::MatrixXd propagated = T * f.fullCovariance() * T.transpose();
+      propagated.block(ib.offset, ib.offset, ib.dim, ib.dim) += Q;
       f.propagate(acc, gyro, Timestamp::fromSec(0.02 * k));
+      EXPECT_LT(maxRelative(f.fullCovariance(), propagated), 1e-9) << "propagation " << k << ", IMU " << imu;
       std::vector<Linearization> updates;
       const SensorId a = 106 + k % 3;
       updates.push_back(test::imuAnchorRange(f.state(), a, (kTruth.at(a) - p_true).norm() + 0.01));
@@ -176,11 +190,16 @@ TEST(DahJointSets, EveryUpdateFollowsDahsRuleOnTheDenseCovariance) {
       for (const Linearization& lin : updates) {
         const Eigen::MatrixXd expected = denseDahUpdate(f.fullCovariance(), f.instances(), lin);
         ASSERT_TRUE(f.update(lin, 0.0).accepted);
-        EXPECT_LT(maxRelative(f.fullCovariance(), expected), 1e-9) << "step " << k << ", set " << with_set;
-        open_updates += f.instances().belief(1).L.size() > 0 && with_set;
+        EXPECT_LT(maxRelative(f.fullCovariance(), expected), 1e-9) << "step " << k << ", set " << with_set << ", IMU " << imu;
+        open_updates += f.instances().belief(imu).L.size() > 0 && with_set;
+        for (const StateBlock& b : f.instances().layout().blocks()) {
+          const InstanceBelief& belief = f.instances().belief(b.id);
+          for (const FactorEntry& e : belief.factors->entries()) identity_reads += belief.L_inv && e.S_bar == belief.L_inv;
+        }
       }
     }
     if (with_set) EXPECT_GT(open_updates, 10) << "the IMU must have been an open member";
+    EXPECT_GT(identity_reads, 10);
     f.checkInvariants();
   }
 }
