@@ -1,7 +1,6 @@
 /// @file factorized_covariance.cpp
 /// @brief FactorizedCovariance, first part: instances, propagation, the general update with the DP
-/// and DAH write-backs, and the invariant check. The DAH scalar fast path is in
-/// factorized_covariance_dah_scalar.cpp.
+/// write-back, and the invariant check. The DAH update is in factorized_covariance_dah.cpp.
 
 #include "estimator/filter/factorized_covariance.h"
 
@@ -28,15 +27,19 @@ using factorized_internal::shared;
 /// The true factor S_ij = L_i S̄_ij (null S̄: identity; empty L: identity).
 MatrixXd trueFactor(const InstanceBelief& b, const FactorEntry& e) {
   if (!e.S_bar) return b.L.size() ? b.L : MatrixXd::Identity(b.dim, b.dim);
+  if (e.S_bar == b.L_inv) return MatrixXd::Identity(b.dim, b.dim);
   return b.L.size() ? MatrixXd(b.L * *e.S_bar) : *e.S_bar;
 }
 
 /// The true factor S = L_i S̄ of one side of a pair into `out` (dimensions ≤ kMaxInstanceDim;
-/// a fixed-size kernel for the IMU's factor towards a 3-state anchor); false when it is the identity.
+/// fixed-size kernels for the IMU's and an anchor's factor towards an anchor); false when it is the
+/// identity (S̄ null and L_i empty, or S̄ the L_i⁻¹ of the current L_i).
 bool trueFactorInto(const InstanceBelief& b, const FactorEntry& e, factorized_internal::InstMat& out) {
   if (!e.S_bar) {
     if (!b.L.size()) return false;
     out = b.L;
+  } else if (e.S_bar == b.L_inv) {
+    return false;
   } else if (!b.L.size()) {
     out = *e.S_bar;
   } else if (b.dim == ImuErr::kDim && e.S_bar->cols() == 3) {
@@ -46,20 +49,14 @@ bool trueFactorInto(const InstanceBelief& b, const FactorEntry& e, factorized_in
     out.resize(ImuErr::kDim, 3);
     Eigen::Map<M15x3>(out.data()).noalias() =
         Eigen::Map<const M15>(b.L.data()).lazyProduct(Eigen::Map<const M15x3>(e.S_bar->data()));
+  } else if (b.dim == 3 && e.S_bar->cols() == 3) {
+    out.resize(3, 3);
+    Eigen::Map<Eigen::Matrix3d>(out.data()).noalias() =
+        Eigen::Map<const Eigen::Matrix3d>(b.L.data()).lazyProduct(Eigen::Map<const Eigen::Matrix3d>(e.S_bar->data()));
   } else {
     out.noalias() = b.L * *e.S_bar;
   }
   return true;
-}
-
-/// True when every partner of `b` is among `sorted_ids` (a closed participant: no pair of it
-/// with an instance outside the update). O(min(#partners, |ids|) log |ids|).
-bool partnersWithin(const InstanceBelief& b, const std::vector<SensorId>& sorted_ids) {
-  const auto& entries = b.factors->entries();
-  if (entries.size() >= sorted_ids.size()) return false;  // partners are other instances than b
-  return std::all_of(entries.begin(), entries.end(), [&](const FactorEntry& e) {
-    return std::binary_search(sorted_ids.begin(), sorted_ids.end(), e.partner);
-  });
 }
 
 }  // namespace
@@ -133,6 +130,7 @@ void FactorizedCovariance::propagate(SensorId id, const Eigen::Ref<const MatrixX
     b.Sigma = 0.5 * (b.Sigma + b.Sigma.transpose()).eval();
     b.L = b.L.size() ? MatrixXd(Phi * b.L) : MatrixXd(Phi);
   }
+  b.L_inv.reset();
   b.t = t;
   if (++b.lazy_steps > kMaxLazySteps) renormalize(id);
 }
@@ -148,6 +146,7 @@ void FactorizedCovariance::renormalize(SensorId id) {
   if (b.L.size() == 0) return;
   for (FactorEntry& e : mutDict(b).entries()) e.S_bar = shared(trueFactor(b, e));
   b.L.resize(0, 0);
+  b.L_inv.reset();
   b.lazy_steps = 0;
   ++renormalizations_;
 }
@@ -186,6 +185,7 @@ void FactorizedCovariance::pairCovInto(int ki, int kj, Eigen::Ref<MatrixXd> out)
   MatrixXd scratch_i, scratch_j;
   auto factor = [](const InstanceBelief& b, const FactorEntry& e, MatrixXd& scratch) -> const MatrixXd* {
     if (!e.S_bar) return b.L.size() ? &b.L : nullptr;
+    if (e.S_bar == b.L_inv) return nullptr;
     if (!b.L.size()) return e.S_bar.get();
     scratch.noalias() = b.L * *e.S_bar;
     return &scratch;
@@ -226,16 +226,10 @@ MatrixXd FactorizedCovariance::full() const {
 }
 
 FactorizedCovariance::Result FactorizedCovariance::update(const Linearization& lin, double nis_gate, Timestamp t) {
-  // Participants (indices into the layout, in layout order).
+  if (mode_ == Mode::DAH) return updateDah(lin, nis_gate, t);
+  // DP: every instance takes part.
   std::vector<int> part;
-  if (mode_ == Mode::DP) {
-    for (int k = 0; k < static_cast<int>(inst_.size()); ++k) part.push_back(k);
-  } else {
-    // A member of a joint set takes the general path with its whole set (the fast path stacks ≤ 4).
-    Result res;
-    if (!namesJointSet(lin) && updateDahScalar(lin, nis_gate, t, &res)) return res;
-    part = dahParticipants(lin);
-  }
+  for (int k = 0; k < static_cast<int>(inst_.size()); ++k) part.push_back(k);
   StateLayout sub;
   for (int k : part) {
     const StateBlock& b = layout_.blocks()[static_cast<size_t>(k)];
@@ -256,10 +250,7 @@ FactorizedCovariance::Result FactorizedCovariance::update(const Linearization& l
   Result res;
   res.nis = out.nis;
   if (!out.accepted) return res;
-  if (mode_ == Mode::DP)
-    writeBackDp(part, sub, P, t);
-  else
-    writeBackDah(part, sub, P, out.K, out.S, lin, t);
+  writeBackDp(part, sub, P, t);
   res.accepted = true;
   res.blocks = sub.blocks();
   res.dx = std::move(out.dx);
@@ -288,6 +279,7 @@ void FactorizedCovariance::writeBackDp(const std::vector<int>& part, const State
     InstanceBelief& b = mut(part[a]);
     b.Sigma = P.block(sb[a].offset, sb[a].offset, sb[a].dim, sb[a].dim);
     b.L.resize(0, 0);
+    b.L_inv.reset();
     b.lazy_steps = 0;
     b.t = t;
     std::sort(dicts[a].begin(), dicts[a].end(),
@@ -295,79 +287,6 @@ void FactorizedCovariance::writeBackDp(const std::vector<int>& part, const State
     auto d = std::make_shared<FactorDictionary>();
     d->entries() = std::move(dicts[a]);
     b.factors = std::move(d);
-  }
-}
-
-void FactorizedCovariance::writeBackDah(const std::vector<int>& part, const StateLayout& sub, const MatrixXd& P,
-                                        const MatrixXd& K, const MatrixXd& S, const Linearization& lin, Timestamp t) {
-  const auto& sb = sub.blocks();
-  const size_t np = part.size();
-  std::vector<SensorId> ids;  // the participants' ids, sorted
-  if (np > 1) {
-    ids.reserve(np);
-    for (const StateBlock& b : sb) ids.push_back(b.id);
-    std::sort(ids.begin(), ids.end());
-  }
-  // 1. Σ_ii' and the correction of the pairs with non-participants, folded into L_i.
-  for (size_t a = 0; a < np; ++a) {
-    const auto Sigma_new = P.block(sb[a].offset, sb[a].offset, sb[a].dim, sb[a].dim);
-    if (np > 1 && partnersWithin(*inst_[static_cast<size_t>(part[a])], ids)) {
-      // Every correlation of i is a pair within P, written exactly in step 3: no pair is left
-      // for the DAH correction, so L_i restarts as the identity (a DP write-back for i).
-      InstanceBelief& b = mut(part[a]);
-      b.Sigma = Sigma_new;
-      b.L.resize(0, 0);
-      b.lazy_steps = 0;
-      b.t = t;
-      continue;
-    }
-    InstanceBelief& b = mut(part[a]);
-    if (np > 1 && S.size() == 1) {
-      // Scalar: Σ_ii' Σ_ii⁻¹ = I − u wᵀ / s with u = K_i s (rank-one form, as the fast path).
-      const double s = S(0, 0);
-      if (std::abs(s) > std::numeric_limits<double>::min())
-        factorized_internal::foldScalarCorrection(b, K.block(sb[a].offset, 0, sb[a].dim, 1) * s, s);
-    } else {
-      MatrixXd M;
-      if (np == 1) {
-        // Private update: Σ_ik' = (I − K H_i) Σ_ik exactly.
-        M = MatrixXd::Identity(sb[a].dim, sb[a].dim) - K * lin.find(sb[a].id)->H;
-      } else {
-        // DAH: Σ_ik' ≈ Σ_ii' Σ_ii⁻¹ Σ_ik = (Σ_ii⁻¹ Σ_ii')ᵀ Σ_ik.
-        M = b.Sigma.ldlt().solve(Sigma_new).transpose();
-      }
-      b.L = b.L.size() ? MatrixXd(M * b.L) : M;
-    }
-    b.Sigma = Sigma_new;
-    b.t = t;
-    ++b.lazy_steps;
-  }
-  if (np == 1) {
-    if (inst_[static_cast<size_t>(part[0])]->lazy_steps > kMaxLazySteps) renormalize(sb[0].id);
-    return;
-  }
-  // 2. L_i'⁻¹ of the participants (re-normalize when L_i' is badly conditioned or old).
-  std::vector<MatrixXd> Linv(np);
-  std::vector<std::shared_ptr<const MatrixXd>> Linv_shared(np);  // S̄_ji of the larger id: one per member
-  for (size_t a = 0; a < np; ++a) {
-    const InstanceBelief& b = *inst_[static_cast<size_t>(part[a])];
-    if (b.L.size() == 0) continue;
-    if (factorized_internal::invertPendingFactor(b, Linv[a])) {
-      Linv_shared[a] = shared(Linv[a]);
-    } else {
-      renormalize(sb[a].id);
-      Linv[a].resize(0, 0);
-    }
-  }
-  // 3. Pair factors within P: smaller id S̄_ij = L_i'⁻¹ Σ_ij', larger id S̄_ji = L_j'⁻¹ (S_ji = I).
-  for (size_t a = 0; a < np; ++a) {
-    for (size_t c = a + 1; c < np; ++c) {
-      const bool a_small = sb[a].id < sb[c].id;
-      const size_t s = a_small ? a : c, l = a_small ? c : a;
-      const MatrixXd C = P.block(sb[s].offset, sb[l].offset, sb[s].dim, sb[l].dim);
-      mutDict(mut(part[s])).set(sb[l].id, shared(Linv[s].size() ? MatrixXd(Linv[s] * C) : C));
-      mutDict(mut(part[l])).set(sb[s].id, Linv_shared[l]);
-    }
   }
 }
 

@@ -99,15 +99,12 @@ class FactorizedCovariance {
   /// unless both sides have a pending factor and a stored S̄.
   void pairCovInto(int ki, int kj, Eigen::Ref<Eigen::MatrixXd> out) const;
   void writeBackDp(const std::vector<int>& part, const StateLayout& sub, const Eigen::MatrixXd& P, Timestamp t);
-  /// `S`: the innovation covariance (a scalar update folds the DAH correction in rank-one form).
-  void writeBackDah(const std::vector<int>& part, const StateLayout& sub, const Eigen::MatrixXd& P,
-                    const Eigen::MatrixXd& K, const Eigen::MatrixXd& S, const Linearization& lin, Timestamp t);
-  /// DAH update of a scalar measurement on at most 4 participants of dimension ≤ 15 (every range
-  /// and baro update): the same steps as update() + writeBackDah() on stack storage, with the
-  /// rank-one forms of the scalar update (see the .cpp). False: not applicable, use the general path.
-  bool updateDahScalar(const Linearization& lin, double nis_gate, Timestamp t, Result* res);
-  /// Its steps on stack storage (factorized_covariance_dah_scalar.cpp).
-  friend class DahScalarUpdate;
+  /// The DAH update: one path for every measurement (factorized_covariance_dah.cpp, class
+  /// DahUpdate): the participants P (the named instances and their joint sets), Σ_PP, the EKF update
+  /// (scalar: rank-one form; vector: denseEkfUpdate) and the write-back (Σ_ii', L_i, pair factors).
+  Result updateDah(const Linearization& lin, double nis_gate, Timestamp t);
+  template <int MaxN, int MaxParts>
+  friend class DahUpdate;
 
   /// True when `lin` names a member of a joint set (O(1) without sets: the fast path's cost).
   bool namesJointSet(const Linearization& lin) const;

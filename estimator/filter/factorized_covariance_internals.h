@@ -1,7 +1,7 @@
 #pragma once
 /// @file factorized_covariance_internals.h
 /// @brief Helpers shared by the two translation units of FactorizedCovariance
-/// (factorized_covariance.cpp and factorized_covariance_dah_scalar.cpp). Internal to the filter.
+/// (factorized_covariance.cpp and factorized_covariance_dah.cpp). Internal to the filter.
 
 #include <Eigen/Core>
 #include <memory>
@@ -11,9 +11,26 @@
 
 namespace meshnav::estimator::factorized_internal {
 
-/// An immutable shared factor (copy-on-write storage of S̄_ij).
+/// A shared factor (copy-on-write storage of S̄_ij). Created non-const so that its only owner may
+/// write it in place (writableFactor); read-only for everyone else.
 inline std::shared_ptr<const Eigen::MatrixXd> shared(Eigen::MatrixXd m) {
-  return std::make_shared<const Eigen::MatrixXd>(std::move(m));
+  return std::make_shared<Eigen::MatrixXd>(std::move(m));
+}
+
+/// Storage for a new S̄ (rows × cols) in `slot`: the matrix it holds when no one else does (no
+/// snapshot or partner shares it: the dictionary holding `slot` is this instance's own), else a
+/// new one. Every S̄ is made by shared(), so the object is not const.
+inline Eigen::MatrixXd& writableFactor(std::shared_ptr<const Eigen::MatrixXd>& slot, Eigen::Index rows,
+                                       Eigen::Index cols) {
+  if (slot && slot.use_count() == 1) {
+    auto& m = const_cast<Eigen::MatrixXd&>(*slot);
+    m.resize(rows, cols);
+    return m;
+  }
+  auto m = std::make_shared<Eigen::MatrixXd>(rows, cols);
+  Eigen::MatrixXd& ref = *m;
+  slot = std::move(m);
+  return ref;
 }
 
 /// max|A| · max|A⁻¹| as a cheap conditioning measure.
@@ -26,14 +43,5 @@ double roughCondition(const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<B>&
 constexpr int kMaxInstanceDim = 15;
 /// One instance's matrices (factors, L_i⁻¹) without heap allocation.
 using InstMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxInstanceDim, kMaxInstanceDim>;
-
-/// DAH correction of participant `b` of a joint scalar update with u = its rows of Σ_PP hᵀ and
-/// s = h Σ_PP hᵀ + R: L_i ← (Σ_ii' Σ_ii⁻¹) L_i = (I − u wᵀ / s) L_i, w = Σ_ii⁻¹ u (b.Sigma must still
-/// be Σ_ii); fixed-size kernels for the IMU and 3-state anchors (factorized_covariance_dah_scalar.cpp).
-void foldScalarCorrection(InstanceBelief& b, const Eigen::Ref<const Eigen::VectorXd>& u, double s);
-
-/// L_i⁻¹ into `out`; false when L_i must be re-normalized instead (old, not finite, badly conditioned).
-template <typename Out>
-bool invertPendingFactor(const InstanceBelief& b, Out& out);
 
 }  // namespace meshnav::estimator::factorized_internal

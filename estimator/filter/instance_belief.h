@@ -48,6 +48,12 @@ class FactorDictionary {
     else
       entries_.insert(it, FactorEntry{partner, std::move(S_bar)});
   }
+  /// The entry for `partner`, inserted with a null S̄ when absent (to be written by the caller).
+  FactorEntry& slot(SensorId partner) {
+    auto it = lower(partner);
+    if (it == entries_.end() || it->partner != partner) it = entries_.insert(it, FactorEntry{partner, nullptr});
+    return *it;
+  }
   bool erase(SensorId partner) {
     auto it = lower(partner);
     if (it == entries_.end() || it->partner != partner) return false;
@@ -79,6 +85,10 @@ struct InstanceBelief {
   Eigen::MatrixXd Sigma;       ///< Σ_ii (dim × dim)
   Eigen::MatrixXd L;           ///< pending left factor L_i (empty: identity)
   int lazy_steps = 0;          ///< multiplications folded into L_i since the last re-normalization
+  /// L_i⁻¹ of the current L_i as a DAH update stored it as the larger id's S̄_ji (null: none since
+  /// L_i last changed). A partner's entry holding this very matrix stands for S_ji = L_i S̄_ji = I,
+  /// which is then not multiplied out (FactorizedCovariance::pairCovInto).
+  std::shared_ptr<const Eigen::MatrixXd> L_inv;
   /// id_j → S̄_ij; shared between snapshots, never modified while shared (use_count() > 1).
   std::shared_ptr<FactorDictionary> factors = std::make_shared<FactorDictionary>();
 };

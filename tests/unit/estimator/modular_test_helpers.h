@@ -71,8 +71,8 @@ inline std::vector<EstimatorInput> shuffledArrival(const std::vector<EstimatorIn
   return out;
 }
 
-/// A linearized range between the IMU (id 1, tag at its origin) and anchor `a` of `x`, measured
-/// as `z` (σ 0.1 m).
+/// A linearized range between the IMU (`x.imu_id`, tag at its origin) and anchor `a` of `x`,
+/// measured as `z` (σ 0.1 m).
 inline Linearization imuAnchorRange(const NominalState& x, SensorId a, double z) {
   const Eigen::Vector3d d = x.values<AnchorKind>().at(a).p_AinG - x.imu.p_IinG;
   Linearization lin;
@@ -80,7 +80,7 @@ inline Linearization imuAnchorRange(const NominalState& x, SensorId a, double z)
   lin.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, 15);
   H.block<1, 3>(0, ImuErr::kP) = -d.normalized().transpose();
-  lin.blocks.push_back({1, H});
+  lin.blocks.push_back({x.imu_id, H});
   lin.blocks.push_back({a, Eigen::MatrixXd(d.normalized().transpose())});
   return lin;
 }

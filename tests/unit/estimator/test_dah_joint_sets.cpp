@@ -5,10 +5,13 @@
 // merge, forget removed members and are snapshot with the filter; DP ignores them; the node puts
 // anchors added together into one set with the tags' γ, the IMU and its baro bias. An update whose
 // stack holds every partner of a member leaves that member no pending factor; the bound
-// (boundJointSetAnchors, uwb.dah_joint_max_anchors) lets the most refined anchors leave.
+// (boundJointSetAnchors, uwb.dah_joint_max_anchors) lets the most refined anchors leave. Every DAH
+// update (scalar and vector, with and without sets, members open or closed) follows DAH's rule on
+// the dense covariance.
 #include <gtest/gtest.h>
 
 #include "estimator/filter/centralized_ekf.h"
+#include "estimator/filter/dense_ekf_update.h"
 #include "estimator/filter/joint_set_bound.h"
 #include "estimator/filter/modular_filter.h"
 #include "estimator/node/estimator_node.h"
@@ -26,14 +29,15 @@ ImuPropagator propagator() { return ImuPropagator(9.81, ImuNoiseOptions{}); }
 const std::map<SensorId, Eigen::Vector3d> kTruth = {
     {106, {-1.7, 0.9, 3.2}}, {107, {-2.0, 1.8, 1.7}}, {108, {2.6, -0.2, 0.2}}};
 
-/// IMU and anchors 106–108, each 0.1–0.2 m off its truth with a matching prior (uncorrelated).
+/// IMU (id `imu_id`) and anchors 106–108, each 0.1–0.2 m off its truth with a matching prior
+/// (uncorrelated).
 template <typename F>
-void setUp(F& f) {
+void setUp(F& f, SensorId imu_id = 1) {
   ImuState x;
   x.p_IinG = {0.5, -0.2, 1.5};
   ImuMatrix P = ImuMatrix::Identity() * 0.01;
   P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) *= 0.1;
-  f.reset(1, x, P, Timestamp{});
+  f.reset(imu_id, x, P, Timestamp{});
   int k = 0;
   for (const auto& [id, p] : kTruth) {
     const Eigen::Vector3d off(0.1 + 0.05 * k, -0.1, 0.08);
@@ -106,7 +110,99 @@ bool flyWithAnchorBatch(EstimatorNode& node, const Dataset& ds, const std::vecto
   return sent;
 }
 
+/// DAH's rule on the dense covariance `S` (docs/modular_estimator.md, "Strategies"): the exact
+/// EKF update (Joseph form) of the participants P (the named instances and their joint sets),
+/// Σ_ik' = Σ_ii' Σ_ii⁻¹ Σ_ik for i ∈ P and k ∉ P, every other block unchanged.
+Eigen::MatrixXd denseDahUpdate(const Eigen::MatrixXd& S, const FactorizedCovariance& cov, const Linearization& lin) {
+  std::vector<SensorId> P;
+  for (const JacobianBlock& jb : lin.blocks) {
+    P.push_back(jb.id);
+    for (SensorId m : cov.jointSet(jb.id)) P.push_back(m);
+  }
+  StateLayout sub;
+  std::vector<int> idx;
+  for (const StateBlock& b : cov.layout().blocks()) {
+    if (std::find(P.begin(), P.end(), b.id) == P.end()) continue;
+    sub.add(b.id, b.kind, b.dim);
+    for (int r = 0; r < b.dim; ++r) idx.push_back(b.offset + r);
+  }
+  Eigen::MatrixXd Spp = S(idx, idx);
+  EXPECT_TRUE(denseEkfUpdate(Spp, sub, lin, 0.0, true).accepted);
+  Eigen::MatrixXd out = S;
+  out(idx, idx) = Spp;
+  for (const StateBlock& i : cov.layout().blocks()) {
+    if (!sub.find(i.id)) continue;
+    const StateBlock& is = sub.at(i.id);
+    const Eigen::MatrixXd M = Spp.block(is.offset, is.offset, i.dim, i.dim) *
+                              S.block(i.offset, i.offset, i.dim, i.dim).inverse();
+    for (const StateBlock& k : cov.layout().blocks()) {
+      if (sub.find(k.id)) continue;
+      out.block(i.offset, k.offset, i.dim, k.dim) = M * S.block(i.offset, k.offset, i.dim, k.dim);
+      out.block(k.offset, i.offset, k.dim, i.dim) = out.block(i.offset, k.offset, i.dim, k.dim).transpose();
+    }
+  }
+  return out;
+}
+
+/// A ZUPT-like vector update of the IMU's velocity (3 rows).
+Linearization imuVelocityZero(const NominalState& x) {
+  Linearization lin;
+  lin.residual = -x.imu.v_IinG;
+  lin.R = Eigen::Matrix3d::Identity() * 1e-4;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(3, ImuErr::kDim);
+  H.middleCols<3>(ImuErr::kV).setIdentity();
+  lin.blocks.push_back({x.imu_id, H});
+  return lin;
+}
+
 }  // namespace
+
+TEST(DahJointSets, EveryUpdateFollowsDahsRuleOnTheDenseCovariance) {
+  // 108 stays outside the set {IMU, 106, 107}: once it is correlated, the members' updates without
+  // it are open (DAH's correction folded into L_i, pair factors relative to L_i'⁻¹), a range to 108
+  // stacks everything (closed members). Checked after every step against the dense rule. The IMU
+  // as id 300 is the larger id of its pairs: its S̄ is its L⁻¹ (remembered as L_inv, read as the
+  // identity), which every propagation must invalidate.
+  for (const auto& [with_set, imu] : std::vector<std::pair<bool, SensorId>>{{true, 1}, {false, 1}, {true, 300}, {false, 300}}) {
+    ModularFilter f(ModularFilter::Mode::DAH, propagator(), KindRandomWalks{}, true);
+    setUp(f, imu);
+    if (with_set) f.joinJointSet({imu, 106, 107});
+    int identity_reads = 0;  // factors that are their instance's remembered L⁻¹, summed over the updates
+    const Eigen::Vector3d acc(0.05, 0.0, 9.81), gyro(0.0, 0.01, 0.02), p_true(0.5, -0.2, 1.5);
+    int open_updates = 0;
+    for (int k = 1; k <= 40; ++k) {
+      // Propagation: Σ ← T Σ Tᵀ + Q on the IMU's rows and columns (T = Φ there, I elsewhere).
+      ImuState x = f.state().imu;
+      ImuMatrix Phi, Q;
+      propagator().propagate(x, acc, gyro, 0.02, &Phi, &Q);
+      const StateBlock& ib = f.instances().layout().at(imu);
+      Eigen::MatrixXd T = Eigen::MatrixXd::Identity(f.layout().dim(), f.layout().dim());
+      T.block(ib.offset, ib.offset, ib.dim, ib.dim) = Phi;
+      Eigen::MatrixXd propagated = T * f.fullCovariance() * T.transpose();
+      propagated.block(ib.offset, ib.offset, ib.dim, ib.dim) += Q;
+      f.propagate(acc, gyro, Timestamp::fromSec(0.02 * k));
+      EXPECT_LT(maxRelative(f.fullCovariance(), propagated), 1e-9) << "propagation " << k << ", IMU " << imu;
+      std::vector<Linearization> updates;
+      const SensorId a = 106 + k % 3;
+      updates.push_back(test::imuAnchorRange(f.state(), a, (kTruth.at(a) - p_true).norm() + 0.01));
+      if (k % 4 == 0) updates.push_back(test::anchorPairRange(f.state(), 106 + k % 2, 108, 3.0));
+      if (k % 7 == 0) updates.push_back(imuVelocityZero(f.state()));
+      for (const Linearization& lin : updates) {
+        const Eigen::MatrixXd expected = denseDahUpdate(f.fullCovariance(), f.instances(), lin);
+        ASSERT_TRUE(f.update(lin, 0.0).accepted);
+        EXPECT_LT(maxRelative(f.fullCovariance(), expected), 1e-9) << "step " << k << ", set " << with_set << ", IMU " << imu;
+        open_updates += f.instances().belief(imu).L.size() > 0 && with_set;
+        for (const StateBlock& b : f.instances().layout().blocks()) {
+          const InstanceBelief& belief = f.instances().belief(b.id);
+          for (const FactorEntry& e : belief.factors->entries()) identity_reads += belief.L_inv && e.S_bar == belief.L_inv;
+        }
+      }
+    }
+    if (with_set) EXPECT_GT(open_updates, 10) << "the IMU must have been an open member";
+    EXPECT_GT(identity_reads, 10);
+    f.checkInvariants();
+  }
+}
 
 TEST(DahJointSets, AnchorSetWithTagRangesEqualsCentralized) {
   const auto ref = centralizedFlight(false);
