@@ -344,33 +344,8 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
     cur_.rest_rate.add(s.gyro_rad_s, (s.t - previous->t).sec(), options_.imu.max_dt_s);
   else if (!cur_.landed)
     cur_.rest_rate.reset();
-  if (options_.zupt.enabled && cur_.landed && (s.t - cur_.last_zupt).sec() >= 1.0 / options_.zupt.rate_hz - 1e-9) {
-    ScopedStepTimer timer(timings_, "zupt");
-    ZuptMeasurement z;
-    z.t = s.t;
-    z.acc_m_s2 = s.acc_m_s2;
-    // Only a flight state says v = 0 and ω = 0 exactly; IMU stillness allows a slow drift and turn.
-    z.sigma_acc_m_s2 = options_.zupt.sigma_acc_m_s2;
-    // ω row: the mean reading since the last ZUPT, σ² = (rest rotation allowed)² + σ_ω² λ / T
-    // (RestRateMean; λ the IMU noise scale); the latest reading with the loosest σ before any interval.
-    const double rest_sigma = have_flight_state_ ? options_.zupt.sigma_gyro_rad_s : options_.zupt.stillness_sigma_gyro_rad_s;
-    if (cur_.rest_rate.span() > 0.0) {
-      const double mean_sigma = cur_.rest_rate.sigma(options_.imu.gyro_noise_density * std::sqrt(cur_.noise_adapter.scale()));
-      z.gyro_rad_s = cur_.rest_rate.mean();
-      z.sigma_gyro_rad_s = std::hypot(rest_sigma, mean_sigma);
-    } else {
-      z.gyro_rad_s = s.gyro_rad_s;
-      z.sigma_gyro_rad_s = std::max(rest_sigma, options_.zupt.stillness_sigma_gyro_rad_s);
-    }
-    z.sigma_vel_m_s = have_flight_state_ ? options_.zupt.sigma_vel_m_s : options_.zupt.stillness_sigma_vel_m_s;
-    const Linearization lin = zupt_model_.linearize(z, f.state());
-    const double gate = have_flight_state_ ? 0.0 : chi2Quantile(static_cast<int>(lin.residual.size()),
-                                                                options_.zupt.stillness_gate_probability);
-    if (!f.update(lin, gate).accepted) event(first, "gated_zupt");
-    cur_.last_zupt = s.t;
-    cur_.rest_rate.reset();
-    if (first) ++instance_stats_[setup_.imu_id].n_updates;
-  }
+  if (options_.zupt.enabled && cur_.landed && (s.t - cur_.last_zupt).sec() >= 1.0 / options_.zupt.rate_hz - 1e-9)
+    processZupt(s, first);
   if (carried_height_ &&
       (s.t - cur_.last_carried_height).sec() >= 1.0 / options_.carried_height.rate_hz - 1e-9) {
     cur_.last_carried_height = s.t;

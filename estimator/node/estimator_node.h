@@ -197,6 +197,7 @@ class EstimatorNode {
   void processBaro(const BaroSample& s, bool first);
   void processRange(const RangeSample& s, bool first);
   void processHeight(const HeightSample& s, bool first);
+  void processZupt(const ImuSample& s, bool first);
   /// A height for the in-motion alignment, thinned to height.align_rate_hz (all sources).
   void addAlignHeight(const AlignHeight& h);
   /// A height reading (rangefinder or carried height) for the in-motion alignment, thinned.

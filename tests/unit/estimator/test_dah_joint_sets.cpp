@@ -198,7 +198,9 @@ TEST(DahJointSets, EveryUpdateFollowsDahsRuleOnTheDenseCovariance) {
         }
       }
     }
-    if (with_set) EXPECT_GT(open_updates, 10) << "the IMU must have been an open member";
+    if (with_set) {
+      EXPECT_GT(open_updates, 10) << "the IMU must have been an open member";
+    }
     EXPECT_GT(identity_reads, 10);
     f.checkInvariants();
   }
