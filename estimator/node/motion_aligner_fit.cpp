@@ -213,7 +213,7 @@ bool MotionAligner::fitStarts(const Eigen::Vector3d& bias_gyro_rad_s, Window* w)
   // 166 m (ATE 3.3 → 54 m). Off there until a lost filter's drift is bounded (docs/robustness.md).
   const bool relinearize = options_.relinearize_rad > 0.0 && spanSeconds() <= options_.window_s + 1e-6;
   // Windows 0.5 s apart share most of their data: start at the gyro bias the previous solve
-  // fitted about the same prior, so that repeated solves (while refused) rarely need a second pass.
+  // fitted about the same prior, so that repeated solves (while refused) need fewer passes.
   w->b_lin = relinearize && last_fit_ && last_fit_->first == bias_gyro_rad_s ? last_fit_->second : bias_gyro_rad_s;
   for (int pass = 0;; ++pass) {
     dbg_prior_mean_ = bias_gyro_rad_s - w->b_lin;
