@@ -188,6 +188,7 @@ class MotionAligner {
     std::vector<HeightObs> heights;
     Increments end;
     Eigen::Vector3d b_lin = Eigen::Vector3d::Zero();
+    Eigen::Vector3d dbg_prior_mean = Eigen::Vector3d::Zero();  ///< the caller's bias − b_lin [rad/s]
     std::vector<Candidate> cands;
   };
   /// Builds the observations and fits every start, integrating again at the best fit's gyro bias
@@ -197,7 +198,10 @@ class MotionAligner {
   std::vector<Obs> buildObservations(const Eigen::Vector3d& bias_gyro, Increments* end,
                                      std::vector<HeightObs>* heights) const;
   /// Levenberg–Marquardt with Huber weights; returns the cost (Huber terms and bias priors).
-  double fit(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights, Unknowns& x, Info* info) const;
+  /// `dbg_prior_mean`: the prior mean of δb_ω, the caller's gyro bias minus the one the increments
+  /// were integrated with (nonzero after a re-integration) [rad/s].
+  double fit(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights, const Eigen::Vector3d& dbg_prior_mean,
+             Unknowns& x, Info* info) const;
   /// huber::varianceFactor of the inlier ranges: how much noisier than their σ they fit.
   double robustVarianceFactor(const std::vector<Obs>& obs, const Unknowns& x) const;
   double residual(const Obs& o, const Unknowns& x) const;
@@ -221,9 +225,6 @@ class MotionAligner {
 
   MotionAlignerOptions options_;
   double gravity_z_sign_ = -1.0, assumed_gravity_z_sign_ = -1.0;
-  /// Prior mean of δb_ω in `fit`: the caller's gyro bias minus the one the increments were
-  /// integrated with (nonzero after a re-integration) [rad/s]
-  Eigen::Vector3d dbg_prior_mean_ = Eigen::Vector3d::Zero();
   int relinearizations_ = 0;  ///< re-integrations over this aligner's life
   /// The caller's gyro bias (the prior's centre) and the bias the best fit of the last solve found
   /// about it; the next solve with the same prior integrates at the latter [rad/s]

@@ -54,13 +54,14 @@ std::vector<size_t> rivalOrder(const std::vector<Candidate>& cands, const Eigen:
 
 }  // namespace
 
-double MotionAligner::fit(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights, Unknowns& x,
+double MotionAligner::fit(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights,
+                          const Eigen::Vector3d& dbg_prior_mean, Unknowns& x,
                           MatU* info) const {
   const double prior_ba = 1.0 / (options_.sigma_bias_acc_m_s2 * options_.sigma_bias_acc_m_s2);
   const double prior_bg = 1.0 / (options_.sigma_bias_gyro_rad_s * options_.sigma_bias_gyro_rad_s);
   const double prior_bh = 1.0 / (options_.sigma_bias_height_m * options_.sigma_bias_height_m);
   auto cost = [&](const Unknowns& u) {
-    double c = prior_ba * u.ba.squaredNorm() + prior_bg * (u.dbg - dbg_prior_mean_).squaredNorm() + prior_bh * u.bh * u.bh;
+    double c = prior_ba * u.ba.squaredNorm() + prior_bg * (u.dbg - dbg_prior_mean).squaredNorm() + prior_bh * u.bh * u.bh;
     for (const Obs& o : obs)
       if (o.use) c += huber::cost(residual(o, u) / o.r.sigma_m);
     for (const HeightObs& o : heights)
@@ -94,7 +95,7 @@ double MotionAligner::fit(const std::vector<Obs>& obs, const std::vector<HeightO
     H.block<3, 3>(9, 9).diagonal().array() += prior_ba;
     g.segment<3>(9) += prior_ba * x.ba;
     H.block<3, 3>(12, 12).diagonal().array() += prior_bg;
-    g.segment<3>(12) += prior_bg * (x.dbg - dbg_prior_mean_);
+    g.segment<3>(12) += prior_bg * (x.dbg - dbg_prior_mean);
     bool improved = false;
     for (int tries = 0; tries < 6 && !improved; ++tries) {
       MatU A = H;
@@ -216,7 +217,7 @@ bool MotionAligner::fitStarts(const Eigen::Vector3d& bias_gyro_rad_s, Window* w)
   // fitted about the same prior, so that repeated solves (while refused) need fewer passes.
   w->b_lin = relinearize && last_fit_ && last_fit_->first == bias_gyro_rad_s ? last_fit_->second : bias_gyro_rad_s;
   for (int pass = 0;; ++pass) {
-    dbg_prior_mean_ = bias_gyro_rad_s - w->b_lin;
+    w->dbg_prior_mean = bias_gyro_rad_s - w->b_lin;
     w->obs = buildObservations(w->b_lin, &w->end, &w->heights);
     std::set<SensorId> anchor_ids;
     for (const Obs& o : w->obs) anchor_ids.insert(o.r.anchor);
@@ -229,7 +230,7 @@ bool MotionAligner::fitStarts(const Eigen::Vector3d& bias_gyro_rad_s, Window* w)
     }
     w->cands.clear();
     for (Unknowns x : starts(w->obs)) {  // δb_ω = 0: at b_lin
-      const double c = fit(w->obs, w->heights, x, nullptr);
+      const double c = fit(w->obs, w->heights, w->dbg_prior_mean, x, nullptr);
       if (std::isfinite(c)) w->cands.push_back({x, c, endState(x, w->end, w->b_lin)});
     }
     if (w->cands.empty()) {
@@ -266,7 +267,7 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
   for (Obs& o : obs) o.use = std::abs(residual(o, best)) <= std::max(options_.outlier_m, 4.0 * o.r.sigma_m);
   for (HeightObs& o : heights) o.use = std::abs(residual(o, best)) <= std::max(0.3, 4.0 * o.h.sigma_m);
   MatU info;
-  const double best_cost = fit(obs, heights, best, &info);
+  const double best_cost = fit(obs, heights, w.dbg_prior_mean, best, &info);
   const ImuState best_end = endState(best, end, b_lin);
   // Distinct rivals are refitted on the same inliers, in rivalOrder, up to 6 in all.
   // Costs are compared in units of the residuals' own scatter: ranges that fit worse than their σ
@@ -280,7 +281,7 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
       continue;
     checked.push_back(cands[k].end);
     Unknowns rival = cands[k].x;
-    const double c = fit(obs, heights, rival, nullptr);
+    const double c = fit(obs, heights, w.dbg_prior_mean, rival, nullptr);
     const ImuState rival_end = endState(rival, end, b_lin);
     if (c - best_cost < margin && distinctPoses(rival_end, best_end)) {
       reason_ = "motion alignment: ambiguous (two poses " + std::to_string((rival_end.p_IinG - best_end.p_IinG).norm()) +
@@ -293,7 +294,6 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
 }
 
 std::optional<MotionAligner::GravityCheck> MotionAligner::checkGravityDirection(const Eigen::Vector3d& bias_gyro_rad_s) {
-  dbg_prior_mean_.setZero();
   if (spanSeconds() < options_.min_span_s) {
     reason_ = "gravity check: too short a window";
     return std::nullopt;
@@ -316,7 +316,7 @@ std::optional<MotionAligner::GravityCheck> MotionAligner::checkGravityDirection(
     gravity_z_sign_ = sign;
     double best = std::numeric_limits<double>::infinity();
     for (Unknowns x : starts(obs)) {
-      const double c = fit(obs, heights, x, nullptr);
+      const double c = fit(obs, heights, Eigen::Vector3d::Zero(), x, nullptr);
       if (std::isfinite(c) && c < best) {
         best = c;
         if (sign < 0.0) best_up = x;
