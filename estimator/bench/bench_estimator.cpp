@@ -16,6 +16,8 @@
 ///    (`uwb.dah_joint_max_anchors: 0`); ranges cycle through all <n> anchors;
 ///  - RangeUpdateJointSetBounded/dah/<n>: the same joins with the node's default bound
 ///    (boundJointSetAnchors, `uwb.dah_joint_max_anchors`: the most refined anchors leave the set);
+///  - RangeUpdateJointSetBound<b>/dah/<n>: the same with the bound b ∈ {3, 5, 6} (n ∈ {5, 100}: the
+///    ratio 100 ÷ 5 of docs/modular_estimator.md, "Bounding the set");
 ///  - DelayedRangeUpdate/<s>/<n>: through EstimatorNode, one IMU sample plus one range arriving
 ///    50 ms late (rewind to the snapshot before it, re-process 50 ms of inputs);
 ///  - Micro/<s>/<N>: reference scenario (a 6-state p, v body at 100 Hz, N stationary 3-state
@@ -398,6 +400,11 @@ void registerAll() {
   for (int n : kAnchorCounts)
     benchmark::RegisterBenchmark(("RangeUpdateJointSetBounded/dah/" + std::to_string(n)).c_str(), Update, "dah", n,
                                  false, false, 0, EstimatorOptions{}.uwb.dah_joint_max_anchors);
+  for (int bound : {3, 5, 6})
+    for (int n : {5, 100})
+      benchmark::RegisterBenchmark(
+          ("RangeUpdateJointSetBound" + std::to_string(bound) + "/dah/" + std::to_string(n)).c_str(), Update, "dah",
+          n, false, false, 0, bound);
   for (const char* s : listedStrategies())
     for (int N : {2, 5, 10, 20})
       benchmark::RegisterBenchmark(("Micro/" + std::string(s) + "/" + std::to_string(N)).c_str(), Micro, s, N);
