@@ -7,6 +7,7 @@
 #include <set>
 
 #include "common/atmosphere.h"
+#include "estimator/core/cauchy.h"
 #include "estimator/core/huber.h"
 
 namespace meshnav::estimator {
@@ -16,17 +17,12 @@ constexpr double kDeg = M_PI / 180.0;
 
 Eigen::Matrix3d rotZ(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
 
-/// A local minimum of the static range fit from one start.
-struct FitMinimum {
-  double cost;
-  Eigen::Vector3d p;
-  double yaw;
-};
-
 /// Why the fit is ambiguous ("" when it is not): a second minimum within `chi2` of the best cost
 /// elsewhere (nearly coplanar anchors mirror the position) or at another heading (lever arms too
 /// short for the range noise). Refused rather than one picked.
-std::string ambiguityOf(const std::vector<FitMinimum>& minima, const FitMinimum& best, double chi2) {
+std::string ambiguityOf(const std::vector<StaticInitializer::FitMinimum>& minima, const StaticInitializer::FitMinimum& best,
+                        double chi2) {
+  using FitMinimum = StaticInitializer::FitMinimum;
   for (const FitMinimum& m : minima) {
     if (m.cost - best.cost >= chi2) continue;
     if ((m.p - best.p).norm() > 0.5)
@@ -206,7 +202,9 @@ std::optional<InitialBelief> StaticInitializer::build(const Eigen::Matrix3d& R_r
 }
 
 double StaticInitializer::solveFit(const Eigen::Matrix3d& R_rp, const std::vector<bool>& use, Eigen::Vector3d& p,
-                                   double& yaw, Eigen::Matrix4d* cov) const {
+                                   double& yaw, Eigen::Matrix4d* cov, FitLoss loss) const {
+  const auto rho = [loss](double e) { return loss == FitLoss::kCauchy ? cauchy::cost(e) : huber::cost(e); };
+  const auto weight = [loss](double e) { return loss == FitLoss::kCauchy ? cauchy::weight(e) : huber::weight(e); };
   double cost = 0.0;
   for (int it = 0; it < 30; ++it) {
     Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
@@ -224,16 +222,18 @@ double StaticInitializer::solveFit(const Eigen::Matrix3d& R_rp, const std::vecto
       Eigen::Vector4d J;  // ∂res/∂[p, yaw]
       J.head<3>() = u;
       J(3) = u.dot(Eigen::Vector3d::UnitZ().cross(lever));
-      // Huber (k = 2σ): NLOS outliers must not pick the minimum (a 109° yaw error in hover).
+      // Robust (FitLoss): NLOS outliers must not pick the minimum (a 109° yaw error in hover).
       const double e = res / r.sigma_m;
-      const double w = huber::weight(e) / (r.sigma_m * r.sigma_m);
+      const double w = weight(e) / (r.sigma_m * r.sigma_m);
       A += w * J * J.transpose();
       g += w * J * res;
-      cost += huber::cost(e);
+      cost += rho(e);
     }
     if (height_prior_) {  // ∂(z_h − p_z)/∂[p, yaw] = −e_z (roll and pitch fixed: the lever's z does not depend on yaw)
       const double res = height_prior_->z_m - p.z();
       const double e = res / height_prior_->sigma_m;
+      // Huber under either loss: the prior is not an outlier candidate, and a redescending loss
+      // would let a mirror image metres away in height escape it.
       const double w = huber::weight(e) / (height_prior_->sigma_m * height_prior_->sigma_m);
       A(2, 2) += w;
       g(2) -= w * res;
@@ -264,18 +264,10 @@ std::optional<StaticInitializer::HeightPrior> StaticInitializer::heightPrior(con
   return std::nullopt;
 }
 
-bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p_out, double& yaw_out,
-                                        Eigen::Matrix4d& cov_out, double& rms_out, int& n_used) {
-  waiting_for_.clear();
-  height_prior_ = heightPrior(R_rp);
-  std::set<SensorId> anchors;
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const auto& r : ranges_) anchors.insert(r.anchor);
-  if (anchors.size() < 3) return false;
-  for (SensorId a : anchors) centroid += setup_.abs_anchor_positions.at(a);
-  centroid /= static_cast<double>(anchors.size());
-
-  std::vector<bool> use(ranges_.size(), true);
+std::vector<StaticInitializer::FitMinimum> StaticInitializer::searchMinima(const Eigen::Matrix3d& R_rp,
+                                                                          const std::vector<bool>& use,
+                                                                          const Eigen::Vector3d& centroid,
+                                                                          FitLoss loss) const {
   // Starts near the floor (a landed pad) and 1.5 m below and above the anchors' mean height (a
   // body at rest in the air): anchors in a narrow height band mirror the height, and only a start
   // on each side lets the ambiguity check see both (a start at the mean height itself may slide to
@@ -291,36 +283,85 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
           Eigen::Vector3d p = centroid + Eigen::Vector3d(2.0 * sx, 2.0 * sy, 0.0);
           p.z() = z0;
           double yaw = k * 0.5 * M_PI;
-          const double c = solveFit(R_rp, use, p, yaw, nullptr);
+          const double c = solveFit(R_rp, use, p, yaw, nullptr, loss);
           if (std::isfinite(c)) minima.push_back({c, p, yaw});
         }
+  return minima;
+}
+
+std::vector<StaticInitializer::FitMinimum> StaticInitializer::refineDistinct(const Eigen::Matrix3d& R_rp,
+                                                                            const std::vector<bool>& use,
+                                                                            const std::vector<FitMinimum>& starts) const {
+  std::vector<FitMinimum> distinct, refined;
+  for (const FitMinimum& m : starts) {
+    const bool seen = std::any_of(distinct.begin(), distinct.end(), [&](const FitMinimum& d) {
+      return (d.p - m.p).norm() < 0.05 && std::abs(std::remainder(d.yaw - m.yaw, 2.0 * M_PI)) < 2.0 * kDeg;
+    });
+    if (!seen) distinct.push_back(m);
+  }
+  for (FitMinimum m : distinct) {
+    m.cost = solveFit(R_rp, use, m.p, m.yaw, nullptr, FitLoss::kHuber);
+    if (std::isfinite(m.cost)) refined.push_back(m);
+  }
+  return refined;
+}
+
+double StaticInitializer::rangeResidual(size_t i, const Eigen::Matrix3d& R, const Eigen::Vector3d& p) const {
+  const InitRange& r = ranges_[i];
+  return r.d_m - (setup_.abs_anchor_positions.at(r.anchor) - p - R * setup_.rel_tag_positions.at(r.tag)).norm();
+}
+
+int StaticInitializer::markInliers(const Eigen::Matrix3d& R_rp, const FitMinimum& at, std::vector<bool>& use) const {
+  const Eigen::Matrix3d R = rotZ(at.yaw) * R_rp;
+  int n = 0;
+  for (size_t i = 0; i < ranges_.size(); ++i) {
+    use[i] = std::abs(rangeResidual(i, R, at.p)) <= options_.init.range_init_outlier_m;
+    n += use[i] ? 1 : 0;
+  }
+  return n;
+}
+
+bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p_out, double& yaw_out,
+                                        Eigen::Matrix4d& cov_out, double& rms_out, int& n_used) {
+  waiting_for_.clear();
+  height_prior_ = heightPrior(R_rp);
+  std::set<SensorId> anchors;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& r : ranges_) anchors.insert(r.anchor);
+  if (anchors.size() < 3) return false;
+  for (SensorId a : anchors) centroid += setup_.abs_anchor_positions.at(a);
+  centroid /= static_cast<double>(anchors.size());
+  const auto lowest = [](const std::vector<FitMinimum>& m) {
+    return *std::min_element(m.begin(), m.end(), [](const FitMinimum& x, const FitMinimum& y) { return x.cost < y.cost; });
+  };
+
+  // Two passes. The first, Cauchy over every range from a grid of starts, finds the minima and
+  // which ranges are outliers (beyond `range_init_outlier_m` at its best minimum). The second
+  // descends again from each distinct minimum over the inliers only (Huber, nearly χ² there), and
+  // its costs decide: two minima must not differ by what a few NLOS ranges happen to add to each
+  // (docs/robustness.md, "Outliers in the static fit").
+  std::vector<bool> use(ranges_.size(), true);
+  std::vector<FitMinimum> minima = searchMinima(R_rp, use, centroid, FitLoss::kCauchy);
   if (minima.empty()) return false;
-  const FitMinimum best = *std::min_element(minima.begin(), minima.end(),
-                                            [](const FitMinimum& x, const FitMinimum& y) { return x.cost < y.cost; });
+  if (markInliers(R_rp, lowest(minima), use) < 4) return false;
+  minima = refineDistinct(R_rp, use, minima);
+  if (minima.empty()) return false;
+  const FitMinimum best = lowest(minima);
   waiting_for_ = ambiguityOf(minima, best, options_.init.ambiguity_chi2);
   if (!waiting_for_.empty()) return false;
+
+  // The inliers at this minimum, and the refinement there.
+  n_used = markInliers(R_rp, best, use);
+  if (n_used < 4) return false;
   Eigen::Vector3d best_p = best.p;
   double best_yaw = best.yaw;
-  // Range residual of range i at pose (R, p).
-  auto residual = [&](size_t i, const Eigen::Matrix3d& R, const Eigen::Vector3d& p) {
-    const InitRange& r = ranges_[i];
-    return r.d_m - (setup_.abs_anchor_positions.at(r.anchor) - p - R * setup_.rel_tag_positions.at(r.tag)).norm();
-  };
-  // Drop outliers and refine.
-  const Eigen::Matrix3d R = rotZ(best_yaw) * R_rp;
-  n_used = 0;
-  for (size_t i = 0; i < ranges_.size(); ++i) {
-    use[i] = std::abs(residual(i, R, best_p)) <= options_.init.range_init_outlier_m;
-    n_used += use[i] ? 1 : 0;
-  }
-  if (n_used < 4) return false;
-  solveFit(R_rp, use, best_p, best_yaw, &cov_out);
+  solveFit(R_rp, use, best_p, best_yaw, &cov_out, FitLoss::kHuber);
   double sq = 0.0;
   std::vector<double> abs_e;
   const Eigen::Matrix3d R2 = rotZ(best_yaw) * R_rp;
   for (size_t i = 0; i < ranges_.size(); ++i) {
     if (!use[i]) continue;
-    const double e = residual(i, R2, best_p);
+    const double e = rangeResidual(i, R2, best_p);
     sq += e * e;
     abs_e.push_back(std::abs(e) / ranges_[i].sigma_m);
   }

@@ -50,6 +50,17 @@ struct InitialBelief {
 
 class StaticInitializer {
  public:
+  /// The robust loss of a fit: Cauchy for the first search, which only tells the outliers (a gross
+  /// outlier's pull vanishes, so it cannot pick between minima the inliers leave alike); Huber for
+  /// the second search over the inliers, whose minima decide ambiguity, and for the refinement
+  /// (its covariance is the one the filter starts from).
+  enum class FitLoss { kCauchy, kHuber };
+  /// A local minimum of the static range fit from one start.
+  struct FitMinimum {
+    double cost;
+    Eigen::Vector3d p;
+    double yaw;
+  };
   StaticInitializer(const EstimatorOptions& options, const SystemSetup& setup);
 
   void addFlightState(const FlightStateSample& s);
@@ -76,11 +87,12 @@ class StaticInitializer {
   };
   void restart();
   std::optional<InitialBelief> build(const Eigen::Matrix3d& R_rp);
-  /// Gauss–Newton on [p, yaw] over the ranges marked in `use`, Huber weights (k = 2σ); returns
-  /// the Huber cost Σ ρ(e_i), e_i = (d_i − ‖p_A − p − R p_T‖)/σ_i, plus ρ((z_h − p_z)/σ_h) of the
-  /// height prior when there is one.
+
+  /// Iteratively reweighted Gauss–Newton on [p, yaw] over the ranges marked in `use` with the
+  /// weights of `loss` (scale 2σ); returns the cost Σ ρ(e_i), e_i = (d_i − ‖p_A − p − R p_T‖)/σ_i,
+  /// plus ρ((z_h − p_z)/σ_h) of the height prior when there is one.
   double solveFit(const Eigen::Matrix3d& R_rp, const std::vector<bool>& use, Eigen::Vector3d& p, double& yaw,
-                  Eigen::Matrix4d* cov) const;
+                  Eigen::Matrix4d* cov, FitLoss loss) const;
   /// A prior on the IMU's height for the range fit from what else knows it: the barometer when
   /// the setup gives its reference pressure (h = height from the mean pressure minus the baro's
   /// lever arm, σ² = baro.init_bias_sigma_m² + the pressure noise over the samples), else the
@@ -91,6 +103,18 @@ class StaticInitializer {
     double sigma_m = 1.0;
   };
   std::optional<HeightPrior> heightPrior(const Eigen::Matrix3d& R_rp) const;
+  /// Starts of the fit on a grid (3 × 3 positions around the anchors' centroid at three or four
+  /// heights, four headings) and the minimum each reaches over the ranges in `use`.
+  std::vector<FitMinimum> searchMinima(const Eigen::Matrix3d& R_rp, const std::vector<bool>& use,
+                                       const Eigen::Vector3d& centroid, FitLoss loss) const;
+  /// The distinct minima among `starts` (0.05 m, 2° apart), each descended again over the ranges
+  /// in `use` with Huber weights, with its cost there.
+  std::vector<FitMinimum> refineDistinct(const Eigen::Matrix3d& R_rp, const std::vector<bool>& use,
+                                         const std::vector<FitMinimum>& starts) const;
+  /// d_i − ‖p_A − p − R p_T‖ of range i [m].
+  double rangeResidual(size_t i, const Eigen::Matrix3d& R, const Eigen::Vector3d& p) const;
+  /// Marks the ranges within `range_init_outlier_m` of the pose `at`; returns their number.
+  int markInliers(const Eigen::Matrix3d& R_rp, const FitMinimum& at, std::vector<bool>& use) const;
   /// Least-squares [p, yaw]; returns false when it does not converge.
   bool fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vector3d& p, double& yaw, Eigen::Matrix4d& cov,
                        double& rms, int& n_used);

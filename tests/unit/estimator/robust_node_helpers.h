@@ -17,6 +17,7 @@ namespace meshnav::estimator::test {
 struct RunResult {
   double final_error_m = 0.0;
   double max_error_after_m = 0.0;
+  double max_angle_error_after_deg = 0.0;  ///< largest rotation angle of R̂ᵀR after t_check [deg]
   Health final_health = Health::Initializing;
 };
 
@@ -32,7 +33,10 @@ RunResult run(EstimatorNode& node, const Dataset& ds, double t_check, Hook hook)
     while (gi + 1 < ds.ground_truth.size() && ds.ground_truth[gi + 1].t <= t) ++gi;
     const double e = (node.pose()->p_IinG - ds.ground_truth[gi].p_IinG).norm();
     res.final_error_m = e;
-    if (t.sec() > t_check) res.max_error_after_m = std::max(res.max_error_after_m, e);
+    if (t.sec() <= t_check) continue;
+    res.max_error_after_m = std::max(res.max_error_after_m, e);
+    const double angle = node.pose()->q_ItoG.angularDistance(ds.ground_truth[gi].q_ItoG) * 180.0 / M_PI;
+    res.max_angle_error_after_deg = std::max(res.max_angle_error_after_deg, angle);
   }
   res.final_health = node.health();
   return res;
