@@ -11,7 +11,7 @@
 #include <fstream>
 #include <iostream>
 
-#include "common/cli.h"
+#include "common/cli_main.h"
 #include "common/dataset.h"
 #include "common/estimate_io.h"
 #include "estimator/filter/strategy_factory.h"
@@ -25,6 +25,10 @@ using namespace meshnav;
 using namespace meshnav::estimator;
 
 namespace {
+
+constexpr char kDescription[] =
+    "Runs the estimator, calibrator and mission nodes on a dataset folder in one process, in time order, as fast "
+    "as possible (deterministic).";
 
 /// The command line of meshnav_run.
 struct RunOptions {
@@ -181,31 +185,24 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
   return report(node, data_s, wall_s, out_dir.string(), o.allow_lost);
 }
 
+/// The work of main: --print-config, or the pipeline on --dataset.
+int run(const RunOptions& o) {
+  EstimatorOptions options = o.config.empty() ? EstimatorOptions{} : EstimatorOptions::fromYaml(o.config);
+  if (o.print_config) {
+    std::cout << options.toString();
+    return 0;
+  }
+  if (o.dataset.empty() || o.out.empty()) {
+    std::cerr << "meshnav_run: --dataset and --out are required (see --help)\n";
+    return 2;
+  }
+  if (!o.strategy.empty()) options.strategy = o.strategy;
+  return runPipeline(o, options);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  setupLogging("meshnav_run");
-  Cli cli("meshnav_run",
-          "Runs the estimator, calibrator and mission nodes on a dataset folder in one process, in time order, as "
-          "fast as possible (deterministic).");
-  RunOptions o;
-  declareOptions(cli, o);
-  int code = 0;
-  if (!cli.parse(argc, argv, code)) return code;
-  try {
-    EstimatorOptions options = o.config.empty() ? EstimatorOptions{} : EstimatorOptions::fromYaml(o.config);
-    if (o.print_config) {
-      std::cout << options.toString();
-      return 0;
-    }
-    if (o.dataset.empty() || o.out.empty()) {
-      std::cerr << "meshnav_run: --dataset and --out are required (see --help)\n";
-      return 2;
-    }
-    if (!o.strategy.empty()) options.strategy = o.strategy;
-    return runPipeline(o, options);
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
-  }
+  return cliMain<RunOptions>(argc, argv, "meshnav_run", kDescription, declareOptions,
+                             [](const Cli&, RunOptions& o) { return run(o); });
 }

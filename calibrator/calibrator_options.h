@@ -76,6 +76,8 @@ struct CalibratorOptions {
   /// Reads the keys present under `node` (the `calibrator:` map). Throws std::runtime_error naming
   /// `where` and the key on an unknown key or a value of the wrong type/range.
   static CalibratorOptions fromYaml(const YAML::Node& node, const std::string& where);
+  /// Throws std::runtime_error naming the key of a value out of range.
+  void validate() const;
   /// Multi-line "key: value" listing.
   std::string toString() const;
 };

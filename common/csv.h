@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/diagnostics.h"
@@ -68,5 +69,25 @@ std::optional<Timestamp> parseRowTime(const CsvRow& r, const std::string& key, D
 
 /// Base name of a path, for counter keys ("ranges.csv").
 std::string baseName(const std::string& path);
+
+/// What every reader of a time-stamped CSV does: the rows of `path` (columns `required`), a row
+/// whose time does not parse reported (parseRowTime) and skipped, every other row given to
+/// `sample(row, t, key)` (`key` the file's base name, for counters), which returns the sample to
+/// keep or nullopt to skip the row (after reporting why). In file order.
+template <class T, class Sample>
+std::vector<T> readTimedRows(const std::string& path, const std::vector<std::string>& required, Diagnostics& diag,
+                             Sample&& sample) {
+  CsvReader reader(path, required);
+  const std::string key = baseName(path);
+  std::vector<T> out;
+  reader.forEach(
+      [&](const CsvRow& r) {
+        const std::optional<Timestamp> t = parseRowTime(r, key, diag);
+        if (!t) return;
+        if (std::optional<T> s = sample(r, *t, key)) out.push_back(std::move(*s));
+      },
+      diag);
+  return out;
+}
 
 }  // namespace meshnav

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <sstream>
 
 #include "sim/random_stream.h"
@@ -10,31 +9,21 @@
 
 namespace meshnav::sim {
 
-namespace {
-constexpr double kPi = std::numbers::pi;
-}  // namespace
-
 Figure8Trajectory::Figure8Trajectory(const Hall& hall, double duration_s, uint64_t seed)
     : PadFlightTrajectory(PadFlightTiming::forDuration(duration_s)) {
   RandomStream rng(RandomStream::deriveSeed(seed, "trajectory:figure8"));
   const Eigen::Vector3d size = hall.size();
-  const bool x_long = size.x() >= size.y();
-  u_axis_ = x_long ? Eigen::Vector2d::UnitX() : Eigen::Vector2d::UnitY();
-  w_axis_ = x_long ? Eigen::Vector2d::UnitY() : Eigen::Vector2d::UnitX();
-  const double half_u = 0.5 * std::max(size.x(), size.y()), half_w = 0.5 * std::min(size.x(), size.y());
-  amplitude_u_m_ = std::max(0.3, half_u - 0.7) * rng.uniform(0.8, 1.0);
-  amplitude_w_m_ = 2.0 * std::max(0.3, half_w - 0.7) * rng.uniform(0.8, 1.0);  // |B/2 sin 2θ| ≤ B/2
-  center_m_ = Eigen::Vector3d(hall.center().x(), hall.center().y(), kPadHeight_m);
+  axes_ = HallAxes::of(hall);
+  amplitude_u_m_ = axes_.reachU(0.3) * rng.uniform(0.8, 1.0);
+  amplitude_w_m_ = 2.0 * axes_.reachW(0.3) * rng.uniform(0.8, 1.0);  // |B/2 sin 2θ| ≤ B/2
+  center_m_ = centralPad(hall);
   const double pattern_s = timing().pattern_end_s - timing().pattern_start_s;
   loops_ = std::max(1.0, std::round(pattern_s / rng.uniform(20.0, 30.0)));
-  cruise_height_m_ = std::clamp(rng.uniform(0.25, 0.5) * size.z(), 1.0, size.z() - 1.0);
+  cruise_height_m_ = cruiseHeight(hall, rng.uniform(0.25, 0.5));
   z_amplitude_m_ = std::min(0.3, 0.1 * size.z()) * rng.uniform(0.5, 1.0);
   z_period_s_ = rng.uniform(8.0, 14.0);
   z_phase_rad_ = rng.uniform(-kPi, kPi);
-  yaw0_rad_ = rng.uniform(-kPi, kPi);
-  yaw_amplitude_rad_ = rng.uniform(0.2, 0.6);
-  yaw_period_s_ = rng.uniform(15.0, 30.0);
-  yaw_phase_rad_ = rng.uniform(-kPi, kPi);
+  yaw_ = HeadingWobble::draw(rng, 0.2, 0.6, 15.0, 30.0);
 }
 
 TrajectoryState Figure8Trajectory::evaluate(double t_s) const {
@@ -43,19 +32,17 @@ TrajectoryState Figure8Trajectory::evaluate(double t_s) const {
   const PositionJet theta = (2.0 * kPi * loops_) * pattern().progress(t);
   const PositionJet along = amplitude_u_m_ * sin(theta);
   const PositionJet across = (0.5 * amplitude_w_m_) * sin(2.0 * theta);
-  const PositionJet x = center_m_.x() + u_axis_.x() * along + w_axis_.x() * across;
-  const PositionJet y = center_m_.y() + u_axis_.y() * along + w_axis_.y() * across;
+  const auto [x, y] = axes_.point(center_m_, along, across);
   const PositionJet z = center_m_.z() + (cruise_height_m_ - center_m_.z()) * airborne(t) +
                         z_amplitude_m_ * (e * sin(t * (2.0 * kPi / z_period_s_) + z_phase_rad_));
-  const PositionJet psi = yaw0_rad_ + yaw_amplitude_rad_ * (e * sin(t * (2.0 * kPi / yaw_period_s_) + yaw_phase_rad_));
-  return quadrotorState(t_s, {x, y, z}, psi);
+  return quadrotorState(t_s, {x, y, z}, yaw_.at(t, e));
 }
 
 std::string Figure8Trajectory::toString() const {
   std::ostringstream s;
   s << "figure8: " << loops_ << " loops, centre [" << center_m_.x() << ", " << center_m_.y() << "] m, amplitudes "
     << amplitude_u_m_ << " / " << 0.5 * amplitude_w_m_ << " m, cruise " << cruise_height_m_ << " m, z wobble "
-    << z_amplitude_m_ << " m / " << z_period_s_ << " s, yaw0 " << yaw0_rad_ << " rad +- " << yaw_amplitude_rad_
+    << z_amplitude_m_ << " m / " << z_period_s_ << " s, yaw0 " << yaw_.yaw0_rad << " rad +- " << yaw_.amplitude_rad
     << " rad; " << timing().toString();
   return s.str();
 }

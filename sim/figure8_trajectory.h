@@ -13,6 +13,7 @@
 
 #include "sim/hall.h"
 #include "sim/pad_flight_trajectory.h"
+#include "sim/trajectory_jets.h"
 
 namespace meshnav::sim {
 
@@ -26,12 +27,12 @@ class Figure8Trajectory : public PadFlightTrajectory {
 
  private:
   Eigen::Vector3d center_m_;                 ///< c (z = pad height) [m]
-  Eigen::Vector2d u_axis_, w_axis_;          ///< long and short horizontal axes
+  HallAxes axes_;                            ///< long and short horizontal axes
   double amplitude_u_m_ = 0, amplitude_w_m_ = 0;  ///< A, B [m]
   double loops_ = 1;                         ///< n
   double cruise_height_m_ = 2;               ///< h [m]
   double z_amplitude_m_ = 0, z_period_s_ = 10, z_phase_rad_ = 0;
-  double yaw0_rad_ = 0, yaw_amplitude_rad_ = 0, yaw_period_s_ = 20, yaw_phase_rad_ = 0;
+  HeadingWobble yaw_;
 };
 
 }  // namespace meshnav::sim

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <sstream>
 
 #include "sim/random_stream.h"
@@ -10,16 +9,12 @@
 
 namespace meshnav::sim {
 
-namespace {
-constexpr double kPi = std::numbers::pi;
-}  // namespace
-
 HelixTrajectory::HelixTrajectory(const Hall& hall, double duration_s, uint64_t seed)
     : PadFlightTrajectory(PadFlightTiming::forDuration(duration_s)) {
   RandomStream rng(RandomStream::deriveSeed(seed, "trajectory:helix"));
   const Eigen::Vector3d size = hall.size();
-  center_m_ = Eigen::Vector3d(hall.center().x(), hall.center().y(), kPadHeight_m);
-  radius_m_ = std::max(0.5, 0.5 * std::min(size.x(), size.y()) - 0.7) * rng.uniform(0.75, 1.0);
+  center_m_ = centralPad(hall);
+  radius_m_ = HallAxes::of(hall).reachW(0.5) * rng.uniform(0.75, 1.0);
   const double pattern_s = timing().pattern_end_s - timing().pattern_start_s;
   turns_ = std::max(1.0, std::round(pattern_s / rng.uniform(20.0, 30.0)));
   direction_ = rng.bernoulli(0.5) ? 1.0 : -1.0;

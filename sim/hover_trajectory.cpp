@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -10,10 +9,6 @@
 #include "sim/trajectory_jets.h"
 
 namespace meshnav::sim {
-
-namespace {
-constexpr double kPi = std::numbers::pi;
-}  // namespace
 
 HoverTrajectory::HoverTrajectory(const Hall& hall, double duration_s, uint64_t seed) : duration_s_(duration_s) {
   if (!(duration_s > 0.0)) throw std::invalid_argument("HoverTrajectory: duration must be > 0 s");
@@ -32,10 +27,7 @@ HoverTrajectory::HoverTrajectory(const Hall& hall, double duration_s, uint64_t s
     phase1_rad_[i] = rng.uniform(-kPi, kPi);
     phase2_rad_[i] = rng.uniform(-kPi, kPi);
   }
-  yaw0_rad_ = rng.uniform(-kPi, kPi);
-  yaw_amplitude_rad_ = rng.uniform(0.1, 0.5);
-  yaw_period_s_ = rng.uniform(15.0, 40.0);
-  yaw_phase_rad_ = rng.uniform(-kPi, kPi);
+  yaw_ = HeadingWobble::draw(rng, 0.1, 0.5, 15.0, 40.0);
 }
 
 TrajectoryState HoverTrajectory::evaluate(double t_s) const {
@@ -44,14 +36,13 @@ TrajectoryState HoverTrajectory::evaluate(double t_s) const {
   for (int i = 0; i < 3; ++i)
     p[i] = center_m_[i] + amp1_m_[i] * sin(t * (2.0 * kPi / period1_s_[i]) + phase1_rad_[i]) +
            amp2_m_[i] * sin(t * (2.0 * kPi / period2_s_[i]) + phase2_rad_[i]);
-  const PositionJet psi = yaw0_rad_ + yaw_amplitude_rad_ * sin(t * (2.0 * kPi / yaw_period_s_) + yaw_phase_rad_);
-  return quadrotorState(t_s, p, psi);
+  return quadrotorState(t_s, p, yaw_.at(t));
 }
 
 std::string HoverTrajectory::toString() const {
   std::ostringstream s;
   s << "hover: in the air from the start at [" << center_m_.transpose() << "] m, drift amplitudes ["
-    << (amp1_m_ + amp2_m_).transpose() << "] m, yaw0 " << yaw0_rad_ << " rad +- " << yaw_amplitude_rad_
+    << (amp1_m_ + amp2_m_).transpose() << "] m, yaw0 " << yaw_.yaw0_rad << " rad +- " << yaw_.amplitude_rad
     << " rad; " << duration_s_ << " s, no landed phase";
   return s.str();
 }

@@ -12,6 +12,7 @@
 
 #include "sim/hall.h"
 #include "sim/trajectory.h"
+#include "sim/trajectory_jets.h"
 
 namespace meshnav::sim {
 
@@ -30,7 +31,7 @@ class HoverTrajectory : public Trajectory {
   Eigen::Vector3d amp1_m_, amp2_m_;          ///< A, B [m]
   Eigen::Vector3d period1_s_, period2_s_;    ///< P, Q [s]
   Eigen::Vector3d phase1_rad_, phase2_rad_;  ///< φ, χ [rad]
-  double yaw0_rad_ = 0, yaw_amplitude_rad_ = 0, yaw_period_s_ = 20, yaw_phase_rad_ = 0;
+  HeadingWobble yaw_;
 };
 
 }  // namespace meshnav::sim

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <sstream>
 
 #include "sim/random_stream.h"
@@ -11,7 +10,6 @@
 namespace meshnav::sim {
 
 namespace {
-constexpr double kPi = std::numbers::pi;
 constexpr double kShiftShare = 0.4;   ///< T_s / T_l
 constexpr double kReturnShare = 1.5;  ///< T_ret / T_l
 }  // namespace
@@ -19,19 +17,16 @@ constexpr double kReturnShare = 1.5;  ///< T_ret / T_l
 LawnmowerTrajectory::LawnmowerTrajectory(const Hall& hall, double duration_s, uint64_t seed)
     : PadFlightTrajectory(PadFlightTiming::forDuration(duration_s)) {
   RandomStream rng(RandomStream::deriveSeed(seed, "trajectory:lawnmower"));
-  const Eigen::Vector3d size = hall.size();
-  const bool x_long = size.x() >= size.y();
-  u_axis_ = x_long ? Eigen::Vector2d::UnitX() : Eigen::Vector2d::UnitY();
-  w_axis_ = x_long ? Eigen::Vector2d::UnitY() : Eigen::Vector2d::UnitX();
-  half_length_m_ = std::max(0.5, 0.5 * std::max(size.x(), size.y()) - 0.7) * rng.uniform(0.85, 1.0);
-  half_width_m_ = std::max(0.5, 0.5 * std::min(size.x(), size.y()) - 0.7) * rng.uniform(0.85, 1.0);
+  axes_ = HallAxes::of(hall);
+  half_length_m_ = axes_.reachU(0.5) * rng.uniform(0.85, 1.0);
+  half_width_m_ = axes_.reachW(0.5) * rng.uniform(0.85, 1.0);
   lanes_ = std::clamp(static_cast<int>(std::floor(2.0 * half_width_m_ / rng.uniform(0.8, 1.4))) + 1, 2, 6);
-  center_m_ = Eigen::Vector3d(hall.center().x(), hall.center().y(), kPadHeight_m);
+  center_m_ = centralPad(hall);
   const double pattern_s = timing().pattern_end_s - timing().pattern_start_s;
   leg_s_ = pattern_s / (lanes_ + kShiftShare * (lanes_ - 1) + kReturnShare);
   shift_s_ = kShiftShare * leg_s_;
   return_s_ = kReturnShare * leg_s_;
-  cruise_height_m_ = std::clamp(rng.uniform(0.3, 0.5) * size.z(), 1.0, size.z() - 1.0);
+  cruise_height_m_ = cruiseHeight(hall, rng.uniform(0.3, 0.5));
   yaw0_rad_ = rng.uniform(-kPi, kPi);
   yaw_amplitude_rad_ = rng.uniform(0.1, 0.4);
   yaw_period_s_ = rng.uniform(15.0, 30.0);
@@ -55,8 +50,7 @@ TrajectoryState LawnmowerTrajectory::evaluate(double t_s) const {
   const PositionJet back = smoothStep((t - a_ret) / return_s_);
   u = u - (u_end + half_length_m_) * back;
   w = w - (2.0 * half_width_m_) * back;
-  const PositionJet x = center_m_.x() + u_axis_.x() * u + w_axis_.x() * w;
-  const PositionJet y = center_m_.y() + u_axis_.y() * u + w_axis_.y() * w;
+  const auto [x, y] = axes_.point(center_m_, u, w);
   const PositionJet z = center_m_.z() + (cruise_height_m_ - center_m_.z()) * airborne(t);
   const PositionJet e = pattern().envelope(t);
   const PositionJet psi = yaw0_rad_ + yaw_amplitude_rad_ * (e * sin(t * (2.0 * kPi / yaw_period_s_)));

@@ -16,6 +16,7 @@
 
 #include "sim/hall.h"
 #include "sim/pad_flight_trajectory.h"
+#include "sim/trajectory_jets.h"
 
 namespace meshnav::sim {
 
@@ -29,7 +30,7 @@ class LawnmowerTrajectory : public PadFlightTrajectory {
 
  private:
   Eigen::Vector3d center_m_;                 ///< survey area centre (z = pad height) [m]
-  Eigen::Vector2d u_axis_, w_axis_;          ///< long and short horizontal axes
+  HallAxes axes_;                            ///< long and short horizontal axes
   double half_length_m_ = 1, half_width_m_ = 1;  ///< L, W [m]
   int lanes_ = 2;                            ///< n
   double leg_s_ = 10, shift_s_ = 4, return_s_ = 15;  ///< T_l, T_s, T_ret [s]

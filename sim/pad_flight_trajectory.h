@@ -10,7 +10,10 @@
 /// are purely vertical and the flight lands where it took off.
 /// Fractions of the duration T (at T = 140 s: landed 4.9 s, take-off 6.3 s, landing 9.8 s).
 
+#include <algorithm>
 #include <string>
+
+#include "sim/hall.h"
 
 #include "sim/smooth_progress.h"
 #include "sim/trajectory.h"
@@ -41,6 +44,14 @@ class PadFlightTrajectory : public Trajectory {
   static constexpr double kPadHeight_m = 0.12;  ///< z of the IMU while landed [m]
 
   explicit PadFlightTrajectory(const PadFlightTiming& timing);
+  /// The pad in the middle of the hall: its centre at z = kPadHeight_m.
+  static Eigen::Vector3d centralPad(const Hall& hall) {
+    return Eigen::Vector3d(hall.center().x(), hall.center().y(), kPadHeight_m);
+  }
+  /// A cruise height of `share` of the hall's height, at least 1 m from floor and ceiling [m].
+  static double cruiseHeight(const Hall& hall, double share) {
+    return std::clamp(share * hall.size().z(), 1.0, hall.size().z() - 1.0);
+  }
   bool isLanded(double t_s) const override { return t_s <= takeoffTime() || t_s >= touchdownTime(); }
   double duration() const override { return timing_.duration_s; }
   double takeoffTime() const override { return timing_.takeoff_start_s; }

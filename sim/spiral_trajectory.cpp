@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -12,7 +11,6 @@
 namespace meshnav::sim {
 
 namespace {
-constexpr double kPi = std::numbers::pi;
 using JetP = PositionJet;
 }  // namespace
 

@@ -1,5 +1,7 @@
 #include "sim/trajectory_jets.h"
 
+#include <algorithm>
+
 #include "sim/trajectory.h"
 
 namespace meshnav::sim {
@@ -101,6 +103,39 @@ TrajectoryState yawPitchRollState(double t_s, const PositionJet3& p, const Posit
   const Jet3R z_I{cy * sp * cr + sy * sr, sy * sp * cr - cy * sr, cp * cr};
   setAttitude(st, x_I, y_I, z_I);
   return st;
+}
+
+HallAxes HallAxes::of(const Hall& hall) {
+  const Eigen::Vector3d size = hall.size();
+  const bool x_long = size.x() >= size.y();
+  HallAxes a;
+  a.u = x_long ? Eigen::Vector2d::UnitX() : Eigen::Vector2d::UnitY();
+  a.w = x_long ? Eigen::Vector2d::UnitY() : Eigen::Vector2d::UnitX();
+  a.half_u_m = 0.5 * std::max(size.x(), size.y());
+  a.half_w_m = 0.5 * std::min(size.x(), size.y());
+  return a;
+}
+
+std::array<PositionJet, 2> HallAxes::point(const Eigen::Vector3d& c, const PositionJet& a, const PositionJet& b) const {
+  return {c.x() + u.x() * a + w.x() * b, c.y() + u.y() * a + w.y() * b};
+}
+
+HeadingWobble HeadingWobble::draw(RandomStream& rng, double amplitude_lo, double amplitude_hi, double period_lo,
+                                  double period_hi) {
+  HeadingWobble h;
+  h.yaw0_rad = rng.uniform(-kPi, kPi);
+  h.amplitude_rad = rng.uniform(amplitude_lo, amplitude_hi);
+  h.period_s = rng.uniform(period_lo, period_hi);
+  h.phase_rad = rng.uniform(-kPi, kPi);
+  return h;
+}
+
+PositionJet HeadingWobble::at(const PositionJet& t) const {
+  return yaw0_rad + amplitude_rad * sin(t * (2.0 * kPi / period_s) + phase_rad);
+}
+
+PositionJet HeadingWobble::at(const PositionJet& t, const PositionJet& envelope) const {
+  return yaw0_rad + amplitude_rad * (envelope * sin(t * (2.0 * kPi / period_s) + phase_rad));
 }
 
 }  // namespace meshnav::sim

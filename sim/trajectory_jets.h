@@ -12,12 +12,18 @@
 /// Attitude of a hand-held rig from yaw ψ, pitch θ, roll φ:  R_ItoG = R_z(ψ) R_y(θ) R_x(φ).
 /// Rates from the attitude jet: ω_I = vee(Rᵀ Ṙ), α_I = vee(Ṙᵀ Ṙ + Rᵀ R̈) (skew parts).
 
+#include <algorithm>
 #include <array>
+#include <numbers>
 
+#include "sim/hall.h"
+#include "sim/random_stream.h"
 #include "sim/taylor_jet.h"
 #include "sim/trajectory_state.h"
 
 namespace meshnav::sim {
+
+inline constexpr double kPi = std::numbers::pi;
 
 constexpr int kPositionJetOrder = 4;  ///< p, v, a, jerk, snap
 constexpr int kAttitudeJetOrder = 2;  ///< R, Ṙ, R̈
@@ -29,6 +35,36 @@ using PositionJet3 = std::array<PositionJet, 3>;
 PositionJet smoothStep(const PositionJet& u);
 /// I(u) = ∫₀ᵘ S(s) ds: 0 for u ≤ 0, u − ½ for u ≥ 1.
 PositionJet smoothStepIntegral(const PositionJet& u);
+
+/// The horizontal frame of a hall: unit vectors u along its longer side (x when the sides are
+/// equal) and w along the shorter one, and the half lengths of both sides.
+struct HallAxes {
+  Eigen::Vector2d u = Eigen::Vector2d::UnitX(), w = Eigen::Vector2d::UnitY();
+  double half_u_m = 0, half_w_m = 0;
+
+  static constexpr double kWallMargin_m = 0.7;  ///< a pattern's reach stays this far from the walls
+
+  static HallAxes of(const Hall& hall);
+  /// How far a pattern centred in the hall may reach along u (w): the half length less the wall
+  /// margin, at least `min_m` [m].
+  double reachU(double min_m) const { return std::max(min_m, half_u_m - kWallMargin_m); }
+  double reachW(double min_m) const { return std::max(min_m, half_w_m - kWallMargin_m); }
+  /// x and y of the point c + a u + b w (c's z not used).
+  std::array<PositionJet, 2> point(const Eigen::Vector3d& c, const PositionJet& a, const PositionJet& b) const;
+};
+
+/// A quadrotor's heading swinging around ψ₀: ψ = ψ₀ + A_ψ e sin(2πt/P_ψ + φ_ψ), e the pattern's
+/// speed envelope (1 where not given).
+struct HeadingWobble {
+  double yaw0_rad = 0, amplitude_rad = 0, period_s = 20, phase_rad = 0;
+
+  /// ψ₀, A_ψ ∈ [amplitude_lo, amplitude_hi], P_ψ ∈ [period_lo, period_hi], φ_ψ drawn in this order
+  /// (ψ₀ and φ_ψ uniform in [−π, π]); the order is part of what a seed means.
+  static HeadingWobble draw(RandomStream& rng, double amplitude_lo, double amplitude_hi, double period_lo,
+                            double period_hi);
+  PositionJet at(const PositionJet& t) const;
+  PositionJet at(const PositionJet& t, const PositionJet& envelope) const;
+};
 
 /// State of a quadrotor at `t_s` from the position jets p_IinG(t) and the heading jet ψ(t) [rad].
 TrajectoryState quadrotorState(double t_s, const PositionJet3& p_IinG, const PositionJet& yaw_rad);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -12,7 +11,6 @@
 namespace meshnav::sim {
 
 namespace {
-constexpr double kPi = std::numbers::pi;
 constexpr double kDegToRad = kPi / 180.0;
 
 /// Walking window: standing ~3 s at both ends (less for short sequences), 2 s speed ramps.

@@ -10,6 +10,8 @@
 ///   transport::ProcessMain process("estimator", "Fuses ...");
 ///   process.cli().option("heartbeat", heartbeat_s, "...");
 ///   return process.run(argc, argv, [&] { ...; return process.lcm().spin(); });
+/// or, with an options struct and its `declareOptions(Cli&, Options&)`:
+///   return process.run<Options>(argc, argv, declareOptions, [&](Options& o) { ... });
 
 #include <spdlog/spdlog.h>
 
@@ -37,6 +39,17 @@ class ProcessMain {
   /// else $MESHNAV_LOG_LEVEL) and the SIGINT/SIGTERM stop, and runs `body`, whose return value is
   /// the exit code; an exception out of it is logged and gives exit 1.
   int run(int argc, char** argv, const std::function<int()>& body);
+  /// The same with the options held here: `declare(cli(), options)` before parsing, then
+  /// `body(options)`.
+  template <class Options>
+  int run(int argc, char** argv, void (*declare)(Cli&, Options&), const std::function<int(Options&)>& body) {
+    Options options;
+    declare(cli_, options);
+    return run(argc, argv, [&] { return body(options); });
+  }
+  /// Unless `given`, ends run() with exit 2 and "--<option> is required (see --help)": for an
+  /// option the process cannot run without but --print-config can (so CLI11 may not require it).
+  void require(bool given, const std::string& option) const;
 
   /// The LCM instance on --lcm-url (created on first use; throws when LCM cannot start).
   LcmNode& lcm();

@@ -18,7 +18,7 @@
 #include "calibrator/node/calibrator_config.h"
 #include "calibrator/observation_builder.h"
 #include "calibrator/range_model.h"
-#include "common/cli.h"
+#include "common/cli_main.h"
 #include "common/dataset.h"
 #include "common/estimate_io.h"
 #include "common/setup.h"
@@ -144,69 +144,65 @@ std::ofstream openSummary(const std::string& path) {
   return summary;
 }
 
+/// The work of main: every anchor of --anchors calibrated and written to --out.
+int calibrate(const Cli& cli, CalibrateCli& c) {
+  const std::string& dir = c.dataset;
+  Diagnostics diag;
+  const SystemSetup setup = loadSetup(dir + "/setup.yaml");
+  const CalibratorOptions opt = calibratorOptions(cli, c, setup);
+  spdlog::debug("calibrator options:\n{}", opt.toString());
+
+  const auto ranges = readRangesCsv(dir + "/ranges.csv", diag);
+  ObservationBuilder builder(setup, opt);
+  const std::string pose_path = c.poses.empty() ? dir + "/groundtruth.csv" : c.poses;
+  if (looksLikeEstimateCsv(pose_path))
+    builder.setPoses(readEstimateCsv(pose_path, diag));
+  else
+    builder.setPoses(readPosesAuto(pose_path, diag));
+  std::optional<Truth> truth;
+  if (std::filesystem::exists(dir + "/truth.yaml")) truth = loadTruth(dir + "/truth.yaml");
+
+  std::optional<Timestamp> t0, t1;
+  if (cli.given("t-start")) t0 = Timestamp::fromSec(c.t_start_s);
+  if (cli.given("t-end")) t1 = Timestamp::fromSec(c.t_end_s);
+  const Timestamp t_stamp = t1 ? *t1 : (ranges.empty() ? Timestamp{} : ranges.back().t);
+
+  const AnchorCalibrator calibrator(opt);
+  std::vector<CalibrationResult> results;
+  std::ofstream summary = openSummary(c.summary_csv);
+  printHeader(truth.has_value());
+  for (SensorId id : c.anchors) {
+    if (setup.isTag(id)) {
+      spdlog::warn("{} is a tag in setup.yaml; skipped", id);
+      continue;
+    }
+    const bool known = setup.isKnownAnchor(id);
+    if (known) spdlog::info("anchor {} is known in setup.yaml; calibrating it as if unknown", id);
+    const auto obs = builder.collect(id, ranges, diag, t0, t1);
+    // A known anchor's a-priori pair biases were calibrated with its position: not used then.
+    const auto priors = known ? std::map<SensorId, ReferencePrior>{} : builder.priors(id);
+    const auto tic = std::chrono::steady_clock::now();
+    CalibrationResult r = calibrator.calibrate(id, obs, priors, t_stamp);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tic).count();
+    std::optional<TruthFigures> f;
+    if (truth) f = truthFigures(*truth, id, obs, priors, opt, r);
+    printRow(id, r, f);
+    const TruthFigures shown = f.value_or(TruthFigures{});
+    if (summary)
+      summary << c.label << "," << dir << "," << id << "," << toString(r.status) << "," << shown.err << ","
+              << shown.nees << "," << shown.crb << "," << r.n_inliers << "," << r.n_outliers << "," << ms << "\n";
+    results.push_back(std::move(r));
+  }
+  writeCalibrationYaml(results, c.out);
+  if (diag.total() > 0) spdlog::info("input diagnostics: {}", diag.summary());
+  spdlog::info("wrote {}", c.out);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  setupLogging("meshnav_calibrate");
-  Cli cli("meshnav_calibrate", "Offline anchor calibration (optimal double + Levenberg-Marquardt + RANSAC).");
-  CalibrateCli c;
-  declareOptions(cli, c);
-  int code = 0;
-  if (!cli.parse(argc, argv, code)) return code;
-  const std::string& dir = c.dataset;
-  try {
-    Diagnostics diag;
-    const SystemSetup setup = loadSetup(dir + "/setup.yaml");
-    const CalibratorOptions opt = calibratorOptions(cli, c, setup);
-    spdlog::debug("calibrator options:\n{}", opt.toString());
-
-    const auto ranges = readRangesCsv(dir + "/ranges.csv", diag);
-    ObservationBuilder builder(setup, opt);
-    const std::string pose_path = c.poses.empty() ? dir + "/groundtruth.csv" : c.poses;
-    if (looksLikeEstimateCsv(pose_path))
-      builder.setPoses(readEstimateCsv(pose_path, diag));
-    else
-      builder.setPoses(readPosesAuto(pose_path, diag));
-    std::optional<Truth> truth;
-    if (std::filesystem::exists(dir + "/truth.yaml")) truth = loadTruth(dir + "/truth.yaml");
-
-    std::optional<Timestamp> t0, t1;
-    if (cli.given("t-start")) t0 = Timestamp::fromSec(c.t_start_s);
-    if (cli.given("t-end")) t1 = Timestamp::fromSec(c.t_end_s);
-    const Timestamp t_stamp = t1 ? *t1 : (ranges.empty() ? Timestamp{} : ranges.back().t);
-
-    const AnchorCalibrator calibrator(opt);
-    std::vector<CalibrationResult> results;
-    std::ofstream summary = openSummary(c.summary_csv);
-    printHeader(truth.has_value());
-    for (SensorId id : c.anchors) {
-      if (setup.isTag(id)) {
-        spdlog::warn("{} is a tag in setup.yaml; skipped", id);
-        continue;
-      }
-      const bool known = setup.isKnownAnchor(id);
-      if (known) spdlog::info("anchor {} is known in setup.yaml; calibrating it as if unknown", id);
-      const auto obs = builder.collect(id, ranges, diag, t0, t1);
-      // A known anchor's a-priori pair biases were calibrated with its position: not used then.
-      const auto priors = known ? std::map<SensorId, ReferencePrior>{} : builder.priors(id);
-      const auto tic = std::chrono::steady_clock::now();
-      CalibrationResult r = calibrator.calibrate(id, obs, priors, t_stamp);
-      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tic).count();
-      std::optional<TruthFigures> f;
-      if (truth) f = truthFigures(*truth, id, obs, priors, opt, r);
-      printRow(id, r, f);
-      const TruthFigures shown = f.value_or(TruthFigures{});
-      if (summary)
-        summary << c.label << "," << dir << "," << id << "," << toString(r.status) << "," << shown.err << ","
-                << shown.nees << "," << shown.crb << "," << r.n_inliers << "," << r.n_outliers << "," << ms << "\n";
-      results.push_back(std::move(r));
-    }
-    writeCalibrationYaml(results, c.out);
-    if (diag.total() > 0) spdlog::info("input diagnostics: {}", diag.summary());
-    spdlog::info("wrote {}", c.out);
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
-  }
-  return 0;
+  return cliMain<CalibrateCli>(argc, argv, "meshnav_calibrate",
+                               "Offline anchor calibration (optimal double + Levenberg-Marquardt + RANSAC).",
+                               declareOptions, calibrate);
 }

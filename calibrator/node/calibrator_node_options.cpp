@@ -1,47 +1,51 @@
 #include "calibrator/node/calibrator_node_options.h"
 
-#include "common/yaml_options.h"
+#include "common/options_list.h"
 
 #include <sstream>
 #include <stdexcept>
+#include <variant>
 
 namespace meshnav::calib {
 
 namespace {
 
-/// Visits every option as (key, reference) so that reading and printing share one list.
+/// Where an option lives: a pointer to the member, of one of the types its options have.
+using Ref = std::variant<double*, int*, bool*>;
+
+template <auto... path>
+constexpr auto at = &memberAt<CalibratorNodeOptions, Ref, path...>;
+
+/// Every option as (key, member): the one list reading and printing share.
+const OptionField<CalibratorNodeOptions, Ref> kFields[] = {
+    {"auto_mode", at<&CalibratorNodeOptions::auto_mode>},
+    {"auto_min_ranges", at<&CalibratorNodeOptions::auto_min_ranges>},
+    {"auto_min_references", at<&CalibratorNodeOptions::auto_min_references>},
+    {"auto_min_plane_spread", at<&CalibratorNodeOptions::auto_min_plane_spread_m>},
+    {"auto_min_line_spread", at<&CalibratorNodeOptions::auto_min_line_spread_m>},
+    {"auto_check_period", at<&CalibratorNodeOptions::auto_check_period_s>},
+    {"auto_retry_period", at<&CalibratorNodeOptions::auto_retry_period_s>},
+    {"retry_refused", at<&CalibratorNodeOptions::retry_refused>},
+    {"collect_from_start", at<&CalibratorNodeOptions::collect_from_start>},
+    {"history_window", at<&CalibratorNodeOptions::history_window_s>},
+    {"max_ranges_per_anchor", at<&CalibratorNodeOptions::max_ranges_per_anchor>},
+    {"status_period", at<&CalibratorNodeOptions::status_period_s>},
+    {"time_max_offset", at<&CalibratorNodeOptions::time, &TimeGuardOptions::max_offset_s>},
+    {"time_rebase_after", at<&CalibratorNodeOptions::time, &TimeGuardOptions::rebase_after>},
+};
+
+/// Visits every option as (key, field, unit).
 template <typename Opts, typename F>
 void visitOptions(Opts& o, F&& f) {
-  f("auto_mode", o.auto_mode);
-  f("auto_min_ranges", o.auto_min_ranges);
-  f("auto_min_references", o.auto_min_references);
-  f("auto_min_plane_spread", o.auto_min_plane_spread_m);
-  f("auto_min_line_spread", o.auto_min_line_spread_m);
-  f("auto_check_period", o.auto_check_period_s);
-  f("auto_retry_period", o.auto_retry_period_s);
-  f("retry_refused", o.retry_refused);
-  f("collect_from_start", o.collect_from_start);
-  f("history_window", o.history_window_s);
-  f("max_ranges_per_anchor", o.max_ranges_per_anchor);
-  f("status_period", o.status_period_s);
-  f("time_max_offset", o.time.max_offset_s);
-  f("time_rebase_after", o.time.rebase_after);
+  forEachOption(o, kFields, f);
 }
 
 }  // namespace
 
 CalibratorNodeOptions CalibratorNodeOptions::fromYaml(const YAML::Node& node, const std::string& where) {
   // The one rule of common/yaml_options.h (missing: default; unknown or bad: file and key).
-  CalibratorNodeOptions o;
   YamlOptions yaml(node, where, "calibrator_node");
-  visitOptions(o, [&](const char* key, auto& ref) { yaml.read(key, ref); });
-  yaml.rejectUnknown();
-  try {
-    o.validate();
-  } catch (const std::exception& e) {
-    throw std::runtime_error(where + ": " + e.what());
-  }
-  return o;
+  return readOptionsList<CalibratorNodeOptions>(yaml, [](auto& o, auto&& f) { visitOptions(o, f); });
 }
 
 void CalibratorNodeOptions::validate() const {
@@ -62,18 +66,7 @@ void CalibratorNodeOptions::validate() const {
 }
 
 std::string CalibratorNodeOptions::toString() const {
-  std::ostringstream s;
-  auto copy = *this;
-  visitOptions(copy, [&](const char* key, auto& ref) {
-    s << "  " << key << ": ";
-    if constexpr (std::is_same_v<std::remove_reference_t<decltype(ref)>, bool>) {
-      s << (ref ? "true" : "false");
-    } else {
-      s << ref;
-    }
-    s << "\n";
-  });
-  return s.str();
+  return printOptionsList(*this, [](auto& o, auto&& f) { visitOptions(o, f); });
 }
 
 }  // namespace meshnav::calib

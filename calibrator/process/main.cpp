@@ -154,14 +154,10 @@ class CalibratorProcess {
 
 int main(int argc, char** argv) {
   transport::ProcessMain process("calibrator", calib::kCalibratorProcessDescription);
-  calib::CalibratorProcessConfig config;
-  calib::declareCalibratorProcessOptions(process.cli(), config);
-  return process.run(argc, argv, [&] {
+  using Config = calib::CalibratorProcessConfig;
+  return process.run<Config>(argc, argv, calib::declareCalibratorProcessOptions, [&](Config& config) {
     calib::loadCalibratorProcessConfig(config);
-    if (config.setup_path.empty() && !config.print_config) {
-      spdlog::error("--setup is required (see --help)");
-      return 2;
-    }
+    process.require(!config.setup_path.empty() || config.print_config, "setup");
     SystemSetup setup;
     if (!config.setup_path.empty()) {
       setup = loadSetup(config.setup_path);

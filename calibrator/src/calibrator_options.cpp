@@ -1,9 +1,10 @@
 #include "calibrator/calibrator_options.h"
 
-#include "common/yaml_options.h"
+#include "common/options_list.h"
 
 #include <sstream>
 #include <stdexcept>
+#include <variant>
 
 namespace meshnav::calib {
 
@@ -25,95 +26,90 @@ RobustLoss robustLossFromString(const std::string& s) {
 
 namespace {
 
-/// Visits every option as (key, reference) so that reading and printing share one list.
+/// Where an option lives: a pointer to the member, of one of the types its options have.
+using Ref = std::variant<double*, int*, bool*, uint64_t*, RobustLoss*>;
+
+template <auto... path>
+constexpr auto at = &memberAt<CalibratorOptions, Ref, path...>;
+
+/// Every option as (key, member): the one list reading and printing share.
+const OptionField<CalibratorOptions, Ref> kFields[] = {
+    {"sigma_range", at<&CalibratorOptions::sigma_range_m>},
+    {"gamma_prior_sigma", at<&CalibratorOptions::gamma_prior_sigma_m>},
+    {"beta_prior_sigma", at<&CalibratorOptions::beta_prior_sigma>},
+    {"estimate_beta", at<&CalibratorOptions::estimate_beta>},
+    {"beta_min_range_spread", at<&CalibratorOptions::beta_min_range_spread_m>},
+    {"moving_min_spread", at<&CalibratorOptions::moving_min_spread_m>},
+    {"linear_bias_correction", at<&CalibratorOptions::linear_bias_correction>},
+    {"linear_passes", at<&CalibratorOptions::linear_passes>},
+    {"robust_loss", at<&CalibratorOptions::robust_loss>},
+    {"robust_loss_scale", at<&CalibratorOptions::robust_loss_scale>},
+    {"lm_max_iterations", at<&CalibratorOptions::lm_max_iterations>},
+    {"ransac", at<&CalibratorOptions::ransac>},
+    {"ransac_seed", at<&CalibratorOptions::ransac_seed>},
+    {"ransac_threshold_sigmas", at<&CalibratorOptions::ransac_threshold_sigmas>},
+    {"ransac_confidence", at<&CalibratorOptions::ransac_confidence>},
+    {"ransac_min_iterations", at<&CalibratorOptions::ransac_min_iterations>},
+    {"ransac_max_iterations", at<&CalibratorOptions::ransac_max_iterations>},
+    {"ransac_rows_margin", at<&CalibratorOptions::ransac_rows_margin>},
+    {"scale_covariance_by_residuals", at<&CalibratorOptions::scale_covariance_by_residuals>},
+    {"correlated_reference_fraction", at<&CalibratorOptions::correlated_reference_fraction>},
+    {"outlier_threshold_sigmas", at<&CalibratorOptions::outlier_threshold_sigmas>},
+    {"min_measurements", at<&CalibratorOptions::min_measurements>},
+    {"min_measurements_per_reference", at<&CalibratorOptions::min_measurements_per_reference>},
+    {"min_distinct_positions", at<&CalibratorOptions::min_distinct_positions>},
+    {"distinct_position_resolution", at<&CalibratorOptions::distinct_position_resolution_m>},
+    {"min_plane_spread", at<&CalibratorOptions::min_plane_spread_m>},
+    {"min_line_spread", at<&CalibratorOptions::min_line_spread_m>},
+    {"max_position_sigma", at<&CalibratorOptions::max_position_sigma_m>},
+    {"use_range_variance", at<&CalibratorOptions::use_range_variance>},
+    {"max_pose_gap", at<&CalibratorOptions::max_pose_gap_s>},
+    {"min_tag_position_sigma", at<&CalibratorOptions::min_tag_position_sigma_m>},
+};
+
+/// Visits every option as (key, field, unit).
 template <typename Opts, typename F>
 void visitOptions(Opts& o, F&& f) {
-  f("sigma_range", o.sigma_range_m);
-  f("gamma_prior_sigma", o.gamma_prior_sigma_m);
-  f("beta_prior_sigma", o.beta_prior_sigma);
-  f("estimate_beta", o.estimate_beta);
-  f("beta_min_range_spread", o.beta_min_range_spread_m);
-  f("moving_min_spread", o.moving_min_spread_m);
-  f("linear_bias_correction", o.linear_bias_correction);
-  f("linear_passes", o.linear_passes);
-  f("robust_loss", o.robust_loss);
-  f("robust_loss_scale", o.robust_loss_scale);
-  f("lm_max_iterations", o.lm_max_iterations);
-  f("ransac", o.ransac);
-  f("ransac_seed", o.ransac_seed);
-  f("ransac_threshold_sigmas", o.ransac_threshold_sigmas);
-  f("ransac_confidence", o.ransac_confidence);
-  f("ransac_min_iterations", o.ransac_min_iterations);
-  f("ransac_max_iterations", o.ransac_max_iterations);
-  f("ransac_rows_margin", o.ransac_rows_margin);
-  f("scale_covariance_by_residuals", o.scale_covariance_by_residuals);
-  f("correlated_reference_fraction", o.correlated_reference_fraction);
-  f("outlier_threshold_sigmas", o.outlier_threshold_sigmas);
-  f("min_measurements", o.min_measurements);
-  f("min_measurements_per_reference", o.min_measurements_per_reference);
-  f("min_distinct_positions", o.min_distinct_positions);
-  f("distinct_position_resolution", o.distinct_position_resolution_m);
-  f("min_plane_spread", o.min_plane_spread_m);
-  f("min_line_spread", o.min_line_spread_m);
-  f("max_position_sigma", o.max_position_sigma_m);
-  f("use_range_variance", o.use_range_variance);
-  f("max_pose_gap", o.max_pose_gap_s);
-  f("min_tag_position_sigma", o.min_tag_position_sigma_m);
-}
-
-template <typename T>
-std::string printValue(const T& v) {
-  std::ostringstream s;
-  if constexpr (std::is_same_v<T, RobustLoss>) {
-    s << toString(v);
-  } else if constexpr (std::is_same_v<T, bool>) {
-    s << (v ? "true" : "false");
-  } else {
-    s << v;
-  }
-  return s.str();
+  forEachOption(o, kFields, f);
 }
 
 }  // namespace
 
+void readOption(YamlOptions& yaml, const std::string& key, RobustLoss& field) {
+  std::string name = toString(field);
+  yaml.read(key, name);
+  try {
+    field = robustLossFromString(name);
+  } catch (const std::exception& e) {
+    yaml.fail(key, e.what());
+  }
+}
+
+void printOption(std::ostream& os, RobustLoss value) { os << toString(value); }
+
 CalibratorOptions CalibratorOptions::fromYaml(const YAML::Node& node, const std::string& where) {
   // The one rule of common/yaml_options.h (missing: default; unknown or bad: file and key).
-  CalibratorOptions o;
   YamlOptions yaml(node, where, "calibrator");
-  visitOptions(o, [&](const char* key, auto& ref) {
-    if constexpr (std::is_same_v<std::remove_reference_t<decltype(ref)>, RobustLoss>) {
-      std::string name = calib::toString(ref);
-      yaml.read(key, name);
-      try {
-        ref = robustLossFromString(name);
-      } catch (const std::exception& e) {
-        yaml.fail(key, e.what());
-      }
-    } else {
-      yaml.read(key, ref);
-    }
-  });
-  yaml.rejectUnknown();
-  auto positive = [&](double v, const char* key) {
-    if (!(v > 0.0)) throw std::runtime_error(where + ": key 'calibrator." + std::string(key) + "' must be > 0");
+  return readOptionsList<CalibratorOptions>(yaml, [](auto& o, auto&& f) { visitOptions(o, f); });
+}
+
+void CalibratorOptions::validate() const {
+  auto positive = [](double v, const char* key) {
+    if (!(v > 0.0)) throw std::runtime_error("key 'calibrator." + std::string(key) + "' must be > 0");
   };
-  positive(o.sigma_range_m, "sigma_range");
-  positive(o.robust_loss_scale, "robust_loss_scale");
-  positive(o.ransac_threshold_sigmas, "ransac_threshold_sigmas");
-  positive(o.outlier_threshold_sigmas, "outlier_threshold_sigmas");
-  positive(o.distinct_position_resolution_m, "distinct_position_resolution");
-  if (!(o.ransac_confidence > 0.0 && o.ransac_confidence < 1.0))
-    throw std::runtime_error(where + ": key 'calibrator.ransac_confidence' must be in (0, 1)");
-  if (o.ransac_min_iterations < 1 || o.ransac_max_iterations < o.ransac_min_iterations)
-    throw std::runtime_error(where + ": need 1 <= ransac_min_iterations <= ransac_max_iterations");
-  return o;
+  positive(sigma_range_m, "sigma_range");
+  positive(robust_loss_scale, "robust_loss_scale");
+  positive(ransac_threshold_sigmas, "ransac_threshold_sigmas");
+  positive(outlier_threshold_sigmas, "outlier_threshold_sigmas");
+  positive(distinct_position_resolution_m, "distinct_position_resolution");
+  if (!(ransac_confidence > 0.0 && ransac_confidence < 1.0))
+    throw std::runtime_error("key 'calibrator.ransac_confidence' must be in (0, 1)");
+  if (ransac_min_iterations < 1 || ransac_max_iterations < ransac_min_iterations)
+    throw std::runtime_error("need 1 <= ransac_min_iterations <= ransac_max_iterations");
 }
 
 std::string CalibratorOptions::toString() const {
-  std::ostringstream s;
-  auto copy = *this;
-  visitOptions(copy, [&](const char* key, auto& ref) { s << "  " << key << ": " << printValue(ref) << "\n"; });
-  return s.str();
+  return printOptionsList(*this, [](auto& o, auto&& f) { visitOptions(o, f); });
 }
 
 }  // namespace meshnav::calib

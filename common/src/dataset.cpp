@@ -58,27 +58,35 @@ std::ofstream openOut(const std::string& path) {
   return out;
 }
 
+constexpr size_t kCsvLineMax = 256;  ///< longest line a writer formats (an IMU row is about 110)
+
+/// Writes `header`, then for every sample the line `row(sample, buf)` formats into `buf`.
+template <typename T, typename Row>
+void writeCsv(const std::vector<T>& v, const std::string& path, const char* header, Row&& row) {
+  auto out = openOut(path);
+  out << header;
+  char buf[kCsvLineMax];
+  for (const auto& s : v) {
+    row(s, buf);
+    out << buf;
+  }
+}
+
 /// Files `t,<column>` of one number per row; values outside [lo, hi] (or not finite) are reported
 /// as "<file>:bad_value" and dropped. T is a {Timestamp, double} sample.
 template <typename T>
 std::vector<T> readTimeValueCsv(const std::string& path, const char* column, double lo, double hi,
                                 const char* expected, Diagnostics& diag) {
-  CsvReader reader(path, {"t", column});
-  const std::string key = baseName(path);
-  std::vector<T> out;
-  reader.forEach(
-      [&](const CsvRow& r) {
-        auto t = parseRowTime(r, key, diag);
-        if (!t) return;
-        auto v = r.number(column);
-        if (!v || *v < lo || *v > hi) {
-          diag.report(key + ":bad_value", r.where() + ": " + column + " '" + r.text(column) + "' is not " + expected +
-                                              "; row skipped");
-          return;
-        }
-        out.push_back({*t, *v});
-      },
-      diag);
+  const auto sample = [&](const CsvRow& r, Timestamp t, const std::string& key) -> std::optional<T> {
+    auto v = r.number(column);
+    if (!v || *v < lo || *v > hi) {
+      diag.report(key + ":bad_value", r.where() + ": " + column + " '" + r.text(column) + "' is not " + expected +
+                                          "; row skipped");
+      return std::nullopt;
+    }
+    return T{t, *v};
+  };
+  std::vector<T> out = readTimedRows<T>(path, {"t", column}, diag, sample);
   checkOrder(out, path, diag);
   return out;
 }
@@ -87,31 +95,25 @@ std::vector<T> readTimeValueCsv(const std::string& path, const char* column, dou
 
 std::vector<ImuSample> readImuCsv(const std::string& path, Diagnostics& diag) {
   const std::vector<std::string> cols = {"t", "lin_acc_x", "lin_acc_y", "lin_acc_z", "ang_vel_x", "ang_vel_y", "ang_vel_z"};
-  CsvReader reader(path, cols);
-  const std::string key = baseName(path);
-  std::vector<ImuSample> out;
-  reader.forEach(
-      [&](const CsvRow& r) {
-        auto t = parseRowTime(r, key, diag);
-        if (!t) return;
-        double v[6];
-        for (int i = 0; i < 6; ++i) {
-          auto x = r.number(cols[i + 1]);
-          if (!x) {
-            diag.report(key + ":bad_value", r.where() + ": " + cols[i + 1] + " '" + r.text(cols[i + 1]) +
-                                                "' is not a finite number; row skipped");
-            return;
-          }
-          v[i] = *x;
-        }
-        ImuSample s{*t, {v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
-        if (s.acc_m_s2.norm() > plausible::kMaxSpecificForce_m_s2 || s.gyro_rad_s.norm() > plausible::kMaxAngularRate_rad_s) {
-          diag.report(key + ":absurd_value", r.where() + ": IMU reading beyond 500 m/s^2 or 50 rad/s; row skipped");
-          return;
-        }
-        out.push_back(s);
-      },
-      diag);
+  const auto sample = [&](const CsvRow& r, Timestamp t, const std::string& key) -> std::optional<ImuSample> {
+    double v[6];
+    for (int i = 0; i < 6; ++i) {
+      auto x = r.number(cols[i + 1]);
+      if (!x) {
+        diag.report(key + ":bad_value", r.where() + ": " + cols[i + 1] + " '" + r.text(cols[i + 1]) +
+                                            "' is not a finite number; row skipped");
+        return std::nullopt;
+      }
+      v[i] = *x;
+    }
+    ImuSample s{t, {v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+    if (s.acc_m_s2.norm() > plausible::kMaxSpecificForce_m_s2 || s.gyro_rad_s.norm() > plausible::kMaxAngularRate_rad_s) {
+      diag.report(key + ":absurd_value", r.where() + ": IMU reading beyond 500 m/s^2 or 50 rad/s; row skipped");
+      return std::nullopt;
+    }
+    return s;
+  };
+  std::vector<ImuSample> out = readTimedRows<ImuSample>(path, cols, diag, sample);
   checkOrder(out, path, diag);
   return out;
 }
@@ -122,88 +124,77 @@ std::vector<BaroSample> readBaroCsv(const std::string& path, Diagnostics& diag) 
 }
 
 std::vector<RangeSample> readRangesCsv(const std::string& path, Diagnostics& diag, const RangeLimits& limits) {
-  CsvReader reader(path, {"t", "range_raw", "UWB_ID1", "UWB_ID2", "type_ID1", "type_ID2"});
-  const std::string key = baseName(path);
-  std::vector<RangeSample> out;
-  reader.forEach(
-      [&](const CsvRow& r) {
-        auto t = parseRowTime(r, key, diag);
-        if (!t) return;
-        RangeSample s;
-        s.t = *t;
-        auto id1 = parseId(r.text("UWB_ID1"));
-        auto id2 = parseId(r.text("UWB_ID2"));
-        if (!id1 || !id2) {
-          diag.report(key + ":bad_id", r.where() + ": UWB ids '" + r.text("UWB_ID1") + "', '" + r.text("UWB_ID2") +
-                                           "' are not non-negative integers; row skipped");
-          return;
-        }
-        if (*id1 == *id2) {
-          diag.report(key + ":self_range", r.where() + ": range from device " + std::to_string(*id1) +
-                                               " to itself; row skipped");
-          return;
-        }
-        auto ty1 = parseType(r.text("type_ID1"));
-        auto ty2 = parseType(r.text("type_ID2"));
-        if (!ty1 || !ty2) {
-          diag.report(key + ":bad_type", r.where() + ": device types '" + r.text("type_ID1") + "', '" +
-                                             r.text("type_ID2") + "' are not T/A (or 84/65); row skipped");
-          return;
-        }
-        auto z = r.number("range_raw");
-        if (!z) {
-          diag.report(key + ":nan_range", r.where() + ": range '" + r.text("range_raw") +
-                                              "' is not a finite number; row skipped");
-          return;
-        }
-        if (*z < limits.min_m) {
-          diag.report(key + ":negative_range", r.where() + ": range " + r.text("range_raw") + " m is below " +
-                                                   std::to_string(limits.min_m) + " m; row skipped");
-          return;
-        }
-        if (*z > limits.max_m) {
-          diag.report(key + ":absurd_range", r.where() + ": range " + r.text("range_raw") + " m exceeds " +
-                                                 std::to_string(limits.max_m) + " m; row skipped");
-          return;
-        }
-        s.id_initiator = static_cast<SensorId>(*id1);
-        s.id_responder = static_cast<SensorId>(*id2);
-        s.type_initiator = *ty1;
-        s.type_responder = *ty2;
-        s.range_m = *z;
-        s.range_corr_m = r.has("range_corr") ? r.number("range_corr").value_or(0.0) : 0.0;
-        const double R = r.has("R") ? r.number("R").value_or(0.0) : 0.0;
-        s.R_m2 = R > 0.0 ? R : 0.0;
-        if (r.has("LOS")) {
-          const std::string l = r.text("LOS");
-          s.los = !(l == "0" || l == "False" || l == "false");
-        }
-        out.push_back(s);
-      },
-      diag);
+  const auto sample = [&](const CsvRow& r, Timestamp t, const std::string& key) -> std::optional<RangeSample> {
+    RangeSample s;
+    s.t = t;
+    auto id1 = parseId(r.text("UWB_ID1"));
+    auto id2 = parseId(r.text("UWB_ID2"));
+    if (!id1 || !id2) {
+      diag.report(key + ":bad_id", r.where() + ": UWB ids '" + r.text("UWB_ID1") + "', '" + r.text("UWB_ID2") +
+                                       "' are not non-negative integers; row skipped");
+      return std::nullopt;
+    }
+    if (*id1 == *id2) {
+      diag.report(key + ":self_range", r.where() + ": range from device " + std::to_string(*id1) +
+                                           " to itself; row skipped");
+      return std::nullopt;
+    }
+    auto ty1 = parseType(r.text("type_ID1"));
+    auto ty2 = parseType(r.text("type_ID2"));
+    if (!ty1 || !ty2) {
+      diag.report(key + ":bad_type", r.where() + ": device types '" + r.text("type_ID1") + "', '" +
+                                         r.text("type_ID2") + "' are not T/A (or 84/65); row skipped");
+      return std::nullopt;
+    }
+    auto z = r.number("range_raw");
+    if (!z) {
+      diag.report(key + ":nan_range", r.where() + ": range '" + r.text("range_raw") +
+                                          "' is not a finite number; row skipped");
+      return std::nullopt;
+    }
+    if (*z < limits.min_m) {
+      diag.report(key + ":negative_range", r.where() + ": range " + r.text("range_raw") + " m is below " +
+                                               std::to_string(limits.min_m) + " m; row skipped");
+      return std::nullopt;
+    }
+    if (*z > limits.max_m) {
+      diag.report(key + ":absurd_range", r.where() + ": range " + r.text("range_raw") + " m exceeds " +
+                                             std::to_string(limits.max_m) + " m; row skipped");
+      return std::nullopt;
+    }
+    s.id_initiator = static_cast<SensorId>(*id1);
+    s.id_responder = static_cast<SensorId>(*id2);
+    s.type_initiator = *ty1;
+    s.type_responder = *ty2;
+    s.range_m = *z;
+    s.range_corr_m = r.has("range_corr") ? r.number("range_corr").value_or(0.0) : 0.0;
+    const double R = r.has("R") ? r.number("R").value_or(0.0) : 0.0;
+    s.R_m2 = R > 0.0 ? R : 0.0;
+    if (r.has("LOS")) {
+      const std::string l = r.text("LOS");
+      s.los = !(l == "0" || l == "False" || l == "false");
+    }
+    return s;
+  };
+  std::vector<RangeSample> out = readTimedRows<RangeSample>(
+      path, {"t", "range_raw", "UWB_ID1", "UWB_ID2", "type_ID1", "type_ID2"}, diag, sample);
   checkOrder(out, path, diag);
   return out;
 }
 
 std::vector<FlightStateSample> readFlightStateCsv(const std::string& path, Diagnostics& diag) {
-  CsvReader reader(path, {"t", "landed"});
-  const std::string key = baseName(path);
-  std::vector<FlightStateSample> out;
-  reader.forEach(
-      [&](const CsvRow& r) {
-        auto t = parseRowTime(r, key, diag);
-        if (!t) return;
-        const std::string l = r.text("landed");
-        bool landed;
-        if (l == "1" || l == "true" || l == "True") landed = true;
-        else if (l == "0" || l == "false" || l == "False") landed = false;
-        else {
-          diag.report(key + ":bad_value", r.where() + ": landed '" + l + "' is not 0/1; row skipped");
-          return;
-        }
-        out.push_back({*t, landed});
-      },
-      diag);
+  const auto sample = [&](const CsvRow& r, Timestamp t, const std::string& key) -> std::optional<FlightStateSample> {
+    const std::string l = r.text("landed");
+    bool landed;
+    if (l == "1" || l == "true" || l == "True") landed = true;
+    else if (l == "0" || l == "false" || l == "False") landed = false;
+    else {
+      diag.report(key + ":bad_value", r.where() + ": landed '" + l + "' is not 0/1; row skipped");
+      return std::nullopt;
+    }
+    return FlightStateSample{t, landed};
+  };
+  std::vector<FlightStateSample> out = readTimedRows<FlightStateSample>(path, {"t", "landed"}, diag, sample);
   checkOrder(out, path, diag);
   return out;
 }
@@ -214,94 +205,68 @@ std::vector<HeightSample> readHeightCsv(const std::string& path, Diagnostics& di
 
 std::vector<PoseSample> readTumCsv(const std::string& path, Diagnostics& diag) {
   const std::vector<std::string> cols = {"t", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
-  CsvReader reader(path, cols);
-  const std::string key = baseName(path);
-  std::vector<PoseSample> out;
-  reader.forEach(
-      [&](const CsvRow& r) {
-        auto t = parseRowTime(r, key, diag);
-        if (!t) return;
-        double v[7];
-        for (int i = 0; i < 7; ++i) {
-          auto x = r.number(cols[i + 1]);
-          if (!x) {
-            diag.report(key + ":bad_value", r.where() + ": " + cols[i + 1] + " is not a finite number; row skipped");
-            return;
-          }
-          v[i] = *x;
-        }
-        Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
-        if (std::abs(q.norm() - 1.0) > 0.1) {
-          diag.report(key + ":bad_quaternion", r.where() + ": quaternion norm " + std::to_string(q.norm()) +
-                                                   " is far from 1; row skipped");
-          return;
-        }
-        q.normalize();
-        out.push_back({*t, {v[0], v[1], v[2]}, q});
-      },
-      diag);
+  const auto sample = [&](const CsvRow& r, Timestamp t, const std::string& key) -> std::optional<PoseSample> {
+    double v[7];
+    for (int i = 0; i < 7; ++i) {
+      auto x = r.number(cols[i + 1]);
+      if (!x) {
+        diag.report(key + ":bad_value", r.where() + ": " + cols[i + 1] + " is not a finite number; row skipped");
+        return std::nullopt;
+      }
+      v[i] = *x;
+    }
+    Eigen::Quaterniond q(v[6], v[3], v[4], v[5]);
+    if (std::abs(q.norm() - 1.0) > 0.1) {
+      diag.report(key + ":bad_quaternion", r.where() + ": quaternion norm " + std::to_string(q.norm()) +
+                                               " is far from 1; row skipped");
+      return std::nullopt;
+    }
+    q.normalize();
+    return PoseSample{t, {v[0], v[1], v[2]}, q};
+  };
+  std::vector<PoseSample> out = readTimedRows<PoseSample>(path, cols, diag, sample);
   checkOrder(out, path, diag);
   return out;
 }
 
 void writeImuCsv(const std::vector<ImuSample>& v, const std::string& path) {
-  auto out = openOut(path);
-  out << "t,lin_acc_x,lin_acc_y,lin_acc_z,ang_vel_x,ang_vel_y,ang_vel_z\n";
-  char buf[256];
-  for (const auto& s : v) {
-    std::snprintf(buf, sizeof(buf), "%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", formatSeconds(s.t).c_str(), s.acc_m_s2.x(),
+  writeCsv(v, path, "t,lin_acc_x,lin_acc_y,lin_acc_z,ang_vel_x,ang_vel_y,ang_vel_z\n", [](const ImuSample& s, char* buf) {
+    std::snprintf(buf, kCsvLineMax, "%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", formatSeconds(s.t).c_str(), s.acc_m_s2.x(),
                   s.acc_m_s2.y(), s.acc_m_s2.z(), s.gyro_rad_s.x(), s.gyro_rad_s.y(), s.gyro_rad_s.z());
-    out << buf;
-  }
+  });
 }
 
 void writeBaroCsv(const std::vector<BaroSample>& v, const std::string& path) {
-  auto out = openOut(path);
-  out << "t,pressure\n";
-  char buf[96];
-  for (const auto& s : v) {
-    std::snprintf(buf, sizeof(buf), "%s,%.4f\n", formatSeconds(s.t).c_str(), s.pressure_pa);
-    out << buf;
-  }
+  writeCsv(v, path, "t,pressure\n", [](const BaroSample& s, char* buf) {
+    std::snprintf(buf, kCsvLineMax, "%s,%.4f\n", formatSeconds(s.t).c_str(), s.pressure_pa);
+  });
 }
 
 void writeRangesCsv(const std::vector<RangeSample>& v, const std::string& path) {
-  auto out = openOut(path);
-  out << "t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS\n";
-  char buf[192];
-  for (const auto& s : v) {
-    std::snprintf(buf, sizeof(buf), "%s,%.6f,%.6f,%.6g,%d,%d,%c,%c,%d\n", formatSeconds(s.t).c_str(), s.range_m,
+  writeCsv(v, path, "t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS\n", [](const RangeSample& s, char* buf) {
+    std::snprintf(buf, kCsvLineMax, "%s,%.6f,%.6f,%.6g,%d,%d,%c,%c,%d\n", formatSeconds(s.t).c_str(), s.range_m,
                   s.range_corr_m, s.R_m2, s.id_initiator, s.id_responder, static_cast<char>(s.type_initiator),
                   static_cast<char>(s.type_responder), s.los ? 1 : 0);
-    out << buf;
-  }
+  });
 }
 
 void writeFlightStateCsv(const std::vector<FlightStateSample>& v, const std::string& path) {
-  auto out = openOut(path);
-  out << "t,landed\n";
-  for (const auto& s : v) out << formatSeconds(s.t) << "," << (s.landed ? 1 : 0) << "\n";
+  writeCsv(v, path, "t,landed\n", [](const FlightStateSample& s, char* buf) {
+    std::snprintf(buf, kCsvLineMax, "%s,%d\n", formatSeconds(s.t).c_str(), s.landed ? 1 : 0);
+  });
 }
 
 void writeHeightCsv(const std::vector<HeightSample>& v, const std::string& path) {
-  auto out = openOut(path);
-  out << "t,range_m\n";
-  char buf[96];
-  for (const auto& s : v) {
-    std::snprintf(buf, sizeof(buf), "%s,%.9g\n", formatSeconds(s.t).c_str(), s.range_m);
-    out << buf;
-  }
+  writeCsv(v, path, "t,range_m\n", [](const HeightSample& s, char* buf) {
+    std::snprintf(buf, kCsvLineMax, "%s,%.9g\n", formatSeconds(s.t).c_str(), s.range_m);
+  });
 }
 
 void writeTumCsv(const std::vector<PoseSample>& v, const std::string& path) {
-  auto out = openOut(path);
-  out << "#t,tx,ty,tz,qx,qy,qz,qw\n";
-  char buf[256];
-  for (const auto& s : v) {
-    std::snprintf(buf, sizeof(buf), "%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", formatSeconds(s.t).c_str(),
+  writeCsv(v, path, "#t,tx,ty,tz,qx,qy,qz,qw\n", [](const PoseSample& s, char* buf) {
+    std::snprintf(buf, kCsvLineMax, "%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", formatSeconds(s.t).c_str(),
                   s.p_IinG.x(), s.p_IinG.y(), s.p_IinG.z(), s.q_ItoG.x(), s.q_ItoG.y(), s.q_ItoG.z(), s.q_ItoG.w());
-    out << buf;
-  }
+  });
 }
 
 Dataset readDataset(const std::string& dir, Diagnostics& diag, bool with_truth) {

@@ -74,66 +74,55 @@ void AnchorsCsvWriter::write(const AnchorEstimate& a) {
 void AnchorsCsvWriter::flush() { out_.flush(); }
 
 std::vector<PoseEstimate> readEstimateCsv(const std::string& path, Diagnostics& diag) {
-  CsvReader reader(path, {"t", "tx", "ty", "tz", "qx", "qy", "qz", "qw", "pxx", "pxy", "pxz", "pyy", "pyz", "pzz",
-                          "qrr", "qrp", "qry", "qpp", "qpy", "qyy"});
   static const char* const kP[6] = {"pxx", "pxy", "pxz", "pyy", "pyz", "pzz"};
   static const char* const kQ[6] = {"qrr", "qrp", "qry", "qpp", "qpy", "qyy"};
-  const std::string key = baseName(path);
-  std::vector<PoseEstimate> out;
-  reader.forEach(
-      [&](const CsvRow& r) {
-        auto t = parseRowTime(r, key, diag);
-        if (!t) return;
-        auto tx = r.number("tx"), ty = r.number("ty"), tz = r.number("tz");
-        auto qx = r.number("qx"), qy = r.number("qy"), qz = r.number("qz"), qw = r.number("qw");
-        auto P = upper(r, kP);
-        auto Q = upper(r, kQ);
-        if (!tx || !ty || !tz || !qx || !qy || !qz || !qw || !P || !Q) {
-          diag.report(key + ":bad_value", r.where() + ": a value is missing or not finite; row skipped");
-          return;
-        }
-        PoseEstimate e;
-        e.t = *t;
-        e.p_IinG = {*tx, *ty, *tz};
-        const Eigen::Quaterniond q(*qw, *qx, *qy, *qz);
-        if (std::abs(q.norm() - 1.0) > 0.1) {  // as groundtruth.csv: a zero quaternion stays zero
-          diag.report(key + ":bad_quaternion", r.where() + ": quaternion norm " + std::to_string(q.norm()) +
-                                                   " is far from 1; row skipped");
-          return;
-        }
-        e.q_ItoG = q.normalized();
-        e.cov_p_m2 = *P;
-        e.cov_theta_rad2 = *Q;
-        out.push_back(e);
-      },
-      diag);
-  return out;
+  const auto sample = [&](const CsvRow& r, Timestamp t, const std::string& key) -> std::optional<PoseEstimate> {
+    auto tx = r.number("tx"), ty = r.number("ty"), tz = r.number("tz");
+    auto qx = r.number("qx"), qy = r.number("qy"), qz = r.number("qz"), qw = r.number("qw");
+    auto P = upper(r, kP);
+    auto Q = upper(r, kQ);
+    if (!tx || !ty || !tz || !qx || !qy || !qz || !qw || !P || !Q) {
+      diag.report(key + ":bad_value", r.where() + ": a value is missing or not finite; row skipped");
+      return std::nullopt;
+    }
+    PoseEstimate e;
+    e.t = t;
+    e.p_IinG = {*tx, *ty, *tz};
+    const Eigen::Quaterniond q(*qw, *qx, *qy, *qz);
+    if (std::abs(q.norm() - 1.0) > 0.1) {  // as groundtruth.csv: a zero quaternion stays zero
+      diag.report(key + ":bad_quaternion", r.where() + ": quaternion norm " + std::to_string(q.norm()) +
+                                               " is far from 1; row skipped");
+      return std::nullopt;
+    }
+    e.q_ItoG = q.normalized();
+    e.cov_p_m2 = *P;
+    e.cov_theta_rad2 = *Q;
+    return e;
+  };
+  return readTimedRows<PoseEstimate>(path,
+                                     {"t", "tx", "ty", "tz", "qx", "qy", "qz", "qw", "pxx", "pxy", "pxz", "pyy",
+                                      "pyz", "pzz", "qrr", "qrp", "qry", "qpp", "qpy", "qyy"},
+                                     diag, sample);
 }
 
 std::vector<AnchorEstimate> readAnchorsCsv(const std::string& path, Diagnostics& diag) {
-  CsvReader reader(path, {"t", "id", "x", "y", "z", "pxx", "pxy", "pxz", "pyy", "pyz", "pzz"});
   static const char* const kP[6] = {"pxx", "pxy", "pxz", "pyy", "pyz", "pzz"};
-  const std::string key = baseName(path);
-  std::vector<AnchorEstimate> out;
-  reader.forEach(
-      [&](const CsvRow& r) {
-        auto t = parseRowTime(r, key, diag);
-        if (!t) return;
-        auto id = r.number("id"), x = r.number("x"), y = r.number("y"), z = r.number("z");
-        auto P = upper(r, kP);
-        if (!id || !x || !y || !z || !P) {
-          diag.report(key + ":bad_value", r.where() + ": a value is missing or not finite; row skipped");
-          return;
-        }
-        // a cast of anything but a whole number in [0, INT32_MAX] to SensorId is undefined
-        if (*id != std::floor(*id) || *id < 0 || *id > INT32_MAX) {
-          diag.report(key + ":bad_id", r.where() + ": id '" + r.text("id") + "' is not a device id; row skipped");
-          return;
-        }
-        out.push_back({*t, static_cast<SensorId>(*id), {*x, *y, *z}, *P});
-      },
-      diag);
-  return out;
+  const auto sample = [&](const CsvRow& r, Timestamp t, const std::string& key) -> std::optional<AnchorEstimate> {
+    auto id = r.number("id"), x = r.number("x"), y = r.number("y"), z = r.number("z");
+    auto P = upper(r, kP);
+    if (!id || !x || !y || !z || !P) {
+      diag.report(key + ":bad_value", r.where() + ": a value is missing or not finite; row skipped");
+      return std::nullopt;
+    }
+    // a cast of anything but a whole number in [0, INT32_MAX] to SensorId is undefined
+    if (*id != std::floor(*id) || *id < 0 || *id > INT32_MAX) {
+      diag.report(key + ":bad_id", r.where() + ": id '" + r.text("id") + "' is not a device id; row skipped");
+      return std::nullopt;
+    }
+    return AnchorEstimate{t, static_cast<SensorId>(*id), {*x, *y, *z}, *P};
+  };
+  return readTimedRows<AnchorEstimate>(path, {"t", "id", "x", "y", "z", "pxx", "pxy", "pxz", "pyy", "pyz", "pzz"},
+                                       diag, sample);
 }
 
 std::vector<PoseSample> readPosesAuto(const std::string& path, Diagnostics& diag) {

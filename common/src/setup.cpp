@@ -127,6 +127,17 @@ void emitVec(YAML::Emitter& e, const Eigen::Vector3d& v) {
   e << YAML::Flow << YAML::BeginSeq << v.x() << v.y() << v.z() << YAML::EndSeq;
 }
 
+/// `key: {id: [x, y, z], ...}` with `comment`: the counterpart of idVecMap.
+void emitIdVecMap(YAML::Emitter& e, const char* key, const char* comment,
+                  const std::map<SensorId, Eigen::Vector3d>& m) {
+  e << YAML::Key << key << YAML::Comment(comment) << YAML::Value << YAML::BeginMap;
+  for (const auto& [id, p] : m) {
+    e << YAML::Key << id << YAML::Value;
+    emitVec(e, p);
+  }
+  e << YAML::EndMap;
+}
+
 void emitPairBiases(YAML::Emitter& e, const std::vector<PairBias>& biases) {
   e << YAML::BeginSeq;
   for (const auto& b : biases) {
@@ -281,20 +292,8 @@ void saveSetup(const SystemSetup& s, const std::string& path) {
   e << YAML::BeginMap;
   e << YAML::Key << "imu_id" << YAML::Value << s.imu_id;
   e << YAML::Key << "baro_id" << YAML::Value << s.baro_id;
-  e << YAML::Key << "rel_tag_positions" << YAML::Comment("tag position in the IMU frame [m]") << YAML::Value
-    << YAML::BeginMap;
-  for (const auto& [id, p] : s.rel_tag_positions) {
-    e << YAML::Key << id << YAML::Value;
-    emitVec(e, p);
-  }
-  e << YAML::EndMap;
-  e << YAML::Key << "abs_anchor_positions" << YAML::Comment("known anchors in the world frame [m]") << YAML::Value
-    << YAML::BeginMap;
-  for (const auto& [id, p] : s.abs_anchor_positions) {
-    e << YAML::Key << id << YAML::Value;
-    emitVec(e, p);
-  }
-  e << YAML::EndMap;
+  emitIdVecMap(e, "rel_tag_positions", "tag position in the IMU frame [m]", s.rel_tag_positions);
+  emitIdVecMap(e, "abs_anchor_positions", "known anchors in the world frame [m]", s.abs_anchor_positions);
   if (!s.abs_anchor_sigmas_m.empty()) {
     e << YAML::Key << "abs_anchor_sigmas" << YAML::Comment("position sigma of uncertain known anchors [m]")
       << YAML::Value << YAML::BeginMap;
@@ -383,13 +382,7 @@ Truth loadTruth(const std::string& path) {
 void saveTruth(const Truth& t, const std::string& path) {
   YAML::Emitter e;
   e << YAML::BeginMap;
-  e << YAML::Key << "anchor_positions" << YAML::Comment("all anchors, world frame [m]") << YAML::Value
-    << YAML::BeginMap;
-  for (const auto& [id, p] : t.anchor_positions) {
-    e << YAML::Key << id << YAML::Value;
-    emitVec(e, p);
-  }
-  e << YAML::EndMap;
+  emitIdVecMap(e, "anchor_positions", "all anchors, world frame [m]", t.anchor_positions);
   e << YAML::Key << "pair_biases" << YAML::Value;
   emitPairBiases(e, t.pair_biases);
   e << YAML::Key << "scalars" << YAML::Value << YAML::BeginMap;

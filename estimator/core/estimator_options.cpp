@@ -1,211 +1,156 @@
 #include "estimator/core/estimator_options.h"
 #include "estimator/core/strategy_list.h"
 
-#include "common/yaml_options.h"
+#include "common/options_list.h"
 
 
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <variant>
 #include <vector>
 
 namespace meshnav::estimator {
 namespace {
 
-/// forEachField, part: the top-level options and the IMU.
-template <typename Opt, typename Visitor>
-void forEachGeneralField(Opt& o, Visitor& v) {
-  static const std::string strategy_names = strategyNames(" | ");
-  v("strategy", o.strategy, strategy_names.c_str());
-  v("gravity_m_s2", o.gravity_m_s2, "|g| [m/s^2]");
-  v("window_s", o.window_s, "out-of-sequence window [s]");
-  v("pose_output_rate_hz", o.pose_output_rate_hz, "POSE rate, 0 = every IMU step [Hz]");
-  v("anchors_output_rate_hz", o.anchors_output_rate_hz, "ANCHORS rate (data time) [Hz]");
-  v("status_rate_hz", o.status_rate_hz, "ESTIMATOR_STATUS rate (data time) [Hz]");
-  v("joseph_form", o.joseph_form, "Joseph covariance update (false: P - K S K^T, symmetrized)");
-  v("imu.acc_noise_density", o.imu.acc_noise_density, "[m/s^2/sqrt(Hz)]");
-  v("imu.gyro_noise_density", o.imu.gyro_noise_density, "[rad/s/sqrt(Hz)]");
-  v("imu.acc_bias_rw", o.imu.acc_bias_rw, "[m/s^3/sqrt(Hz)]");
-  v("imu.gyro_bias_rw", o.imu.gyro_bias_rw, "[rad/s^2/sqrt(Hz)]");
-  v("imu.max_dt_s", o.imu.max_dt_s, "longer IMU gaps are counted as imu_gap and inflated [s]");
-  v("imu.gap_sigma_acc_m_s2", o.imu.gap_sigma_acc_m_s2, "held-reading error during a gap [m/s^2/sqrt(s)]");
-  v("imu.gap_sigma_gyro_rad_s", o.imu.gap_sigma_gyro_rad_s, "held-reading error during a gap [rad/s/sqrt(s)]");
-}
+/// Where an option lives: a pointer to the member, of one of the types an option may have.
+using FieldRef = std::variant<double*, int*, bool*, std::string*>;
+using Field = OptionField<EstimatorOptions, FieldRef>;
 
-/// forEachField, part: initialization (static, in motion, resume).
-template <typename Opt, typename Visitor>
-void forEachInitField(Opt& o, Visitor& v) {
-  v("init.duration_s", o.init.duration_s, "landed data before initializing [s]");
-  v("init.min_ranges", o.init.min_ranges, "tag-anchor ranges needed without initial_pose [-]");
-  v("init.assume_landed_without_flight_state", o.init.assume_landed_without_flight_state,
-    "no FLIGHT_STATE received yet: treat as landed (else IMU stillness decides)");
-  v("init.sigma_v_m_s", o.init.sigma_v_m_s, "[m/s]");
-  v("init.sigma_roll_pitch_deg", o.init.sigma_roll_pitch_deg, "[deg]");
-  v("init.sigma_bias_gyro_rad_s", o.init.sigma_bias_gyro_rad_s, "[rad/s]");
-  v("init.sigma_bias_acc_m_s2", o.init.sigma_bias_acc_m_s2, "[m/s^2]");
-  v("init.range_init_min_sigma_p_m", o.init.range_init_min_sigma_p_m, "floor of position sigma from ranges [m]");
-  v("init.range_init_sigma_yaw_deg", o.init.range_init_sigma_yaw_deg, "yaw sigma when initialized from ranges [deg]");
-  v("init.range_init_outlier_m", o.init.range_init_outlier_m, "init range residual treated as outlier [m]");
-  v("init.static_max_sigma_yaw_deg", o.init.static_max_sigma_yaw_deg, "static range fit refused above [deg]");
-  v("init.ambiguity_chi2", o.init.ambiguity_chi2, "second fit minimum within this cost: ambiguous, refused [-]");
-  v("init.motion_window_s", o.init.motion_window_s, "in-motion alignment window [s]");
-  v("init.motion_max_window_s", o.init.motion_max_window_s,
-    "in-motion alignment: longest window when ranges are sparse (count-based) [s]");
-  v("init.motion_min_span_s", o.init.motion_min_span_s, "in-motion alignment shortest window [s]");
-  v("init.motion_min_ranges", o.init.motion_min_ranges, "in-motion alignment ranges needed [-]");
-  v("init.motion_max_sigma_yaw_deg", o.init.motion_max_sigma_yaw_deg, "in-motion alignment refused above [deg]");
-  v("init.motion_max_sigma_p_m", o.init.motion_max_sigma_p_m, "in-motion alignment refused above [m]");
-  v("init.motion_relinearize_rad", o.init.motion_relinearize_rad,
-    "in-motion alignment: re-integrate at the fitted gyro bias when it turns the attitude more than this over the window, 0 = never [rad]");
-  v("init.motion_use_baro", o.init.motion_use_baro,
-    "baro heights (setup reference pressure given) constrain the in-motion alignment's height");
-  v("init.resume_max_age_s", o.init.resume_max_age_s, "a restart resumes from a checkpoint at most this old [s]");
-  v("init.resume_max_outage_s", o.init.resume_max_outage_s, "longer restart outages re-initialize the pose (anchors kept) [s]");
-  v("init.resume_max_acc_m_s2", o.init.resume_max_acc_m_s2, "largest acceleration during a restart's outage [m/s^2]");
-  v("init.resume_max_rate_deg_s", o.init.resume_max_rate_deg_s, "largest rotation rate during a restart's outage [deg/s]");
-}
+template <auto... path>
+constexpr auto field = &memberAt<EstimatorOptions, FieldRef, path...>;
 
-/// forEachField, part: barometer and height sensor.
-template <typename Opt, typename Visitor>
-void forEachAltitudeField(Opt& o, Visitor& v) {
-  v("baro.enabled", o.baro.enabled, "");
-  v("baro.pressure_sigma_pa", o.baro.pressure_sigma_pa, "[Pa]");
-  v("baro.bias_rw_m_per_sqrt_s", o.baro.bias_rw_m_per_sqrt_s, "height bias random walk [m/sqrt(s)]");
-  v("baro.init_bias_sigma_m", o.baro.init_bias_sigma_m, "bias sigma with a given reference pressure [m]");
-  v("baro.gate_probability", o.baro.gate_probability, "chi^2 gate, 0 = off [-]");
-  v("height.enabled", o.height.enabled, "downward rangefinder (height.csv)");
-  v("height.sigma_m", o.height.sigma_m, "range noise sigma [m]");
-  v("height.bias_rw_m_per_sqrt_s", o.height.bias_rw_m_per_sqrt_s, "bias random walk [m/sqrt(s)]");
-  v("height.init_bias_sigma_m", o.height.init_bias_sigma_m, "prior sigma of the bias around 0 [m]");
-  v("height.gate_probability", o.height.gate_probability, "chi^2 gate, 0 = off [-]");
-  v("height.min_range_m", o.height.min_range_m, "shorter readings are not used (clamped at the sensor's minimum) [m]");
-  v("height.tilt_correction", o.height.tilt_correction, "h = p_z / cos(tilt) (false: h = p_z)");
-  v("height.max_tilt_deg", o.height.max_tilt_deg, "not used while tilted more [deg]");
-  v("height.align_rate_hz", o.height.align_rate_hz, "rate fed to the in-motion alignment, 0 = not used there [Hz]");
-  v("carried_height.enabled", o.carried_height.enabled, "used when setup.yaml has carried_height (hand-held rig)");
-  v("carried_height.rate_hz", o.carried_height.rate_hz, "pseudo-readings per second of IMU time [Hz]");
-  v("carried_height.sigma_m", o.carried_height.sigma_m, "sigma of one reading (gait bob and sway) [m]");
-  v("carried_height.bias_rw_m_per_sqrt_s", o.carried_height.bias_rw_m_per_sqrt_s,
-    "random walk of the carrying height [m/sqrt(s)]");
-}
+/// The strategies, as the shipped file's comment on `strategy` lists them.
+const std::string kStrategyNames = strategyNames(" | ");
 
-/// forEachField, part: UWB ranges.
-template <typename Opt, typename Visitor>
-void forEachUwbField(Opt& o, Visitor& v) {
-  v("uwb.enabled", o.uwb.enabled, "");
-  v("uwb.sigma_range_m", o.uwb.sigma_range_m, "fallback range sigma [m]");
-  v("uwb.gate_probability", o.uwb.gate_probability, "chi^2 gate, 0 = off [-]");
-  v("uwb.use_corrected_range", o.uwb.use_corrected_range, "fuse range_corr instead of range_raw");
-  v("uwb.max_range_m", o.uwb.max_range_m, "longer ranges are bad input [m]");
-  v("uwb.estimate_tag_biases", o.uwb.estimate_tag_biases, "estimate tag-anchor gamma (setup anchors, sigma_gamma > 0) as states");
-  v("uwb.estimate_anchor_biases", o.uwb.estimate_anchor_biases,
-    "estimate a calibrated anchor's gamma (ANCHOR_INIT, sigma_gamma > 0) as states of its instance");
-  v("uwb.anchor_bias_joint_covariance", o.uwb.anchor_bias_joint_covariance,
-    "initialize them with the calibration's joint covariance of position and gamma");
-  v("uwb.estimate_setup_anchor_biases", o.uwb.estimate_setup_anchor_biases,
-    "the same for known-but-uncertain setup anchors (towards exact and smaller-id uncertain anchors)");
-  v("uwb.fuse_calibrated_anchor_pairs", o.uwb.fuse_calibrated_anchor_pairs,
-    "fuse ranges between two calibrated anchors (their correlated calibration errors are not known)");
-  v("uwb.dah_fuse_estimated_anchor_pairs", o.uwb.dah_fuse_estimated_anchor_pairs,
-    "dah only: fuse ranges between two estimated anchors (overconfident, see docs)");
-  v("uwb.dah_joint_anchors", o.uwb.dah_joint_anchors,
-    "dah only: anchors updated jointly: none | batch (added together, e.g. by a re-run) | all");
-  v("uwb.dah_joint_tag_biases", o.uwb.dah_joint_tag_biases,
-    "dah only: the tags' gamma instances join the anchors' joint set (merges the batches into one)");
-  v("uwb.dah_joint_imu", o.uwb.dah_joint_imu,
-    "dah only: the IMU (with the baro and height biases) joins that set too (every pose update also corrects its anchors)");
-  v("uwb.dah_joint_max_anchors", o.uwb.dah_joint_max_anchors,
-    "dah only: most estimated anchors in a joint set, the most refined leave first, 0 = no bound [-]");
-  v("uwb.reentry_gap_s", o.uwb.reentry_gap_s, "no tag range accepted for this long: hold and cross-check the next ones, 0 = off [s]");
-  v("uwb.reentry_hold_s", o.uwb.reentry_hold_s, "longest hold after a gap, at most window_s [s]");
-  v("uwb.reentry_min_ranges", o.uwb.reentry_min_ranges, "held ranges needed to test them against each other [-]");
-  v("uwb.reentry_min_anchors", o.uwb.reentry_min_anchors, "distinct anchors among them [-]");
-  v("uwb.reentry_gate_probability", o.uwb.reentry_gate_probability, "leave-one-out chi^2 gate of a held range [-]");
-}
+/// Every option, in the order of the shipped file (config/estimator.yaml): the single list used
+/// for loading, printing and that file, so they cannot drift apart.
+const Field kFields[] = {
+    {"strategy", field<&EstimatorOptions::strategy>, kStrategyNames.c_str()},
+    {"gravity_m_s2", field<&EstimatorOptions::gravity_m_s2>, "|g| [m/s^2]"},
+    {"window_s", field<&EstimatorOptions::window_s>, "out-of-sequence window [s]"},
+    {"pose_output_rate_hz", field<&EstimatorOptions::pose_output_rate_hz>, "POSE rate, 0 = every IMU step [Hz]"},
+    {"anchors_output_rate_hz", field<&EstimatorOptions::anchors_output_rate_hz>, "ANCHORS rate (data time) [Hz]"},
+    {"status_rate_hz", field<&EstimatorOptions::status_rate_hz>, "ESTIMATOR_STATUS rate (data time) [Hz]"},
+    {"joseph_form", field<&EstimatorOptions::joseph_form>, "Joseph covariance update (false: P - K S K^T, symmetrized)"},
+    {"imu.acc_noise_density", field<&EstimatorOptions::imu, &ImuNoiseOptions::acc_noise_density>, "[m/s^2/sqrt(Hz)]"},
+    {"imu.gyro_noise_density", field<&EstimatorOptions::imu, &ImuNoiseOptions::gyro_noise_density>, "[rad/s/sqrt(Hz)]"},
+    {"imu.acc_bias_rw", field<&EstimatorOptions::imu, &ImuNoiseOptions::acc_bias_rw>, "[m/s^3/sqrt(Hz)]"},
+    {"imu.gyro_bias_rw", field<&EstimatorOptions::imu, &ImuNoiseOptions::gyro_bias_rw>, "[rad/s^2/sqrt(Hz)]"},
+    {"imu.max_dt_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::max_dt_s>, "longer IMU gaps are counted as imu_gap and inflated [s]"},
+    {"imu.gap_sigma_acc_m_s2", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_sigma_acc_m_s2>, "held-reading error during a gap [m/s^2/sqrt(s)]"},
+    {"imu.gap_sigma_gyro_rad_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_sigma_gyro_rad_s>, "held-reading error during a gap [rad/s/sqrt(s)]"},
+    {"init.duration_s", field<&EstimatorOptions::init, &InitOptions::duration_s>, "landed data before initializing [s]"},
+    {"init.min_ranges", field<&EstimatorOptions::init, &InitOptions::min_ranges>, "tag-anchor ranges needed without initial_pose [-]"},
+    {"init.assume_landed_without_flight_state", field<&EstimatorOptions::init, &InitOptions::assume_landed_without_flight_state>, "no FLIGHT_STATE received yet: treat as landed (else IMU stillness decides)"},
+    {"init.sigma_v_m_s", field<&EstimatorOptions::init, &InitOptions::sigma_v_m_s>, "[m/s]"},
+    {"init.sigma_roll_pitch_deg", field<&EstimatorOptions::init, &InitOptions::sigma_roll_pitch_deg>, "[deg]"},
+    {"init.sigma_bias_gyro_rad_s", field<&EstimatorOptions::init, &InitOptions::sigma_bias_gyro_rad_s>, "[rad/s]"},
+    {"init.sigma_bias_acc_m_s2", field<&EstimatorOptions::init, &InitOptions::sigma_bias_acc_m_s2>, "[m/s^2]"},
+    {"init.range_init_min_sigma_p_m", field<&EstimatorOptions::init, &InitOptions::range_init_min_sigma_p_m>, "floor of position sigma from ranges [m]"},
+    {"init.range_init_sigma_yaw_deg", field<&EstimatorOptions::init, &InitOptions::range_init_sigma_yaw_deg>, "yaw sigma when initialized from ranges [deg]"},
+    {"init.range_init_outlier_m", field<&EstimatorOptions::init, &InitOptions::range_init_outlier_m>, "init range residual treated as outlier [m]"},
+    {"init.static_max_sigma_yaw_deg", field<&EstimatorOptions::init, &InitOptions::static_max_sigma_yaw_deg>, "static range fit refused above [deg]"},
+    {"init.ambiguity_chi2", field<&EstimatorOptions::init, &InitOptions::ambiguity_chi2>, "second fit minimum within this cost: ambiguous, refused [-]"},
+    {"init.motion_window_s", field<&EstimatorOptions::init, &InitOptions::motion_window_s>, "in-motion alignment window [s]"},
+    {"init.motion_max_window_s", field<&EstimatorOptions::init, &InitOptions::motion_max_window_s>, "in-motion alignment: longest window when ranges are sparse (count-based) [s]"},
+    {"init.motion_min_span_s", field<&EstimatorOptions::init, &InitOptions::motion_min_span_s>, "in-motion alignment shortest window [s]"},
+    {"init.motion_min_ranges", field<&EstimatorOptions::init, &InitOptions::motion_min_ranges>, "in-motion alignment ranges needed [-]"},
+    {"init.motion_max_sigma_yaw_deg", field<&EstimatorOptions::init, &InitOptions::motion_max_sigma_yaw_deg>, "in-motion alignment refused above [deg]"},
+    {"init.motion_max_sigma_p_m", field<&EstimatorOptions::init, &InitOptions::motion_max_sigma_p_m>, "in-motion alignment refused above [m]"},
+    {"init.motion_relinearize_rad", field<&EstimatorOptions::init, &InitOptions::motion_relinearize_rad>, "in-motion alignment: re-integrate at the fitted gyro bias when it turns the attitude more than this over the window, 0 = never [rad]"},
+    {"init.motion_use_baro", field<&EstimatorOptions::init, &InitOptions::motion_use_baro>, "baro heights (setup reference pressure given) constrain the in-motion alignment's height"},
+    {"init.resume_max_age_s", field<&EstimatorOptions::init, &InitOptions::resume_max_age_s>, "a restart resumes from a checkpoint at most this old [s]"},
+    {"init.resume_max_outage_s", field<&EstimatorOptions::init, &InitOptions::resume_max_outage_s>, "longer restart outages re-initialize the pose (anchors kept) [s]"},
+    {"init.resume_max_acc_m_s2", field<&EstimatorOptions::init, &InitOptions::resume_max_acc_m_s2>, "largest acceleration during a restart's outage [m/s^2]"},
+    {"init.resume_max_rate_deg_s", field<&EstimatorOptions::init, &InitOptions::resume_max_rate_deg_s>, "largest rotation rate during a restart's outage [deg/s]"},
+    {"baro.enabled", field<&EstimatorOptions::baro, &BaroOptions::enabled>, ""},
+    {"baro.pressure_sigma_pa", field<&EstimatorOptions::baro, &BaroOptions::pressure_sigma_pa>, "[Pa]"},
+    {"baro.bias_rw_m_per_sqrt_s", field<&EstimatorOptions::baro, &BaroOptions::bias_rw_m_per_sqrt_s>, "height bias random walk [m/sqrt(s)]"},
+    {"baro.init_bias_sigma_m", field<&EstimatorOptions::baro, &BaroOptions::init_bias_sigma_m>, "bias sigma with a given reference pressure [m]"},
+    {"baro.gate_probability", field<&EstimatorOptions::baro, &BaroOptions::gate_probability>, "chi^2 gate, 0 = off [-]"},
+    {"height.enabled", field<&EstimatorOptions::height, &HeightOptions::enabled>, "downward rangefinder (height.csv)"},
+    {"height.sigma_m", field<&EstimatorOptions::height, &HeightOptions::sigma_m>, "range noise sigma [m]"},
+    {"height.bias_rw_m_per_sqrt_s", field<&EstimatorOptions::height, &HeightOptions::bias_rw_m_per_sqrt_s>, "bias random walk [m/sqrt(s)]"},
+    {"height.init_bias_sigma_m", field<&EstimatorOptions::height, &HeightOptions::init_bias_sigma_m>, "prior sigma of the bias around 0 [m]"},
+    {"height.gate_probability", field<&EstimatorOptions::height, &HeightOptions::gate_probability>, "chi^2 gate, 0 = off [-]"},
+    {"height.min_range_m", field<&EstimatorOptions::height, &HeightOptions::min_range_m>, "shorter readings are not used (clamped at the sensor's minimum) [m]"},
+    {"height.tilt_correction", field<&EstimatorOptions::height, &HeightOptions::tilt_correction>, "h = p_z / cos(tilt) (false: h = p_z)"},
+    {"height.max_tilt_deg", field<&EstimatorOptions::height, &HeightOptions::max_tilt_deg>, "not used while tilted more [deg]"},
+    {"height.align_rate_hz", field<&EstimatorOptions::height, &HeightOptions::align_rate_hz>, "rate fed to the in-motion alignment, 0 = not used there [Hz]"},
+    {"carried_height.enabled", field<&EstimatorOptions::carried_height, &CarriedHeightOptions::enabled>, "used when setup.yaml has carried_height (hand-held rig)"},
+    {"carried_height.rate_hz", field<&EstimatorOptions::carried_height, &CarriedHeightOptions::rate_hz>, "pseudo-readings per second of IMU time [Hz]"},
+    {"carried_height.sigma_m", field<&EstimatorOptions::carried_height, &CarriedHeightOptions::sigma_m>, "sigma of one reading (gait bob and sway) [m]"},
+    {"carried_height.bias_rw_m_per_sqrt_s", field<&EstimatorOptions::carried_height, &CarriedHeightOptions::bias_rw_m_per_sqrt_s>, "random walk of the carrying height [m/sqrt(s)]"},
+    {"uwb.enabled", field<&EstimatorOptions::uwb, &UwbOptions::enabled>, ""},
+    {"uwb.sigma_range_m", field<&EstimatorOptions::uwb, &UwbOptions::sigma_range_m>, "fallback range sigma [m]"},
+    {"uwb.gate_probability", field<&EstimatorOptions::uwb, &UwbOptions::gate_probability>, "chi^2 gate, 0 = off [-]"},
+    {"uwb.use_corrected_range", field<&EstimatorOptions::uwb, &UwbOptions::use_corrected_range>, "fuse range_corr instead of range_raw"},
+    {"uwb.max_range_m", field<&EstimatorOptions::uwb, &UwbOptions::max_range_m>, "longer ranges are bad input [m]"},
+    {"uwb.estimate_tag_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_tag_biases>, "estimate tag-anchor gamma (setup anchors, sigma_gamma > 0) as states"},
+    {"uwb.estimate_anchor_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_anchor_biases>, "estimate a calibrated anchor's gamma (ANCHOR_INIT, sigma_gamma > 0) as states of its instance"},
+    {"uwb.anchor_bias_joint_covariance", field<&EstimatorOptions::uwb, &UwbOptions::anchor_bias_joint_covariance>, "initialize them with the calibration's joint covariance of position and gamma"},
+    {"uwb.estimate_setup_anchor_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_setup_anchor_biases>, "the same for known-but-uncertain setup anchors (towards exact and smaller-id uncertain anchors)"},
+    {"uwb.fuse_calibrated_anchor_pairs", field<&EstimatorOptions::uwb, &UwbOptions::fuse_calibrated_anchor_pairs>, "fuse ranges between two calibrated anchors (their correlated calibration errors are not known)"},
+    {"uwb.dah_fuse_estimated_anchor_pairs", field<&EstimatorOptions::uwb, &UwbOptions::dah_fuse_estimated_anchor_pairs>, "dah only: fuse ranges between two estimated anchors (overconfident, see docs)"},
+    {"uwb.dah_joint_anchors", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_anchors>, "dah only: anchors updated jointly: none | batch (added together, e.g. by a re-run) | all"},
+    {"uwb.dah_joint_tag_biases", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_tag_biases>, "dah only: the tags' gamma instances join the anchors' joint set (merges the batches into one)"},
+    {"uwb.dah_joint_imu", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_imu>, "dah only: the IMU (with the baro and height biases) joins that set too (every pose update also corrects its anchors)"},
+    {"uwb.dah_joint_max_anchors", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_max_anchors>, "dah only: most estimated anchors in a joint set, the most refined leave first, 0 = no bound [-]"},
+    {"uwb.reentry_gap_s", field<&EstimatorOptions::uwb, &UwbOptions::reentry_gap_s>, "no tag range accepted for this long: hold and cross-check the next ones, 0 = off [s]"},
+    {"uwb.reentry_hold_s", field<&EstimatorOptions::uwb, &UwbOptions::reentry_hold_s>, "longest hold after a gap, at most window_s [s]"},
+    {"uwb.reentry_min_ranges", field<&EstimatorOptions::uwb, &UwbOptions::reentry_min_ranges>, "held ranges needed to test them against each other [-]"},
+    {"uwb.reentry_min_anchors", field<&EstimatorOptions::uwb, &UwbOptions::reentry_min_anchors>, "distinct anchors among them [-]"},
+    {"uwb.reentry_gate_probability", field<&EstimatorOptions::uwb, &UwbOptions::reentry_gate_probability>, "leave-one-out chi^2 gate of a held range [-]"},
+    {"zupt.enabled", field<&EstimatorOptions::zupt, &ZuptOptions::enabled>, ""},
+    {"zupt.rate_hz", field<&EstimatorOptions::zupt, &ZuptOptions::rate_hz>, "pseudo-measurement rate while landed [Hz]"},
+    {"zupt.sigma_acc_m_s2", field<&EstimatorOptions::zupt, &ZuptOptions::sigma_acc_m_s2>, "sigma of a = 0 [m/s^2]"},
+    {"zupt.sigma_gyro_rad_s", field<&EstimatorOptions::zupt, &ZuptOptions::sigma_gyro_rad_s>, "rest rotation allowed while landed; the omega row fuses the mean gyro since the last ZUPT with sigma^2 = this^2 + gyro_noise_density^2/T [rad/s]"},
+    {"zupt.sigma_vel_m_s", field<&EstimatorOptions::zupt, &ZuptOptions::sigma_vel_m_s>, "sigma of v = 0 [m/s]"},
+    {"zupt.detect_stillness", field<&EstimatorOptions::zupt, &ZuptOptions::detect_stillness>, "without FLIGHT_STATE: ZUPT while the IMU shows rest"},
+    {"zupt.stillness_gate_probability", field<&EstimatorOptions::zupt, &ZuptOptions::stillness_gate_probability>, "chi^2 gate of those ZUPTs [-]"},
+    {"zupt.stillness_sigma_vel_m_s", field<&EstimatorOptions::zupt, &ZuptOptions::stillness_sigma_vel_m_s>, "sigma of v = 0 when only IMU stillness says rest (a smooth hover drifts) [m/s]"},
+    {"zupt.stillness_sigma_gyro_rad_s", field<&EstimatorOptions::zupt, &ZuptOptions::stillness_sigma_gyro_rad_s>, "sigma of omega = 0 and of the initial gyro bias on stillness alone [rad/s]"},
+    {"health.window_s", field<&EstimatorOptions::health, &HealthOptions::window_s>, "innovation statistics window [s]"},
+    {"health.min_ranges", field<&EstimatorOptions::health, &HealthOptions::min_ranges>, "ranges in the window before gating can mean lost [-]"},
+    {"health.min_anchors", field<&EstimatorOptions::health, &HealthOptions::min_anchors>, "anchors gated alike before it means lost [-]"},
+    {"health.degraded_gated_fraction", field<&EstimatorOptions::health, &HealthOptions::degraded_gated_fraction>, "[-]"},
+    {"health.lost_gated_fraction", field<&EstimatorOptions::health, &HealthOptions::lost_gated_fraction>, "[-]"},
+    {"health.degraded_mean_nis", field<&EstimatorOptions::health, &HealthOptions::degraded_mean_nis>, "mean NIS of accepted ranges, 1 if consistent [-]"},
+    {"health.degraded_no_aiding_s", field<&EstimatorOptions::health, &HealthOptions::degraded_no_aiding_s>, "no accepted range for this long: degraded [s]"},
+    {"health.lost_no_aiding_s", field<&EstimatorOptions::health, &HealthOptions::lost_no_aiding_s>, "no accepted range for this long: lost [s]"},
+    {"health.lost_sigma_p_m", field<&EstimatorOptions::health, &HealthOptions::lost_sigma_p_m>, "largest position sigma beyond which the pose is lost [m]"},
+    {"health.hold_s", field<&EstimatorOptions::health, &HealthOptions::hold_s>, "a better health must hold this long [s]"},
+    {"process_noise.adapt", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::enabled>, "scale the IMU noise densities to the range innovations"},
+    {"process_noise.batch", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::batch>, "tag-anchor ranges per decision [-]"},
+    {"process_noise.upper_ratio", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::upper_ratio>, "median NIS ratio above which the scale grows [-]"},
+    {"process_noise.lower_ratio", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::lower_ratio>, "median NIS ratio below which the scale shrinks [-]"},
+    {"process_noise.max_grow", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::max_grow>, "largest growth of the scale per decision (factor) [-]"},
+    {"process_noise.max_shrink", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::max_shrink>, "largest shrink of the scale per decision (factor) [-]"},
+    {"process_noise.max_scale", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::max_scale>, "largest variance scale [-]"},
+    {"process_noise.max_prior_ratio", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::max_prior_ratio>, "no growth while the median predicted range variance HPH'/R exceeds this [-]"},
+    {"process_noise.confirm_batches", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::confirm_batches>, "consecutive batches above upper_ratio before the scale grows (by the smallest of their ratios) [-]"},
+    {"process_noise.grow_at_once_ratio", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::grow_at_once_ratio>, "a batch whose median NIS ratio exceeds this grows the scale without confirmation [-]"},
+    {"process_noise.min_accepted_fraction", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::min_accepted_fraction>, "median over the accepted ranges while this share of the batch was accepted, else over all [-]"},
+    {"recovery.enabled", field<&EstimatorOptions::recovery, &RecoveryOptions::enabled>, "re-initialize from ranges and IMU when lost"},
+    {"recovery.retry_s", field<&EstimatorOptions::recovery, &RecoveryOptions::retry_s>, "between two attempts while lost or degraded [s]"},
+    {"recovery.degraded_disagreement_chi2", field<&EstimatorOptions::recovery, &RecoveryOptions::degraded_disagreement_chi2>, "degraded: re-initialize when the aligned pose disagrees beyond this chi^2 (4 dof), 0 = off [-]"},
+    {"time.max_offset_s", field<&EstimatorOptions::time, &TimeGuardOptions::max_offset_s>, "an input stamped farther than this from the current (newest) time is refused and counted [s]"},
+    {"time.rebase_after", field<&EstimatorOptions::time, &TimeGuardOptions::rebase_after>, "this many consecutive refused inputs agreeing among themselves move the clock (a real jump) [-]"},
+    {"refine.rerun_on_anchor_join", field<&EstimatorOptions::refine, &RefineOptions::rerun_on_anchor_join>, "on ANCHOR_INIT re-run from the oldest stored input with the calibrated anchors uncertain from there"},
+    {"refine.max_history_s", field<&EstimatorOptions::refine, &RefineOptions::max_history_s>, "inputs kept for re-runs (about 260 B each, S2: 360 inputs/s); older ones are dropped in eighths, counted [s]"},
+    {"refine.rerun_prior_sigma_m", field<&EstimatorOptions::refine, &RefineOptions::rerun_prior_sigma_m>, "position sigma per axis of a calibrated anchor in a re-run, around its calibration [m]"},
+    {"refine.rerun_gamma_sigma_m", field<&EstimatorOptions::refine, &RefineOptions::rerun_gamma_sigma_m>, "sigma of its gamma in a re-run [m]"},
+    {"refine.rerun_gamma_from_calibration", field<&EstimatorOptions::refine, &RefineOptions::rerun_gamma_from_calibration>, "gamma means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false)"},
+    {"refine.rerun_with_dah", field<&EstimatorOptions::refine, &RefineOptions::rerun_with_dah>, "strategy dah too (with its joint sets, uwb.dah_joint_anchors; see docs)"},
+    {"refine.rerun_mode", field<&EstimatorOptions::refine, &RefineOptions::rerun_mode>, "auto | sync | async: re-run inline, or on a worker while the node keeps publishing; auto = async in the LCM process"},
+};
 
-/// forEachField, part: zero-velocity updates and the health monitor.
-template <typename Opt, typename Visitor>
-void forEachRestAndHealthField(Opt& o, Visitor& v) {
-  v("zupt.enabled", o.zupt.enabled, "");
-  v("zupt.rate_hz", o.zupt.rate_hz, "pseudo-measurement rate while landed [Hz]");
-  v("zupt.sigma_acc_m_s2", o.zupt.sigma_acc_m_s2, "sigma of a = 0 [m/s^2]");
-  v("zupt.sigma_gyro_rad_s", o.zupt.sigma_gyro_rad_s, "rest rotation allowed while landed; the omega row fuses the mean gyro since the last ZUPT with sigma^2 = this^2 + gyro_noise_density^2/T [rad/s]");
-  v("zupt.sigma_vel_m_s", o.zupt.sigma_vel_m_s, "sigma of v = 0 [m/s]");
-  v("zupt.detect_stillness", o.zupt.detect_stillness, "without FLIGHT_STATE: ZUPT while the IMU shows rest");
-  v("zupt.stillness_gate_probability", o.zupt.stillness_gate_probability, "chi^2 gate of those ZUPTs [-]");
-  v("zupt.stillness_sigma_vel_m_s", o.zupt.stillness_sigma_vel_m_s,
-    "sigma of v = 0 when only IMU stillness says rest (a smooth hover drifts) [m/s]");
-  v("zupt.stillness_sigma_gyro_rad_s", o.zupt.stillness_sigma_gyro_rad_s,
-    "sigma of omega = 0 and of the initial gyro bias on stillness alone [rad/s]");
-  v("health.window_s", o.health.window_s, "innovation statistics window [s]");
-  v("health.min_ranges", o.health.min_ranges, "ranges in the window before gating can mean lost [-]");
-  v("health.min_anchors", o.health.min_anchors, "anchors gated alike before it means lost [-]");
-  v("health.degraded_gated_fraction", o.health.degraded_gated_fraction, "[-]");
-  v("health.lost_gated_fraction", o.health.lost_gated_fraction, "[-]");
-  v("health.degraded_mean_nis", o.health.degraded_mean_nis, "mean NIS of accepted ranges, 1 if consistent [-]");
-  v("health.degraded_no_aiding_s", o.health.degraded_no_aiding_s, "no accepted range for this long: degraded [s]");
-  v("health.lost_no_aiding_s", o.health.lost_no_aiding_s, "no accepted range for this long: lost [s]");
-  v("health.lost_sigma_p_m", o.health.lost_sigma_p_m, "largest position sigma beyond which the pose is lost [m]");
-  v("health.hold_s", o.health.hold_s, "a better health must hold this long [s]");
-}
-
-/// forEachField, part: process-noise adaptation, recovery and the time guard.
-template <typename Opt, typename Visitor>
-void forEachAdaptationField(Opt& o, Visitor& v) {
-  v("process_noise.adapt", o.process_noise.enabled, "scale the IMU noise densities to the range innovations");
-  v("process_noise.batch", o.process_noise.batch, "tag-anchor ranges per decision [-]");
-  v("process_noise.upper_ratio", o.process_noise.upper_ratio, "median NIS ratio above which the scale grows [-]");
-  v("process_noise.lower_ratio", o.process_noise.lower_ratio, "median NIS ratio below which the scale shrinks [-]");
-  v("process_noise.max_grow", o.process_noise.max_grow, "largest growth of the scale per decision (factor) [-]");
-  v("process_noise.max_shrink", o.process_noise.max_shrink, "largest shrink of the scale per decision (factor) [-]");
-  v("process_noise.max_scale", o.process_noise.max_scale, "largest variance scale [-]");
-  v("process_noise.max_prior_ratio", o.process_noise.max_prior_ratio,
-    "no growth while the median predicted range variance HPH'/R exceeds this [-]");
-  v("process_noise.confirm_batches", o.process_noise.confirm_batches,
-    "consecutive batches above upper_ratio before the scale grows (by the smallest of their ratios) [-]");
-  v("process_noise.grow_at_once_ratio", o.process_noise.grow_at_once_ratio,
-    "a batch whose median NIS ratio exceeds this grows the scale without confirmation [-]");
-  v("process_noise.min_accepted_fraction", o.process_noise.min_accepted_fraction,
-    "median over the accepted ranges while this share of the batch was accepted, else over all [-]");
-  v("recovery.enabled", o.recovery.enabled, "re-initialize from ranges and IMU when lost");
-  v("recovery.retry_s", o.recovery.retry_s, "between two attempts while lost or degraded [s]");
-  v("recovery.degraded_disagreement_chi2", o.recovery.degraded_disagreement_chi2,
-    "degraded: re-initialize when the aligned pose disagrees beyond this chi^2 (4 dof), 0 = off [-]");
-  v("time.max_offset_s", o.time.max_offset_s,
-    "an input stamped farther than this from the current (newest) time is refused and counted [s]");
-  v("time.rebase_after", o.time.rebase_after,
-    "this many consecutive refused inputs agreeing among themselves move the clock (a real jump) [-]");
-}
-
-/// forEachField, part: anchor refinement (the re-run on an anchor join, issue 10).
-template <typename Opt, typename Visitor>
-void forEachRefineField(Opt& o, Visitor& v) {
-  v("refine.rerun_on_anchor_join", o.refine.rerun_on_anchor_join,
-    "on ANCHOR_INIT re-run from the oldest stored input with the calibrated anchors uncertain from there");
-  v("refine.max_history_s", o.refine.max_history_s,
-    "inputs kept for re-runs (about 260 B each, S2: 360 inputs/s); older ones are dropped in eighths, counted [s]");
-  v("refine.rerun_prior_sigma_m", o.refine.rerun_prior_sigma_m,
-    "position sigma per axis of a calibrated anchor in a re-run, around its calibration [m]");
-  v("refine.rerun_gamma_sigma_m", o.refine.rerun_gamma_sigma_m, "sigma of its gamma in a re-run [m]");
-  v("refine.rerun_gamma_from_calibration", o.refine.rerun_gamma_from_calibration,
-    "gamma means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false)");
-  v("refine.rerun_with_dah", o.refine.rerun_with_dah,
-    "strategy dah too (with its joint sets, uwb.dah_joint_anchors; see docs)");
-  v("refine.rerun_mode", o.refine.rerun_mode,
-    "auto | sync | async: re-run inline, or on a worker while the node keeps publishing; auto = async in the LCM process");
-}
-
-/// Visits every option as (dotted key, field, unit/comment). The single list used for loading,
-/// printing and the shipped YAML, so they cannot drift apart.
+/// Visits every option as (dotted key, field, unit/comment).
 template <typename Opt, typename Visitor>
 void forEachField(Opt& o, Visitor&& v) {
-  forEachGeneralField(o, v);
-  forEachInitField(o, v);
-  forEachAltitudeField(o, v);
-  forEachUwbField(o, v);
-  forEachRestAndHealthField(o, v);
-  forEachAdaptationField(o, v);
-  forEachRefineField(o, v);
+  forEachOption(o, kFields, v);
 }
 
 std::vector<std::string> splitKey(const std::string& key) {
@@ -234,15 +179,7 @@ EstimatorOptions EstimatorOptions::fromYaml(const std::string& path) {
   // The one rule of common/yaml_options.h: unknown keys and bad values are errors naming the file
   // and the key; a missing key keeps its default (the defaults are the shipped file).
   YamlOptions yaml(YamlOptions::loadFile(path), path);
-  EstimatorOptions o;
-  forEachField(o, [&](const std::string& key, auto& field, const char*) { yaml.read(key, field); });
-  yaml.rejectUnknown();
-  try {
-    o.validate();
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
-  return o;
+  return readOptionsList<EstimatorOptions>(yaml, [](auto& o, auto&& v) { forEachField(o, v); });
 }
 
 void EstimatorOptions::validate() const {

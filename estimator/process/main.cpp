@@ -138,9 +138,7 @@ int main(int argc, char** argv) {
       "ESTIMATOR_STATUS (also a wall-clock heartbeat). Messages may arrive out of order: the node re-processes "
       "within its window. Malformed messages are counted per channel (\"<CHANNEL>:decode_error\" / "
       "\":invalid_message\") and reported in ESTIMATOR_STATUS.");
-  EstimatorProcessOptions o;
-  declareOptions(process.cli(), o);
-  return process.run(argc, argv, [&] {
+  return process.run<EstimatorProcessOptions>(argc, argv, declareOptions, [&](EstimatorProcessOptions& o) {
     estimator::EstimatorOptions options;
     if (!o.config_path.empty()) options = estimator::EstimatorOptions::fromYaml(o.config_path);
     if (!o.strategy.empty()) options.strategy = o.strategy;
@@ -150,10 +148,7 @@ int main(int argc, char** argv) {
       std::cout << options.toString();
       return 0;
     }
-    if (o.setup_path.empty()) {
-      spdlog::error("--setup is required (see --help)");
-      return 2;
-    }
+    process.require(!o.setup_path.empty(), "setup");
     const SystemSetup setup = loadSetup(o.setup_path);
     EstimatorProcess estimator(process, o, options, setup);
     estimator.resumeFromCheckpoint();

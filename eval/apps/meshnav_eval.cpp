@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "common/cli.h"
+#include "common/cli_main.h"
 #include "eval/plotting.h"
 #include "eval/report.h"
 #include "eval/run_evaluation.h"
@@ -22,6 +22,11 @@ using namespace meshnav;
 using namespace meshnav::eval;
 
 namespace {
+
+constexpr char kDescription[] =
+    "Metrics of a run against ground truth (pose RMSE, ARMSE, ANEES, anchor errors) and plots; the "
+    "multilateration baseline of a dataset alone (no --run); or, with --batch, the paper-style table over many "
+    "runs.";
 
 /// The command line of meshnav_eval (EvalOptions holds the defaults of the metric options).
 struct EvalCli {
@@ -225,19 +230,7 @@ int runBatch(const EvalCli& cli) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  setupLogging("meshnav_eval");
-  Cli cli("meshnav_eval",
-          "Metrics of a run against ground truth (pose RMSE, ARMSE, ANEES, anchor errors) and plots; the "
-          "multilateration baseline of a dataset alone (no --run); or, with --batch, the paper-style table over "
-          "many runs.");
-  EvalCli c;
-  declareOptions(cli, c);
-  int code = 0;
-  if (!cli.parse(argc, argv, code)) return code;
-  try {
+  return cliMain<EvalCli>(argc, argv, "meshnav_eval", kDescription, declareOptions, [](const Cli&, EvalCli& c) {
     return c.batch.empty() ? runSingle(c) : runBatch(c);
-  } catch (const std::exception& ex) {
-    spdlog::error("{}", ex.what());
-    return 1;
-  }
+  });
 }

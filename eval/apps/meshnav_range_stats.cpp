@@ -10,7 +10,7 @@
 #include <fstream>
 #include <iostream>
 
-#include "common/cli.h"
+#include "common/cli_main.h"
 #include "common/dataset.h"
 #include "common/setup.h"
 #include "eval/plotting.h"
@@ -167,16 +167,7 @@ int run(const RangeStatsCli& cli) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  setupLogging("meshnav_range_stats");
-  Cli cli("meshnav_range_stats", "Per ordered pair range bias and noise against true distances.");
-  RangeStatsCli c;
-  declareOptions(cli, c);
-  int code = 0;
-  if (!cli.parse(argc, argv, code)) return code;
-  try {
-    return run(c);
-  } catch (const std::exception& ex) {
-    spdlog::error("{}", ex.what());
-    return 1;
-  }
+  return cliMain<RangeStatsCli>(argc, argv, "meshnav_range_stats",
+                                "Per ordered pair range bias and noise against true distances.", declareOptions,
+                                [](const Cli&, RangeStatsCli& c) { return run(c); });
 }

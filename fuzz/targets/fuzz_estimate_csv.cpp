@@ -7,22 +7,18 @@
 
 #include "common/estimate_io.h"
 #include "fuzz/support/fuzz_target.h"
-#include "fuzz/support/scratch_file.h"
+#include "fuzz/support/sample_checks.h"
 
 using namespace meshnav;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static fuzz::ScratchFile file("estimate.csv");
-  file.write(data, size);
+  const std::string& path = fuzz::scratchFile("estimate.csv", data, size);
   Diagnostics diag;
   fuzz::refusalsAllowed([&] {
-    for (const PoseSample& p : readPosesAuto(file.path(), diag)) {
-      fuzz::require(p.p_IinG.allFinite() && p.q_ItoG.coeffs().allFinite(), "estimate.csv: non-finite pose accepted");
-      fuzz::require(std::abs(p.q_ItoG.norm() - 1.0) < 1e-6, "estimate.csv: quaternion not normalized");
-    }
+    for (const PoseSample& p : readPosesAuto(path, diag)) fuzz::requireFinitePose(p, "estimate.csv");
   });
   fuzz::refusalsAllowed([&] {
-    for (const AnchorEstimate& a : readAnchorsCsv(file.path(), diag))
+    for (const AnchorEstimate& a : readAnchorsCsv(path, diag))
       fuzz::require(a.p_AinG.allFinite() && a.cov_p_m2.allFinite(), "anchors.csv: non-finite anchor accepted");
   });
   return 0;

@@ -25,10 +25,7 @@ int main(int argc, char** argv) {
   cli.optionsFile("these options as a YAML map (`rate: 10`, `wait_for: ESTIMATOR_STATUS`); the command line wins");
 
   return process.run(argc, argv, [&] {
-    if (dataset.empty()) {
-      spdlog::error("--dataset is required (see --help)");
-      return 2;
-    }
+    process.require(!dataset.empty(), "dataset");
     const auto replay_options = transport::replayOptionsFrom(cli, replay_values);
     Diagnostics diag;
     imu::InertialStreams streams = imu::loadInertialStreams(dataset, diag);

@@ -20,22 +20,16 @@ InertialStreams loadInertialStreams(const std::string& dataset_dir, Diagnostics&
   if (!fs::is_directory(dir)) throw std::runtime_error(dataset_dir + ": not a dataset folder");
   InertialStreams s;
   bool any = false;
-  if (fs::exists(dir / "imu.csv")) {
-    s.imu = readImuCsv((dir / "imu.csv").string(), diag);
+  // Reads `name` into `samples` when the dataset has it.
+  const auto read = [&](const char* name, auto& samples, auto reader) {
+    if (!fs::exists(dir / name)) return;
+    samples = reader((dir / name).string(), diag);
     any = true;
-  }
-  if (fs::exists(dir / "baro.csv")) {
-    s.baro = readBaroCsv((dir / "baro.csv").string(), diag);
-    any = true;
-  }
-  if (fs::exists(dir / "flight_state.csv")) {
-    s.flight_states = readFlightStateCsv((dir / "flight_state.csv").string(), diag);
-    any = true;
-  }
-  if (fs::exists(dir / "height.csv")) {
-    s.heights = readHeightCsv((dir / "height.csv").string(), diag);
-    any = true;
-  }
+  };
+  read("imu.csv", s.imu, readImuCsv);
+  read("baro.csv", s.baro, readBaroCsv);
+  read("flight_state.csv", s.flight_states, readFlightStateCsv);
+  read("height.csv", s.heights, readHeightCsv);
   if (!any)
     throw std::runtime_error(dataset_dir + ": none of imu.csv, baro.csv, flight_state.csv, height.csv found");
   spdlog::info("{}: {} IMU, {} baro, {} flight-state, {} height samples", dataset_dir, s.imu.size(), s.baro.size(),

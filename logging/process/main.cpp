@@ -108,13 +108,8 @@ int main(int argc, char** argv) {
       "--flush-period of wall time and on SIGINT/SIGTERM: a stop loses nothing received, a kill -9 at most the last "
       "period. A logger restarted with the same --run-id cuts the half-written last row or event a kill left, then "
       "continues the files.");
-  LoggingOptions o;
-  declareOptions(process.cli(), o);
-  return process.run(argc, argv, [&] {
-    if (o.out.empty()) {
-      spdlog::error("--out is required (see --help)");
-      return 2;
-    }
+  return process.run<LoggingOptions>(argc, argv, declareOptions, [&](LoggingOptions& o) {
+    process.require(!o.out.empty(), "out");
     const std::filesystem::path id_file = std::filesystem::path(o.out) / ".logging_run_id";
     const bool append = continuesRun(id_file, o.run_id, o.out);
     logging::RunRecorder recorder(o.out, append);

@@ -35,18 +35,14 @@ void subscribeTimeChannels(transport::LcmNode& lcm, const std::vector<std::strin
 
 int main(int argc, char** argv) {
   transport::ProcessMain process("mission", mission::kMissionProcessDescription);
-  mission::MissionProcessConfig config;
-  mission::declareMissionProcessOptions(process.cli(), config);
-  return process.run(argc, argv, [&] {
+  using Config = mission::MissionProcessConfig;
+  return process.run<Config>(argc, argv, mission::declareMissionProcessOptions, [&](Config& config) {
     mission::finishMissionProcessConfig(config);
     if (config.print_config) {
       std::cout << config.toString();
       return 0;
     }
-    if (config.mission_path.empty()) {
-      spdlog::error("--mission is required (see --help)");
-      return 2;
-    }
+    process.require(!config.mission_path.empty(), "mission");
     const mission::Mission script = mission::loadMission(config.mission_path);
     transport::LcmNode& lcm = process.lcm();
     mission::MissionSinks sinks;

@@ -10,12 +10,18 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "common/cli.h"
+#include "common/cli_main.h"
 #include "common/dataset.h"
 #include "sim/scenario_simulator.h"
 #include "sim/uncertain_anchors.h"
 
 namespace {
+
+constexpr char kDescription[] =
+    "Simulates one sequence (the paper's scenario by default; docs/scenarios.md) and writes it as a dataset folder: "
+    "imu.csv (200 Hz), baro.csv (50 Hz; not for walk), ranges.csv (meshed TDMA over every tag and anchor, 10 ms "
+    "slots), flight_state.csv (10 Hz; only for motions with a landed phase), groundtruth.csv (60 Hz, TUM), "
+    "setup.yaml (what a user knows) and truth.yaml (evaluation only). The same seed and options give the same files.";
 /// The command line: the simulation options (their defaults are the code's) and the texts that
 /// are parsed after the command line.
 struct SimCli {
@@ -140,47 +146,37 @@ void applyScenarioOptions(const meshnav::Cli& cli, SimCli& c) {
   o.validate();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  meshnav::setupLogging("meshnav_sim");
-  meshnav::Cli cli("meshnav_sim",
-                   "Simulates one sequence (the paper's scenario by default; docs/scenarios.md) and writes it as a "
-                   "dataset folder: imu.csv (200 Hz), baro.csv (50 Hz; not for walk), ranges.csv (meshed TDMA over "
-                   "every tag and anchor, 10 ms slots), flight_state.csv (10 Hz; only for motions with a landed "
-                   "phase), groundtruth.csv (60 Hz, TUM), setup.yaml (what a user knows) and truth.yaml (evaluation "
-                   "only). The same seed and options give the same files.");
-  SimCli c;
-  declareOptions(cli, c);
-  int exit_code = 0;
-  if (!cli.parse(argc, argv, exit_code)) return exit_code;
+/// The work of main: the scenario options checked (a bad combination: exit 2), then the sequence
+/// simulated and written.
+int simulate(const meshnav::Cli& cli, SimCli& c) {
   try {
     applyScenarioOptions(cli, c);
   } catch (const std::exception& e) {
     std::cerr << "meshnav_sim: " << e.what() << "\n(see meshnav_sim --help)\n";
     return 2;
   }
-  try {
-    const auto& options = c.sim;
-    spdlog::info("simulating: {}", options.toString());
-    const meshnav::sim::ScenarioSimulator simulator(options);
-    meshnav::sim::SimulationResult result = simulator.run();
-    if (cli.given("uncertain-anchors")) {
-      meshnav::sim::UncertainAnchorOptions uo;
-      uo.sigma_m = c.uncertain_sigma_m;
-      uo.include_known = c.uncertain_known;
-      uo.seed = options.seed;
-      const int n = meshnav::sim::makeAnchorsUncertain(result.dataset, uo, options.hardware, options.uwb.sigma_range_m);
-      spdlog::info("uncertain anchors: {} anchors written with sigma {} m ({}), {} a-priori pair biases", n,
-                   c.uncertain_sigma_m, uo.include_known ? "all" : "known anchors exact", result.dataset.setup.pair_biases.size());
-    }
-    spdlog::info("{}", result.trajectory_description);
-    spdlog::info("writing dataset to {}", c.out);
-    meshnav::writeDataset(result.dataset, c.out);
-    std::cout << result.summary() << "\nDataset written to " << c.out << std::endl;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
+  const auto& options = c.sim;
+  spdlog::info("simulating: {}", options.toString());
+  const meshnav::sim::ScenarioSimulator simulator(options);
+  meshnav::sim::SimulationResult result = simulator.run();
+  if (cli.given("uncertain-anchors")) {
+    meshnav::sim::UncertainAnchorOptions uo;
+    uo.sigma_m = c.uncertain_sigma_m;
+    uo.include_known = c.uncertain_known;
+    uo.seed = options.seed;
+    const int n = meshnav::sim::makeAnchorsUncertain(result.dataset, uo, options.hardware, options.uwb.sigma_range_m);
+    spdlog::info("uncertain anchors: {} anchors written with sigma {} m ({}), {} a-priori pair biases", n,
+                 c.uncertain_sigma_m, uo.include_known ? "all" : "known anchors exact", result.dataset.setup.pair_biases.size());
   }
+  spdlog::info("{}", result.trajectory_description);
+  spdlog::info("writing dataset to {}", c.out);
+  meshnav::writeDataset(result.dataset, c.out);
+  std::cout << result.summary() << "\nDataset written to " << c.out << std::endl;
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return meshnav::cliMain<SimCli>(argc, argv, "meshnav_sim", kDescription, declareOptions, simulate);
 }

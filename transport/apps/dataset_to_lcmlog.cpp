@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "common/cli.h"
+#include "common/cli_main.h"
 #include "common/dataset.h"
 #include "transport/channels.h"
 #include "transport/convert.h"
@@ -45,70 +45,75 @@ enum Stream : int {
   kStreamCount = 6
 };
 
+constexpr char kDescription[] =
+    "Writes imu.csv, baro.csv, flight_state.csv, ranges.csv and groundtruth.csv of a dataset folder as the channels "
+    "IMU, BARO, FLIGHT_STATE, RANGE, GROUND_TRUTH into an LCM log (event time = data time), ready for "
+    "`lcm-logplayer FILE.lcmlog`.";
+
+struct Options {
+  std::string dataset, out;
+  bool no_ground_truth = false;
+};
+
+void declareOptions(meshnav::Cli& cli, Options& o) {
+  cli.optional("dataset", o.dataset, "dataset folder (setup.yaml and ranges.csv required)")->type_name("DIR")->required();
+  cli.optional("out", o.out, "output log file (overwritten)")->type_name("FILE")->required();
+  cli.flag("no-ground-truth", o.no_ground_truth, "leave GROUND_TRUTH out");
+}
+
+/// The work of main: the dataset's streams merged in time order and written as one log.
+int writeLog(const Options& o) {
+  using namespace meshnav;
+  Diagnostics diag;
+  const Dataset ds = readDataset(o.dataset, diag);
+  const bool with_gt = !o.no_ground_truth;
+  // Equal times keep the order of the streams (Stream).
+  std::vector<std::vector<Timestamp>> times(kStreamCount);
+  times[kFlightStateStream] = replay::timesOf(ds.flight_states);
+  times[kImuStream] = replay::timesOf(ds.imu);
+  times[kBaroStream] = replay::timesOf(ds.baro);
+  times[kRangeStream] = replay::timesOf(ds.ranges);
+  if (with_gt) times[kGroundTruthStream] = replay::timesOf(ds.ground_truth);
+  times[kHeightStream] = replay::timesOf(ds.heights);
+  const auto events = replay::mergeTimeline(times);
+
+  const std::filesystem::path outp(o.out);
+  if (outp.has_parent_path()) std::filesystem::create_directories(outp.parent_path());
+  lcm::LogFile log(o.out, "w");
+  if (!log.good()) {
+    spdlog::error("{}: cannot open for writing", o.out);
+    return 1;
+  }
+  std::vector<uint8_t> buf;
+  size_t written = 0;
+  for (const auto& ev : events) {
+    bool ok = false;
+    switch (ev.stream) {
+      case kFlightStateStream: ok = writeEvent(log, channels::kFlightState, ev.t.us, ds.flight_states[ev.index], buf); break;
+      case kImuStream: ok = writeEvent(log, channels::kImu, ev.t.us, ds.imu[ev.index], buf); break;
+      case kBaroStream: ok = writeEvent(log, channels::kBaro, ev.t.us, ds.baro[ev.index], buf); break;
+      case kRangeStream: ok = writeEvent(log, channels::kRange, ev.t.us, ds.ranges[ev.index], buf); break;
+      case kGroundTruthStream: ok = writeEvent(log, channels::kGroundTruth, ev.t.us, ds.ground_truth[ev.index], buf); break;
+      case kHeightStream: ok = writeEvent(log, channels::kHeight, ev.t.us, ds.heights[ev.index], buf); break;
+      default: break;
+    }
+    if (!ok) {
+      spdlog::error("{}: write failed after {} events", o.out, written);
+      return 1;
+    }
+    ++written;
+  }
+  spdlog::info("{}: {} events (IMU {}, BARO {}, FLIGHT_STATE {}, RANGE {}, GROUND_TRUTH {}, HEIGHT {}), {:.3f}..{:.3f} s",
+               o.out, written, ds.imu.size(), ds.baro.size(), ds.flight_states.size(), ds.ranges.size(),
+               with_gt ? ds.ground_truth.size() : 0, ds.heights.size(), events.empty() ? 0.0 : events.front().t.sec(),
+               events.empty() ? 0.0 : events.back().t.sec());
+  if (diag.total() > 0) spdlog::warn("dataset input problems: {}", diag.summary());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  using namespace meshnav;
-  Cli cli("dataset_to_lcmlog",
-          "Writes imu.csv, baro.csv, flight_state.csv, ranges.csv and groundtruth.csv of a dataset folder as the "
-          "channels IMU, BARO, FLIGHT_STATE, RANGE, GROUND_TRUTH into an LCM log (event time = data time), ready "
-          "for `lcm-logplayer FILE.lcmlog`.");
-  std::string dataset, out;
-  bool no_ground_truth = false;
-  cli.optional("dataset", dataset, "dataset folder (setup.yaml and ranges.csv required)")->type_name("DIR")->required();
-  cli.optional("out", out, "output log file (overwritten)")->type_name("FILE")->required();
-  cli.flag("no-ground-truth", no_ground_truth, "leave GROUND_TRUTH out");
-  int code = 0;
-  if (!cli.parse(argc, argv, code)) return code;
-  setupLogging("dataset_to_lcmlog");
-  try {
-    Diagnostics diag;
-    const Dataset ds = readDataset(dataset, diag);
-    const bool with_gt = !no_ground_truth;
-    // Equal times keep the order of the streams (Stream).
-    std::vector<std::vector<Timestamp>> times(kStreamCount);
-    times[kFlightStateStream] = replay::timesOf(ds.flight_states);
-    times[kImuStream] = replay::timesOf(ds.imu);
-    times[kBaroStream] = replay::timesOf(ds.baro);
-    times[kRangeStream] = replay::timesOf(ds.ranges);
-    if (with_gt) times[kGroundTruthStream] = replay::timesOf(ds.ground_truth);
-    times[kHeightStream] = replay::timesOf(ds.heights);
-    const auto events = replay::mergeTimeline(times);
-
-    const std::filesystem::path outp(out);
-    if (outp.has_parent_path()) std::filesystem::create_directories(outp.parent_path());
-    lcm::LogFile log(out, "w");
-    if (!log.good()) {
-      spdlog::error("{}: cannot open for writing", out);
-      return 1;
-    }
-    std::vector<uint8_t> buf;
-    size_t written = 0;
-    for (const auto& ev : events) {
-      bool ok = false;
-      switch (ev.stream) {
-        case kFlightStateStream: ok = writeEvent(log, channels::kFlightState, ev.t.us, ds.flight_states[ev.index], buf); break;
-        case kImuStream: ok = writeEvent(log, channels::kImu, ev.t.us, ds.imu[ev.index], buf); break;
-        case kBaroStream: ok = writeEvent(log, channels::kBaro, ev.t.us, ds.baro[ev.index], buf); break;
-        case kRangeStream: ok = writeEvent(log, channels::kRange, ev.t.us, ds.ranges[ev.index], buf); break;
-        case kGroundTruthStream: ok = writeEvent(log, channels::kGroundTruth, ev.t.us, ds.ground_truth[ev.index], buf); break;
-        case kHeightStream: ok = writeEvent(log, channels::kHeight, ev.t.us, ds.heights[ev.index], buf); break;
-        default: break;
-      }
-      if (!ok) {
-        spdlog::error("{}: write failed after {} events", out, written);
-        return 1;
-      }
-      ++written;
-    }
-    spdlog::info("{}: {} events (IMU {}, BARO {}, FLIGHT_STATE {}, RANGE {}, GROUND_TRUTH {}, HEIGHT {}), {:.3f}..{:.3f} s",
-                 out, written, ds.imu.size(), ds.baro.size(), ds.flight_states.size(), ds.ranges.size(),
-                 with_gt ? ds.ground_truth.size() : 0, ds.heights.size(), events.empty() ? 0.0 : events.front().t.sec(),
-                 events.empty() ? 0.0 : events.back().t.sec());
-    if (diag.total() > 0) spdlog::warn("dataset input problems: {}", diag.summary());
-    return 0;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
-  }
+  return meshnav::cliMain<Options>(argc, argv, "dataset_to_lcmlog", kDescription, declareOptions,
+                                   [](const meshnav::Cli&, Options& o) { return writeLog(o); });
 }

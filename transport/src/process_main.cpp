@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <stdexcept>
+
 #include "transport/stop_signal.h"
 
 namespace meshnav::transport {
@@ -15,6 +17,17 @@ ProcessMain::ProcessMain(std::string name, const std::string& description)
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "warning", "error", "critical", "off"}));
 }
 
+namespace {
+/// A required option missing (ProcessMain::require): exit 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+}  // namespace
+
+void ProcessMain::require(bool given, const std::string& option) const {
+  if (!given) throw UsageError("--" + option + " is required (see --help)");
+}
+
 int ProcessMain::run(int argc, char** argv, const std::function<int()>& body) {
   int code = 0;
   if (!cli_.parse(argc, argv, code)) return code;
@@ -23,6 +36,9 @@ int ProcessMain::run(int argc, char** argv, const std::function<int()>& body) {
   StopSignal::install();
   try {
     return body();
+  } catch (const UsageError& e) {
+    spdlog::error("{}", e.what());
+    return 2;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

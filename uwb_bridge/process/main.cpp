@@ -200,9 +200,7 @@ int main(int argc, char** argv) {
       "Publishes UWB ranges on RANGE (message utime = range time), from a dataset folder (--dataset), range CSV "
       "files (--csv) or the serial line output of the UWB TWR firmware driver (--serial); give exactly one. Replays "
       "exit when played (0); serial ends at end of input (0). Bad input: 1; --wait-for timeout: 3.");
-  UwbBridgeOptions opts;
-  declareOptions(process.cli(), opts);
-  return process.run(argc, argv, [&] {
+  return process.run<UwbBridgeOptions>(argc, argv, declareOptions, [&](UwbBridgeOptions& opts) {
     std::vector<std::string> csv_files;
     if (!opts.csv.empty()) csv_files = uwb::splitPathList(opts.csv);
     csv_files.insert(csv_files.end(), opts.files.begin(), opts.files.end());
