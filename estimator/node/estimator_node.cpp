@@ -108,7 +108,6 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       time_guard_(options_.time) {
   options_.validate();
   carried_height_ = carriedHeightUsed(options_, setup_);
-  plane_watch_ = AnchorPlaneWatch::of(setup_.abs_anchor_positions);
   baro_aligns_ = baroAligns(options_, setup_);
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
   skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
@@ -131,8 +130,6 @@ void EstimatorNode::resetAll() {
   aligner_.setGravityAlongPlusZ(false);
   zupt_model_ = ZuptModel(Eigen::Vector3d(0.0, 0.0, -options_.gravity_m_s2));
   last_recovery_try_.reset();
-  if (plane_watch_) plane_watch_->reset();
-  plane_check_since_.reset();
   cur_ = Snapshot{};
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);
   cur_.network = std::make_shared<const UwbNetwork>(setup_, options_.uwb.sigma_range_m);

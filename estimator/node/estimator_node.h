@@ -69,7 +69,6 @@
 #include "estimator/node/estimator_input.h"
 #include "estimator/health/health_monitor.h"
 #include "estimator/imu/process_noise_adapter.h"
-#include "estimator/node/anchor_plane_watch.h"
 #include "estimator/node/motion_aligner.h"
 #include "estimator/node/static_initializer.h"
 #include "estimator/zupt/rest_rate_mean.h"
@@ -233,13 +232,6 @@ class EstimatorNode {
   InitialBelief beliefFromAlignment(const AlignmentResult& r) const;
   void updateHealth(Timestamp t);
   void tryRecover(Timestamp t);
-  /// After the estimate crossed the plane of the (coplanar) known anchors: compared with the
-  /// in-motion alignment once it can tell, and replaced by it when they disagree beyond
-  /// `recovery.degraded_disagreement_chi2` (a slide onto the mirror image, AnchorPlaneWatch);
-  /// counters `anchor_plane_crossed`, `recovery_plane_crossing`.
-  void checkPlaneCrossing(Timestamp t);
-  /// Replaces the pose by an aligned one (replaceImu), counted and logged as a recovery.
-  void recoverFrom(const AlignmentResult& r);
   /// χ² (4 dof) between the filter's position and yaw and an aligned pose, both covariances.
   double disagreement(const AlignmentResult& r) const;
   /// Replaces the IMU instance (state, covariance, time); every other instance keeps its mean and
@@ -343,11 +335,6 @@ class EstimatorNode {
   bool have_flight_state_ = false;
   std::optional<double> last_pressure_pa_;
   HealthMonitor health_;
-  std::optional<AnchorPlaneWatch> plane_watch_;  ///< none unless the known anchors are coplanar
-  /// A crossing of that plane waiting for an alignment that can tell (retried every
-  /// `recovery.retry_s`, given up after kPlaneCheckS), and the last try.
-  std::optional<Timestamp> plane_check_since_, last_plane_try_;
-  static constexpr double kPlaneCheckS = 10.0;  ///< [s]
   std::optional<Timestamp> last_align_try_, last_recovery_try_, last_health_eval_;
   std::optional<Timestamp> gravity_check_at_;  ///< when checkGravityDirection runs (once)
   int gravity_checks_ = 0;

@@ -344,12 +344,6 @@ void EstimatorNode::updateHealth(Timestamp t) {
     else
       spdlog::warn("{}", msg);
   }
-  if (plane_watch_ && plane_watch_->crossed(cur_.filter->state().imu.p_IinG)) {
-    diag_.count("anchor_plane_crossed");
-    plane_check_since_ = t;
-    last_plane_try_.reset();
-  }
-  if (plane_check_since_) checkPlaneCrossing(t);
   // Degraded by gating alone, with the accepted ranges fitting, is what NLOS outliers look like:
   // a re-alignment from those ranges is then more likely wrong than the filter (docs/robustness.md).
   if (health_.health() == Health::Lost ||
@@ -391,49 +385,16 @@ void EstimatorNode::tryRecover(Timestamp t) {
     spdlog::warn("estimator: degraded at t={} and the aligned pose disagrees (chi2 {:.1f} > {:.1f})",
                  formatSeconds(t), chi2, options_.recovery.degraded_disagreement_chi2);
   }
-  recoverFrom(*r);
-}
-
-void EstimatorNode::checkPlaneCrossing(Timestamp t) {
-  if (!options_.recovery.enabled || options_.recovery.degraded_disagreement_chi2 <= 0.0 ||
-      (t - *plane_check_since_).sec() > kPlaneCheckS) {
-    plane_check_since_.reset();  // undecided for that long: the filter goes on as it is
-    return;
-  }
-  if (last_plane_try_ && (t - *last_plane_try_).sec() < options_.recovery.retry_s) return;
-  last_plane_try_ = t;
-  const auto r = aligner_.solve(cur_.filter->state().imu.bias_gyro_rad_s);
-  if (!r) {  // at the plane the window often fits both sides alike: asked again as the motion goes on
-    spdlog::debug("estimator: crossed the known anchors' plane at t={}; alignment: {}", formatSeconds(t), aligner_.reason());
-    return;
-  }
-  plane_check_since_.reset();
-  const double chi2 = disagreement(*r);
-  if (chi2 <= options_.recovery.degraded_disagreement_chi2) {  // a real crossing
-    spdlog::debug("estimator: crossed the known anchors' plane; at t={} the aligned pose agrees (chi2 {:.1f})",
-                  formatSeconds(t), chi2);
-    return;
-  }
-  diag_.count("recovery_plane_crossing");
-  spdlog::warn("estimator: crossed the known anchors' plane; at t={} the aligned pose disagrees (chi2 {:.1f} > "
-               "{:.1f}): the mirror image",
-               formatSeconds(t), chi2, options_.recovery.degraded_disagreement_chi2);
-  recoverFrom(*r);
-}
-
-void EstimatorNode::recoverFrom(const AlignmentResult& r) {
   const ImuState before = cur_.filter->state().imu;
-  replaceImu(r.imu, r.cov, r.t, r.last_imu);
+  replaceImu(r->imu, r->cov, r->t, r->last_imu);
   diag_.count("recovery");
   spdlog::warn("estimator: recovered at t={}: re-initialized from {} ranges and the IMU (moved {:.2f} m, "
                "σ_p {:.2f} m, σ_yaw {:.1f} deg); anchors and bias states kept",
-               formatSeconds(r.t), r.n_ranges, (r.imu.p_IinG - before.p_IinG).norm(), r.sigma_p_m,
-               r.sigma_yaw_deg);
+               formatSeconds(r->t), r->n_ranges, (r->imu.p_IinG - before.p_IinG).norm(), r->sigma_p_m,
+               r->sigma_yaw_deg);
 }
 
 void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu) {
-  if (plane_watch_) plane_watch_->reset();  // the new pose sets its own side
-  plane_check_since_.reset();
   const FusionStrategy& old = *cur_.filter;
   const NominalState& s = old.state();
   auto f = makeStrategy(options_, gravity_z_sign_);
