@@ -6,9 +6,10 @@
 ///    roll = atan2(f̄_y, f̄_z), pitch = atan2(−f̄_x, √(f̄_y² + f̄_z²)); gyro bias = mean ω;
 ///  - position and yaw from setup.initial_pose (σ_p, σ_yaw) when given, otherwise from a
 ///    least-squares fit of [p_IinG, yaw] to the bias-corrected tag ranges to known anchors
-///    ((z − γ)/β = ‖p_A − p_IinG − R(yaw) p_TinI‖, Gauss–Newton from several seeds, residuals
-///    beyond `range_init_outlier_m` dropped, a weak yaw prior of σ π keeps the normal matrix
-///    regular). Refused while the fit cannot fix the pose: yaw σ above
+///    ((z − γ)/β = ‖p_A − p_IinG − R(yaw) p_TinI‖, Gauss–Newton from a grid of starts with Cauchy
+///    weights, residuals beyond `range_init_outlier_m` at its best minimum dropped, each distinct
+///    minimum descended again over the inliers with Huber weights, whose costs decide; a weak yaw
+///    prior of σ π keeps the normal matrix regular). Refused while the fit cannot fix the pose: yaw σ above
 ///    `static_max_sigma_yaw_deg` (one tag: only its lever arm shows yaw at rest), a second
 ///    local minimum as good as the best (nearly coplanar anchors mirror the position); the node
 ///    then waits for motion (MotionAligner). The fit's covariance is scaled by the robust
