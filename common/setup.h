@@ -26,6 +26,18 @@ struct CarriedHeight {
   double sigma_m = 0.3;   ///< how far the actual carrying height may be from height_m (1σ) [m]
 };
 
+/// The space the vehicle flies in: an axis-aligned box in G that the user knows (the hall, a
+/// geofence) [m]. The estimator uses it only to tell a position from its mirror image across the
+/// plane of coplanar known anchors (docs/robustness.md, "The flight volume").
+struct FlightVolume {
+  Eigen::Vector3d min_m = Eigen::Vector3d::Zero();  ///< lower corner in G [m]
+  Eigen::Vector3d max_m = Eigen::Vector3d::Zero();  ///< upper corner in G [m]
+  /// Distance of p outside the box (0 inside) [m].
+  double distanceOutside(const Eigen::Vector3d& p) const {
+    return (p - p.cwiseMax(min_m).cwiseMin(max_m)).norm();
+  }
+};
+
 /// Optional noise figures overriding the tuning defaults.
 struct NoiseFigures {
   std::optional<double> sigma_range_m;
@@ -55,6 +67,7 @@ struct SystemSetup {
   Eigen::Vector3d height_p_IH = Eigen::Vector3d::Zero(); ///< rangefinder in IMU frame [m] (unknown: 0)
   std::optional<InitialPose> initial_pose;
   std::optional<CarriedHeight> carried_height;  ///< hand-held rig: its usual height
+  std::optional<FlightVolume> flight_volume;    ///< the hall or geofence, when the user knows it
   NoiseFigures noise;
 
   bool isTag(SensorId id) const { return rel_tag_positions.count(id) > 0; }

@@ -83,6 +83,9 @@ SystemSetup makeSetup(const SimulationOptions& o, const PaperScenario& scenario,
   // A hand-held rig's user knows roughly how high it is carried: the walk holds it at 1.1–1.3 m
   // (± 0.05–0.12 m slowly, plus the gait's bob), said as 1.2 m ± 0.3 m.
   if (trajectory.isHandCarried()) setup.carried_height = CarriedHeight{1.2, 0.3};
+  // The user knows the hall they fly in. Not written for the paper scenario, whose files stay as
+  // they always were (its anchors are not coplanar, so the estimator would not use it).
+  if (!o.isPaperScenario()) setup.flight_volume = FlightVolume{o.hall().min_m, o.hall().max_m};
   setup.noise.sigma_range_m = o.uwb.sigma_range_m;
   setup.noise.imu_acc_noise_density = o.imu.acc_noise_density;
   setup.noise.imu_gyro_noise_density = o.imu.gyro_noise_density;

@@ -264,6 +264,15 @@ SystemSetup loadSetup(const std::string& path) {
     if (!(c.sigma_m > 0.0)) y.fail("carried_height.sigma_m", "must be > 0 [m]");
     s.carried_height = c;
   }
+  if (y.has("flight_volume")) {
+    FlightVolume v;  // no sensible default: both corners required
+    y.require("flight_volume.min_m", v.min_m);
+    y.require("flight_volume.max_m", v.max_m);
+    if (!v.min_m.allFinite() || !v.max_m.allFinite() || !((v.max_m - v.min_m).minCoeff() > 0.0) ||
+        (v.max_m - v.min_m).maxCoeff() > plausible::kMaxHeight_m * 100.0)
+      y.fail("flight_volume", "min_m must be below max_m on every axis, both finite and at most 10 km apart [m]");
+    s.flight_volume = v;
+  }
   y.read("noise.sigma_range", s.noise.sigma_range_m);
   y.read("noise.imu_acc_noise_density", s.noise.imu_acc_noise_density);
   y.read("noise.imu_gyro_noise_density", s.noise.imu_gyro_noise_density);
@@ -333,6 +342,15 @@ void saveSetup(const SystemSetup& s, const std::string& path) {
       << YAML::BeginMap;
     e << YAML::Key << "height_m" << YAML::Value << s.carried_height->height_m;
     e << YAML::Key << "sigma_m" << YAML::Value << s.carried_height->sigma_m;
+    e << YAML::EndMap;
+  }
+  if (s.flight_volume) {
+    e << YAML::Key << "flight_volume" << YAML::Comment("the box in G the vehicle stays in (hall, geofence) [m]")
+      << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "min_m" << YAML::Value;
+    emitVec(e, s.flight_volume->min_m);
+    e << YAML::Key << "max_m" << YAML::Value;
+    emitVec(e, s.flight_volume->max_m);
     e << YAML::EndMap;
   }
   const auto& n = s.noise;

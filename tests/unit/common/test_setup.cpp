@@ -66,6 +66,17 @@ TEST(Setup, RoundTrip) {
   EXPECT_DOUBLE_EQ(rc.carried_height->height_m, 1.35);
   EXPECT_DOUBLE_EQ(rc.carried_height->sigma_m, 0.25);
   EXPECT_FALSE(rc.noise.imu_acc_bias_sigma);
+  EXPECT_FALSE(rc.flight_volume);
+  // The flight volume, written only when given.
+  auto v = s;
+  v.flight_volume = FlightVolume{Eigen::Vector3d(-2.5, -4.2, 0.0), Eigen::Vector3d(3.0, 4.2, 8.2)};
+  saveSetup(v, (d / "volume.yaml").string());
+  const auto rv = loadSetup((d / "volume.yaml").string());
+  ASSERT_TRUE(rv.flight_volume);
+  EXPECT_TRUE(rv.flight_volume->min_m.isApprox(v.flight_volume->min_m));
+  EXPECT_TRUE(rv.flight_volume->max_m.isApprox(v.flight_volume->max_m));
+  EXPECT_DOUBLE_EQ(rv.flight_volume->distanceOutside(Eigen::Vector3d(0.0, 0.0, 1.0)), 0.0);
+  EXPECT_DOUBLE_EQ(rv.flight_volume->distanceOutside(Eigen::Vector3d(4.0, 0.0, -1.0)), std::sqrt(2.0));
   // The IMU's switch-on bias spread, written only when given.
   auto b = s;
   b.noise.imu_acc_bias_sigma = 0.01;
@@ -157,6 +168,13 @@ TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
   EXPECT_NE(error(base + "carried_height: {height_m: 1.2, sigma_m: 0}\n").find("key 'carried_height.sigma_m' must be > 0"),
             std::string::npos);
   EXPECT_NE(error(base + "carried_height: {height_m: 1.2, sigma: 0.3}\n").find("unknown key 'carried_height.sigma'"),
+            std::string::npos);
+  EXPECT_NE(error(base + "flight_volume: {min_m: [0, 0, 0]}\n").find("flight_volume.max_m"), std::string::npos);
+  EXPECT_NE(error(base + "flight_volume: {min_m: [0, 0, 0], max_m: [5, 5, 0]}\n").find("key 'flight_volume' min_m must be below max_m"),
+            std::string::npos);
+  EXPECT_NE(error(base + "flight_volume: {min_m: [0, 0, 0], max_m: [5, .inf, 3]}\n").find("flight_volume"),
+            std::string::npos);
+  EXPECT_NE(error(base + "flight_volume: {min_m: [0, 0, 0], max_m: [5, 5, 3], margin: 1}\n").find("unknown key 'flight_volume.margin'"),
             std::string::npos);
   EXPECT_NE(error(base + "baro: {reference_pressure: 1e9}\n").find("key 'baro.reference_pressure'"), std::string::npos);
   EXPECT_NE(error("abs_anchor_positions: {4294967297: [0, 0, 0]}\n").find("'4294967297' is not a device id"),

@@ -103,6 +103,7 @@ TEST(SimScenarioSimulator, SetupHoldsOnlyWhatAUserKnowsAndTruthEverything) {
   EXPECT_LT((setup.initial_pose->p_IinG - gt0.p_IinG).norm(), 0.3);
   ASSERT_TRUE(setup.noise.sigma_range_m.has_value());
   EXPECT_EQ(*setup.noise.sigma_range_m, 0.1);
+  EXPECT_FALSE(setup.flight_volume.has_value());  // the paper scenario's files stay as they were
 
   ASSERT_TRUE(r.dataset.truth.has_value());
   const auto& truth = *r.dataset.truth;
@@ -205,6 +206,12 @@ TEST(SimScenarioSimulator, GeneratedScenarioHasTheRequestedDevicesInTheTdma) {
   EXPECT_FALSE(ds.baro.empty());
   EXPECT_FALSE(ds.flight_states.empty());
   EXPECT_EQ(ds.truth->scalars.at("scenario_n_tags"), 3.0);
+  // The user knows the hall: it is the flight volume, and every true position is inside it.
+  ASSERT_TRUE(ds.setup.flight_volume.has_value());
+  const Hall hall = generated(TrajectoryKind::Figure8).hall();
+  EXPECT_EQ(ds.setup.flight_volume->min_m, hall.min_m);
+  EXPECT_EQ(ds.setup.flight_volume->max_m, hall.max_m);
+  for (const auto& g : ds.ground_truth) ASSERT_EQ(ds.setup.flight_volume->distanceOutside(g.p_IinG), 0.0);
 }
 
 TEST(SimScenarioSimulator, HoverStartsInTheAirWithAGivenBaroReference) {
