@@ -211,6 +211,19 @@ struct RecoveryOptions {
   double degraded_disagreement_chi2 = 23.5;
 };
 
+/// The setup's `flight_volume` against the mirror image across coplanar known anchors on its walls
+/// or ceiling (AnchorPlaneMirror, docs/robustness.md "The flight volume"). Used only when the
+/// setup has a flight volume and the known anchors lie in one plane that bounds it.
+struct FlightVolumeOptions {
+  bool enabled = true;
+  /// An estimate this far outside the volume whose mirror image is inside is reflected into it [m].
+  double mirror_margin_m = 0.1;
+  /// The vehicle is on the volume's side of the anchors' plane: the position's Gaussian is
+  /// truncated to that side at most this often (Simon's PDF truncation, as a pseudo-measurement
+  /// along the plane's normal); 0: never [Hz].
+  double side_constraint_rate_hz = 10.0;
+};
+
 /// Anchor refinement (issue 10): a second pass when a calibrated anchor joins. The calibration used
 /// the filter's trajectory, so refining the calibrated belief forward cannot undo the trajectory's
 /// error (docs/results.md, "What limits the refinement"); estimating the anchor jointly with the
@@ -259,6 +272,7 @@ struct EstimatorOptions {
   HealthOptions health;
   ProcessNoiseAdaptOptions process_noise;
   RecoveryOptions recovery;
+  FlightVolumeOptions flight_volume;
   RefineOptions refine;
   /// Inputs stamped far from the node's current time (common/time_guard.h): `time.max_offset_s`
   /// (>= window_s) and `time.rebase_after`.

@@ -108,6 +108,8 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       time_guard_(options_.time) {
   options_.validate();
   carried_height_ = carriedHeightUsed(options_, setup_);
+  if (setup_.flight_volume && options_.flight_volume.enabled)
+    plane_mirror_ = AnchorPlaneMirror::of(setup_.abs_anchor_positions, *setup_.flight_volume);
   baro_aligns_ = baroAligns(options_, setup_);
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
   skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
@@ -122,6 +124,7 @@ void EstimatorNode::resetAll() {
   initializer_ = std::make_unique<StaticInitializer>(options_, setup_);
   aligner_.clear();
   last_align_try_.reset();
+  last_side_constraint_.reset();
   gravity_check_at_.reset();
   gravity_checks_ = 0;
   gravity_z_sign_ = -1.0;

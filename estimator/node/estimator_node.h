@@ -69,6 +69,7 @@
 #include "estimator/node/estimator_input.h"
 #include "estimator/health/health_monitor.h"
 #include "estimator/imu/process_noise_adapter.h"
+#include "estimator/node/anchor_plane_mirror.h"
 #include "estimator/node/motion_aligner.h"
 #include "estimator/node/static_initializer.h"
 #include "estimator/zupt/rest_rate_mean.h"
@@ -232,6 +233,13 @@ class EstimatorNode {
   InitialBelief beliefFromAlignment(const AlignmentResult& r) const;
   void updateHealth(Timestamp t);
   void tryRecover(Timestamp t);
+  /// An estimate more than `flight_volume.mirror_margin_m` outside the setup's flight volume whose
+  /// mirror image across the coplanar known anchors' plane is inside is that mirror image: position
+  /// and velocity are reflected (P ← J P Jᵀ), counted (`mirrored_into_flight_volume`) and logged.
+  void checkFlightVolume(Timestamp t);
+  /// Otherwise the position is truncated to the volume's side of that plane
+  /// (AnchorPlaneMirror::sideConstraint, at most `flight_volume.side_constraint_rate_hz`).
+  void constrainToVolumeSide(Timestamp t);
   /// χ² (4 dof) between the filter's position and yaw and an aligned pose, both covariances.
   double disagreement(const AlignmentResult& r) const;
   /// Replaces the IMU instance (state, covariance, time); every other instance keeps its mean and
@@ -335,6 +343,8 @@ class EstimatorNode {
   bool have_flight_state_ = false;
   std::optional<double> last_pressure_pa_;
   HealthMonitor health_;
+  std::optional<AnchorPlaneMirror> plane_mirror_;  ///< setup flight_volume and coplanar known anchors
+  std::optional<Timestamp> last_side_constraint_;
   std::optional<Timestamp> last_align_try_, last_recovery_try_, last_health_eval_;
   std::optional<Timestamp> gravity_check_at_;  ///< when checkGravityDirection runs (once)
   int gravity_checks_ = 0;

@@ -331,6 +331,7 @@ void EstimatorNode::propagateFilter(const Eigen::Vector3d& acc, const Eigen::Vec
 void EstimatorNode::updateHealth(Timestamp t) {
   if (!initialized()) return;
   if (reentry_.since) return;  // ranges are arriving, held for their joint check (at most uwb.reentry_hold_s)
+  checkFlightVolume(t);  // after every input: a slide across the plane takes a few tenths of a second
   if (last_health_eval_ && (t - *last_health_eval_).sec() < 0.1) return;
   last_health_eval_ = t;
   const auto [sigma_p, axis] = weakestPositionAxis(cur_.filter->covariance(setup_.imu_id, setup_.imu_id)
@@ -392,6 +393,50 @@ void EstimatorNode::tryRecover(Timestamp t) {
                "σ_p {:.2f} m, σ_yaw {:.1f} deg); anchors and bias states kept",
                formatSeconds(r->t), r->n_ranges, (r->imu.p_IinG - before.p_IinG).norm(), r->sigma_p_m,
                r->sigma_yaw_deg);
+}
+
+void EstimatorNode::checkFlightVolume(Timestamp t) {
+  if (!plane_mirror_) return;
+  const FusionStrategy& f = *cur_.filter;
+  const ImuState& x = f.state().imu;
+  if (!cur_.last_imu) return;
+  if (!plane_mirror_->isMirrorImage(x.p_IinG, options_.flight_volume.mirror_margin_m)) {
+    constrainToVolumeSide(t);
+    return;
+  }
+  ImuState m = x;
+  m.p_IinG = plane_mirror_->mirror(x.p_IinG);
+  m.v_IinG = plane_mirror_->reflection() * x.v_IinG;
+  ImuMatrix J = ImuMatrix::Identity();
+  J.block<3, 3>(ImuErr::kP, ImuErr::kP) = plane_mirror_->reflection();
+  J.block<3, 3>(ImuErr::kV, ImuErr::kV) = plane_mirror_->reflection();
+  const ImuMatrix P = J * f.covariance(setup_.imu_id, setup_.imu_id) * J.transpose();
+  diag_.count("mirrored_into_flight_volume");
+  spdlog::warn("estimator: at t={} the estimate [{:.2f}, {:.2f}, {:.2f}] m is {:.2f} m outside the flight volume and "
+               "its mirror image across the known anchors' plane is inside: taken as the mirror image (moved {:.2f} m)",
+               formatSeconds(t), x.p_IinG.x(), x.p_IinG.y(), x.p_IinG.z(),
+               setup_.flight_volume->distanceOutside(x.p_IinG), (m.p_IinG - x.p_IinG).norm());
+  replaceImu(m, P, f.state().t, *cur_.last_imu);
+}
+
+void EstimatorNode::constrainToVolumeSide(Timestamp t) {
+  const double rate = options_.flight_volume.side_constraint_rate_hz;
+  if (rate <= 0.0 || (last_side_constraint_ && (t - *last_side_constraint_).sec() < 1.0 / rate - 1e-9)) return;
+  last_side_constraint_ = t;
+  FusionStrategy& f = *cur_.filter;
+  const Eigen::Vector3d n = plane_mirror_->inwardNormal();
+  const double mu = plane_mirror_->inwardDistance(f.state().imu.p_IinG);
+  const Eigen::Matrix3d P_pp = f.covariance(setup_.imu_id, setup_.imu_id).block<3, 3>(ImuErr::kP, ImuErr::kP);
+  const auto c = AnchorPlaneMirror::sideConstraint(mu, n.dot(P_pp * n));
+  if (!c) return;
+  Linearization lin;  // r = z − nᵀ(p̂ − c_plane), H = nᵀ on δp
+  lin.residual = Eigen::VectorXd::Constant(1, c->z - mu);
+  lin.R = Eigen::MatrixXd::Constant(1, 1, c->R);
+  JacobianBlock b{setup_.imu_id, Eigen::MatrixXd::Zero(1, ImuErr::kDim)};
+  b.H.block<1, 3>(0, ImuErr::kP) = n.transpose();
+  lin.blocks.push_back(std::move(b));
+  f.update(lin, 0.0);  // not gated: a constraint, not a sensor
+  diag_.count("flight_volume_side_constraint");
 }
 
 void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu) {

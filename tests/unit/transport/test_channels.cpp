@@ -71,7 +71,9 @@ TEST(Channels, EveryEstimatorInputKindHasItsChannel) {
     if constexpr (requires { K::kDatasetOnly; }) return;
     constexpr auto c = channels::find<T>(K::name);
     EXPECT_NE(c.name, nullptr) << K::name;
-    if (c.name) EXPECT_STREQ(c.name, K::name);
+    if (c.name) {
+      EXPECT_STREQ(c.name, K::name);
+    }
     ++n;
   });
   EXPECT_GE(n, 7);
