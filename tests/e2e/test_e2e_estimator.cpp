@@ -2,7 +2,6 @@
 /// compare estimate.csv with the ground truth: seed 1 with the known anchors 101–104 only, and
 /// seed 10 with 106–110 given as known-but-uncertain (σ 0.3 m) and refined online.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -11,6 +10,7 @@
 
 #include "common/dataset.h"
 #include "common/estimate_io.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 namespace fs = std::filesystem;
@@ -30,11 +30,10 @@ struct PoseMetrics {
 /// Simulates `seed` (extra meshnav_sim args), runs meshnav_run (extra args) and compares
 /// estimate.csv with the ground truth at every ground-truth sample.
 PoseMetrics runSequence(const std::string& name, int seed, const std::string& sim_args, const std::string& run_args) {
-  // The process id keeps two checkouts' test runs on one machine out of each other's folders.
-  const fs::path dir =
-      fs::path(::testing::TempDir()) / ("meshnav_e2e_estimator_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  // A private folder (unique name: parallel jobs and checkouts stay apart), removed at the end;
+  // MESHNAV_KEEP_TEST_FILES=1 keeps it to look at the logs.
+  const meshnav::test::TempDir tmp("e2e_estimator_" + name);
+  const fs::path& dir = tmp.path();
   const fs::path data = dir / "data", out = dir / "run";
   PoseMetrics m;
   EXPECT_EQ(run(std::string(MESHNAV_SIM_BIN) + " --seed " + std::to_string(seed) + " " + sim_args + " --out " +
@@ -76,7 +75,6 @@ PoseMetrics runSequence(const std::string& name, int seed, const std::string& si
   m.anees_p = nees / m.n;
   std::cout << name << ", seed " << seed << ": position RMSE " << m.rmse_p_m << " m, orientation RMSE " << m.rmse_q_deg
             << " deg, position ANEES " << m.anees_p << " (" << m.n << " samples)" << std::endl;
-  if (!::testing::Test::HasFailure()) fs::remove_all(dir);  // kept on failure, to look at
   return m;
 }
 
@@ -111,7 +109,8 @@ TEST(EndToEnd, UncertainAnchorsDpAndDahOnSimulatedSeed10) {
   EXPECT_LE(dah.rmse_p_m, 1.15 * dp.rmse_p_m);
 
   // The same DAH run fusing the estimated anchors' mutual ranges.
-  const fs::path cfg = fs::path(::testing::TempDir()) / "meshnav_e2e_dah_fuse_pairs.yaml";
+  const meshnav::test::TempDir tmp("e2e_dah_fuse_pairs");
+  const fs::path cfg = tmp / "config.yaml";
   ASSERT_EQ(run(std::string(MESHNAV_RUN_BIN) + " --print-config > " + cfg.string()), 0);
   std::ifstream in(cfg);
   std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -4,8 +4,6 @@
 /// when a finished mission lets its process exit.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -16,6 +14,7 @@
 #include "common/anchor_init_io.h"
 #include "calibrator/process/calibrator_process_config.h"
 #include "mission/process/mission_process_config.h"
+#include "tests/support/test_util.h"
 
 namespace {
 
@@ -72,23 +71,17 @@ std::string refusal(const Parsed<Config>& p, Finish finish) {
   return "";
 }
 
-class TempDir {
+/// A private temp folder (tests/support/test_util.h) with a file writer.
+class FileDir {
  public:
-  TempDir() {
-    path_ = fs::temp_directory_path() / ("meshnav_process_config_" + std::to_string(::getpid()) + "_" +
-                                         std::to_string(counter_++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() { fs::remove_all(path_); }
   std::string file(const std::string& name, const std::string& text = "") const {
-    const auto p = (path_ / name).string();
+    const auto p = (dir_ / name).string();
     if (!text.empty()) std::ofstream(p) << text;
     return p;
   }
 
  private:
-  fs::path path_;
-  static inline int counter_ = 0;
+  meshnav::test::TempDir dir_{"process_config"};
 };
 
 std::string repoFile(const std::string& rel) { return std::string(MESHNAV_SOURCE_DIR) + "/" + rel; }
@@ -146,7 +139,7 @@ TEST(CalibratorProcessConfig, RepoConfigEqualsBuiltInDefaults) {
 }
 
 TEST(CalibratorProcessConfig, SigmaRangeFromSetupUnlessConfigured) {
-  TempDir dir;
+  FileDir dir;
   SystemSetup setup;
   setup.noise.sigma_range_m = 0.17;
 
@@ -172,7 +165,7 @@ TEST(CalibratorProcessConfig, SigmaRangeFromSetupUnlessConfigured) {
 }
 
 TEST(CalibratorProcessConfig, EitherMapMayBeMissing) {
-  TempDir dir;
+  FileDir dir;
   auto p = parseCalibrator(
       {"--config", dir.file("n.yaml", "calibrator_node:\n  auto_min_ranges: 50\n")});
   ASSERT_TRUE(p->ok);
@@ -187,7 +180,7 @@ TEST(CalibratorProcessConfig, EitherMapMayBeMissing) {
 }
 
 TEST(CalibratorProcessConfig, ConfigErrorsNameFileAndKey) {
-  TempDir dir;
+  FileDir dir;
   const auto bad = dir.file("bad.yaml", "calibrator_node:\n  auto_min_rangez: 50\n");
   auto p = parseCalibrator({"--config", bad});
   ASSERT_TRUE(p->ok);
@@ -214,7 +207,7 @@ TEST(CalibratorProcessConfig, ConfigErrorsNameFileAndKey) {
 }
 
 TEST(CalibrationYamlWriter, WritesOnChangeAndReadsBack) {
-  TempDir dir;
+  FileDir dir;
   const auto path = dir.file("sub/calibration.yaml");
   calib::CalibrationYamlWriter w(path);
   ASSERT_TRUE(w.enabled());

@@ -46,15 +46,16 @@ class FixedListTest(unittest.TestCase):
         self.assertTrue(all(60 <= s["duration"] <= 90 for s in scs))
 
     def test_unknown_keys_and_duplicate_names_are_rejected(self):
-        with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as f:
-            f.write("scenarios:\n  - {name: a, trajectroy: walk}\n")
-        with self.assertRaisesRegex(ValueError, "trajectroy"):
-            robustness.load_scenarios(f.name)
-        with open(f.name, "w") as g:
-            g.write("scenarios:\n  - {name: a}\n  - {name: a}\n")
-        with self.assertRaisesRegex(ValueError, "unique"):
-            robustness.load_scenarios(f.name)
-        os.unlink(f.name)
+        with tempfile.TemporaryDirectory(prefix="meshnav_robustness_test_") as d:
+            path = os.path.join(d, "scenarios.yaml")
+            with open(path, "w") as g:
+                g.write("scenarios:\n  - {name: a, trajectroy: walk}\n")
+            with self.assertRaisesRegex(ValueError, "trajectroy"):
+                robustness.load_scenarios(path)
+            with open(path, "w") as g:
+                g.write("scenarios:\n  - {name: a}\n  - {name: a}\n")
+            with self.assertRaisesRegex(ValueError, "unique"):
+                robustness.load_scenarios(path)
 
     def test_sim_arguments(self):
         args = robustness.sim_args({"name": "x", "seed": 4, "trajectory": "walk", "hall": [10, 8, 3], "outliers": 0.1,

@@ -10,14 +10,14 @@
 #include "common/anchor_init_io.h"
 #include "calibrator/observation_builder.h"
 #include "calibrator/synthetic_scene.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 using namespace meshnav::calib;
 
 namespace {
 std::string tmpFile(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("meshnav_calib_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  static const meshnav::test::TempDir dir("calib_test");  // removed at exit
   return (dir / name).string();
 }
 }  // namespace

@@ -3,21 +3,19 @@
 /// that does not fit 32 bits) with exit 2 and the option named, and the `--config` options file.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 
 #include "common/cli.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 
 namespace {
 
 std::string tempFile(const std::string& name, const std::string& text) {
-  const auto p = std::filesystem::temp_directory_path() / ("meshnav_test_cli_" + std::to_string(::getpid()) + name);
-  std::ofstream(p) << text;
-  return p.string();
+  static const test::TempDir dir("test_cli");  // removed at exit
+  return test::writeFile(dir / name, text);
 }
 
 /// A command with one option of each kind.

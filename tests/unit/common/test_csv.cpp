@@ -1,12 +1,12 @@
 #include <gtest/gtest.h>
 
 #include "common/csv.h"
-#include "test_util.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 
 TEST(Csv, ReadsColumnsByNameAndSkipsCommentsAndBlankLines) {
-  auto d = test::tempDir("csv");
+  const test::TempDir d("csv");
   auto f = test::writeFile(d / "a.csv", "b,a\n1,2\n\n# comment\n3,4\n");
   CsvReader r(f, {"a", "b"});
   Diagnostics diag;
@@ -33,7 +33,7 @@ TEST(Csv, MissingFileNamesThePath) {
 }
 
 TEST(Csv, MissingColumnNamesFileAndColumn) {
-  auto d = test::tempDir("csv");
+  const test::TempDir d("csv");
   auto f = test::writeFile(d / "a.csv", "t,x\n1,2\n");
   try {
     CsvReader r(f, {"t", "pressure"});
@@ -46,13 +46,13 @@ TEST(Csv, MissingColumnNamesFileAndColumn) {
 }
 
 TEST(Csv, EmptyFileIsAnError) {
-  auto d = test::tempDir("csv");
+  const test::TempDir d("csv");
   auto f = test::writeFile(d / "empty.csv", "");
   EXPECT_THROW(CsvReader(f, {}), std::runtime_error);
 }
 
 TEST(Csv, WrongFieldCountIsCountedAndSkipped) {
-  auto d = test::tempDir("csv");
+  const test::TempDir d("csv");
   auto f = test::writeFile(d / "a.csv", "t,x\n1,2\n3\n4,5,6\n7,8\n");
   CsvReader r(f, {"t", "x"});
   Diagnostics diag;
@@ -63,7 +63,7 @@ TEST(Csv, WrongFieldCountIsCountedAndSkipped) {
 }
 
 TEST(Csv, NonFiniteNumbersAreNullopt) {
-  auto d = test::tempDir("csv");
+  const test::TempDir d("csv");
   auto f = test::writeFile(d / "a.csv", "x,y,z\nnan,inf,abc\n");
   CsvReader r(f, {"x"});
   Diagnostics diag;
@@ -76,7 +76,7 @@ TEST(Csv, NonFiniteNumbersAreNullopt) {
 }
 
 TEST(Csv, TumHeaderWithHashAndSpaces) {
-  auto d = test::tempDir("csv");
+  const test::TempDir d("csv");
   auto f = test::writeFile(d / "gt.txt", "#t tx ty\n1.5 2 3\n");
   CsvReader r(f, {"t", "tx", "ty"});
   Diagnostics diag;
@@ -94,7 +94,7 @@ TEST(Csv, FilesAboveTheSizeLimitAreRefusedWithAMessage) {
   // up front. The limit is lowered to 1 MiB here so that the test file stays small.
   ASSERT_EQ(setenv("MESHNAV_MAX_CSV_MB", "1", 1), 0);
   EXPECT_EQ(maxCsvBytes(), 1u << 20);
-  auto d = test::tempDir("csv");
+  const test::TempDir d("csv");
   std::string text = "t,range_raw,UWB_ID1,UWB_ID2,type_ID1,type_ID2\n";
   while (text.size() <= (1u << 20)) text += "1.000000,4.000000,100,101,T,A\n";
   const auto f = test::writeFile(d / "ranges.csv", text);

@@ -6,12 +6,12 @@
 
 #include "common/dataset.h"
 #include "common/estimate_io.h"
-#include "test_util.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 
 TEST(Ranges, ReadsLettersAndAsciiTypeCodes) {
-  auto d = test::tempDir("ranges");
+  const test::TempDir d("ranges");
   auto f = test::writeFile(d / "ranges.csv",
                            "t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS\n"
                            "1.0,4.5,0.0,0.0,100,101,T,A,1\n"
@@ -29,7 +29,7 @@ TEST(Ranges, ReadsLettersAndAsciiTypeCodes) {
 }
 
 TEST(Ranges, BadRowsAreReportedCountedAndDropped) {
-  auto d = test::tempDir("ranges");
+  const test::TempDir d("ranges");
   auto f = test::writeFile(d / "ranges.csv",
                            "t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS\n"
                            "1.0,nan,0,0,100,101,T,A,1\n"       // NaN range
@@ -56,7 +56,7 @@ TEST(Ranges, BadRowsAreReportedCountedAndDropped) {
 }
 
 TEST(Ranges, TimeGoingBackwardsIsReportedAndSorted) {
-  auto d = test::tempDir("ranges");
+  const test::TempDir d("ranges");
   auto f = test::writeFile(d / "ranges.csv",
                            "t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS\n"
                            "2.0,1,0,0,100,101,T,A,1\n1.0,2,0,0,100,101,T,A,1\n3.0,3,0,0,100,101,T,A,1\n");
@@ -90,7 +90,7 @@ TEST(Ranges, ImportsTheRealRecording) {
 }
 
 TEST(Imu, BadValuesAreDropped) {
-  auto d = test::tempDir("imu");
+  const test::TempDir d("imu");
   auto f = test::writeFile(d / "imu.csv",
                            "t,lin_acc_x,lin_acc_y,lin_acc_z,ang_vel_x,ang_vel_y,ang_vel_z\n"
                            "0.000,0,0,9.81,0,0,0\n0.005,nan,0,9.81,0,0,0\n0.010,0,0,9000,0,0,0\n0.015,0,0,9.8,0,0,0.1\n");
@@ -103,7 +103,7 @@ TEST(Imu, BadValuesAreDropped) {
 }
 
 TEST(Dataset, WriteReadRoundTrip) {
-  auto d = test::tempDir("ds");
+  const test::TempDir d("ds");
   Dataset ds;
   ds.setup.rel_tag_positions[100] = {0.1, 0, 0};
   ds.setup.abs_anchor_positions[101] = {1, 2, 3};
@@ -142,7 +142,7 @@ TEST(Dataset, WriteReadRoundTrip) {
 TEST(Dataset, MissingFolderOrRangesIsAClearError) {
   Diagnostics diag;
   EXPECT_THROW(readDataset("/nonexistent/dataset", diag), std::runtime_error);
-  auto d = test::tempDir("ds");
+  const test::TempDir d("ds");
   saveSetup(SystemSetup{}, (d / "setup.yaml").string());
   try {
     readDataset(d.string(), diag);
@@ -153,7 +153,7 @@ TEST(Dataset, MissingFolderOrRangesIsAClearError) {
 }
 
 TEST(EstimateIo, RoundTripAndAutoDetection) {
-  auto d = test::tempDir("est");
+  const test::TempDir d("est");
   {
     EstimateCsvWriter w((d / "estimate.csv").string());
     PoseEstimate e;
@@ -183,7 +183,7 @@ TEST(EstimateIo, RoundTripAndAutoDetection) {
 }
 
 TEST(Height, OptionalFileIsReadValidatedAndWrittenBack) {
-  auto d = test::tempDir("height");
+  const test::TempDir d("height");
   test::writeFile(d / "setup.yaml", "imu_id: 1\n");
   test::writeFile(d / "ranges.csv", "t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS\n");
   Diagnostics diag;
@@ -195,7 +195,7 @@ TEST(Height, OptionalFileIsReadValidatedAndWrittenBack) {
   EXPECT_EQ(ds.heights[0].t.us, 103621);
   EXPECT_DOUBLE_EQ(ds.heights[1].range_m, 0.31);
   EXPECT_EQ(diag.get("height.csv:bad_value"), 3);
-  auto out = test::tempDir("height_out");
+  const test::TempDir out("height_out");
   writeDataset(ds, out.string());
   Diagnostics diag2;
   const auto back = readHeightCsv((out / "height.csv").string(), diag2);

@@ -2,14 +2,14 @@
 #include <gtest/gtest.h>
 
 #include "common/estimate_io.h"
-#include "test_util.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 
 // Found by fuzz target estimate_csv (UBSan: 1e+20 cast to int): an anchors.csv id that is not a
 // device id is reported and its row skipped; the good row stays.
 TEST(EstimateIo, AnchorIdsThatAreNotDeviceIdsAreSkipped) {
-  const auto d = test::tempDir("estimate_io");
+  const test::TempDir d("estimate_io");
   const std::string path = test::writeFile(d / "anchors.csv",
                                            "t,id,x,y,z,pxx,pxy,pxz,pyy,pyz,pzz\n"
                                            "1,1e20,1,2,3,1,0,0,1,0,1\n"
@@ -26,7 +26,7 @@ TEST(EstimateIo, AnchorIdsThatAreNotDeviceIdsAreSkipped) {
 // Found by fuzz target estimate_csv: a zero quaternion came back as a zero "rotation". A quaternion
 // far from unit norm is reported and its row skipped, as in groundtruth.csv.
 TEST(EstimateIo, QuaternionFarFromUnitIsSkipped) {
-  const auto d = test::tempDir("estimate_io_q");
+  const test::TempDir d("estimate_io_q");
   const std::string head = "t,tx,ty,tz,qx,qy,qz,qw,pxx,pxy,pxz,pyy,pyz,pzz,qrr,qrp,qry,qpp,qpy,qyy\n";
   const std::string cov = ",0.01,0,0,0.01,0,0.02,1e-4,0,0,1e-4,0,1e-4\n";
   const std::string path = test::writeFile(d / "estimate.csv", head + "0.5,1,2,3,0,0,0,0" + cov + "0.6,1,2,3,0,0,0,3" + cov +

@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "common/setup.h"
-#include "test_util.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 
@@ -29,7 +29,7 @@ SystemSetup sample() {
 }  // namespace
 
 TEST(Setup, RoundTrip) {
-  auto d = test::tempDir("setup");
+  const test::TempDir d("setup");
   const auto s = sample();
   saveSetup(s, (d / "setup.yaml").string());
   const auto r = loadSetup((d / "setup.yaml").string());
@@ -99,7 +99,7 @@ TEST(Setup, ReadsThePublishedToolboxConfig) {
 }
 
 TEST(Setup, MalformedFilesNameFileAndKey) {
-  auto d = test::tempDir("setup");
+  const test::TempDir d("setup");
   auto expectError = [&](const std::string& text, const std::string& needle) {
     auto f = test::writeFile(d / "bad.yaml", text);
     try {
@@ -124,7 +124,7 @@ TEST(Setup, MalformedFilesNameFileAndKey) {
 
 TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
   // Issue 12, finding 4 and item 5; issue 11 "options files: one rule".
-  auto d = test::tempDir("setup");
+  const test::TempDir d("setup");
   const std::string base =
       "rel_tag_positions: {100: [0, 0, 0], 105: [0.1, 0, 0]}\n"
       "abs_anchor_positions: {101: [1, 2, 3], 102: [3, 2, 1]}\n";
@@ -194,7 +194,7 @@ TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
 }
 
 TEST(Truth, RoundTrip) {
-  auto d = test::tempDir("truth");
+  const test::TempDir d("truth");
   Truth t;
   t.anchor_positions[106] = {1, 2, 3};
   t.pair_biases.push_back({100, 106, -0.2, 0.995, 0.1});
@@ -208,7 +208,7 @@ TEST(Truth, RoundTrip) {
 }
 
 TEST(Truth, FrameOfTheGroundTruthRoundTripsAndDefaultsToTheWorldFrame) {
-  auto d = test::tempDir("truth_frame");
+  const test::TempDir d("truth_frame");
   Truth t;
   t.truth_frame = "vive/reference";
   t.align_required = true;
@@ -223,7 +223,7 @@ TEST(Truth, FrameOfTheGroundTruthRoundTripsAndDefaultsToTheWorldFrame) {
 }
 
 TEST(Truth, AlignRequiredMustBeABoolean) {
-  auto d = test::tempDir("truth_frame_bad");
+  const test::TempDir d("truth_frame_bad");
   const auto f = test::writeFile(d / "truth.yaml", "truth_frame: vive\nalign_required: maybe\n");
   try {
     loadTruth(f);

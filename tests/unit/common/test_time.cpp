@@ -8,7 +8,7 @@
 
 #include "common/dataset.h"
 #include "common/time.h"
-#include "test_util.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 
@@ -40,7 +40,7 @@ TEST(Time, FormatSecondsHandlesEveryInt64) {
 }
 
 TEST(Time, CsvTimesThatDoNotFitAreReportedWithFileAndLine) {
-  const auto d = test::tempDir("time");
+  const test::TempDir d("time");
   const auto f = test::writeFile(d / "ranges.csv",
                                  "t,range_raw,UWB_ID1,UWB_ID2,type_ID1,type_ID2\n"
                                  "1.0,4.0,100,101,T,A\n"

@@ -12,6 +12,7 @@
 #include "estimator/node/checkpoint.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/testing/synthetic_scenario.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 using namespace meshnav::estimator;
@@ -53,8 +54,10 @@ void runUntil(EstimatorNode& node, const Dataset& ds, double until_s, double aft
   }
 }
 
+/// A fresh folder `name` in this binary's private temp folder (removed at exit).
 std::string tempDir(const std::string& name) {
-  const std::string dir = ::testing::TempDir() + "/" + name;
+  static const meshnav::test::TempDir root("checkpoint");
+  const std::string dir = (root / name).string();
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

@@ -6,14 +6,19 @@
 #include <fstream>
 
 #include "estimator/core/estimator_options.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav::estimator;
 
 namespace {
+/// This binary's private temp folder, removed at exit.
+const meshnav::test::TempDir& tempRoot() {
+  static const meshnav::test::TempDir root("estimator_options");
+  return root;
+}
+
 std::string tempFile(const std::string& name, const std::string& text) {
-  const std::string path = ::testing::TempDir() + name;
-  std::ofstream(path) << text;
-  return path;
+  return meshnav::test::writeFile(tempRoot() / name, text);
 }
 }  // namespace
 
@@ -60,7 +65,7 @@ std::string loadError(const std::string& name, const std::string& text) {
 
 TEST(EstimatorOptions, UnknownKeysAndBadValuesNameFileAndKey) {
   // Issue 12, finding 4 / issue 11: a misspelled key used to be ignored.
-  const std::string path = ::testing::TempDir() + "opts_typo.yaml";
+  const std::string path = (tempRoot() / "opts_typo.yaml").string();
   std::string e = loadError("opts_typo.yaml", "uwb:\n  sigma_range_mm: 0.2\n");
   EXPECT_NE(e.find(path), std::string::npos) << e;
   EXPECT_NE(e.find("unknown key 'uwb.sigma_range_mm'"), std::string::npos) << e;

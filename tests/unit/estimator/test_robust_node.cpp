@@ -12,6 +12,7 @@
 #include "sim/scenario_simulator.h"
 #include "sim/uncertain_anchors.h"
 #include "robust_node_helpers.h"
+#include "tests/support/test_util.h"
 
 
 using namespace meshnav;
@@ -249,7 +250,8 @@ RestartResult restart(const sim::SimulationResult& r, double outage_s, bool with
     before.onInput(in);
   }
   EXPECT_TRUE(before.initialized());
-  const std::string dir = ::testing::TempDir() + "/meshnav_checkpoint_test";
+  const meshnav::test::TempDir tmp("checkpoint_test");
+  const std::string dir = tmp.string();
   writeCheckpoint(before.checkpoint(), dir);
   EstimatorNode after(EstimatorOptions{}, r.dataset.setup);
   if (with_checkpoint) after.resumeFrom(*readCheckpoint(dir));
@@ -283,7 +285,8 @@ TEST(RobustNode, CheckpointFilesRoundTrip) {
   }
   const EstimatorCheckpoint c = node.checkpoint();
   ASSERT_EQ(c.anchors.size(), 5u);
-  const std::string dir = ::testing::TempDir() + "/meshnav_checkpoint_roundtrip";
+  const meshnav::test::TempDir tmp("checkpoint_roundtrip");
+  const std::string dir = tmp.string();
   writeCheckpoint(c, dir);
   const auto back = readCheckpoint(dir);
   ASSERT_TRUE(back.has_value());
@@ -356,8 +359,8 @@ TEST(RobustNode, AStaleCheckpointIsNotUsed) {
 }
 
 TEST(RobustNode, MalformedCheckpointIsRefusedNamingFileAndKey) {
-  const std::string dir = ::testing::TempDir() + "/meshnav_bad_checkpoint";
-  std::filesystem::create_directories(dir);
+  const meshnav::test::TempDir tmp("bad_checkpoint");
+  const std::string dir = tmp.string();
   {
     std::ofstream f(dir + "/estimator_state.yaml");
     f << "format: meshnav_estimator_state\nversion: 2\nt: 1.0\nlanded: false\ninstances:\n"

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "eval/anchor_metrics.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 using namespace meshnav::eval;
@@ -78,8 +79,7 @@ TEST(AnchorMetrics, NoAnchorsGivesNaNMeans) {
 }
 
 TEST(CalibrationYaml, ReadsEntriesAndNamesMissingKeys) {
-  const auto dir = std::filesystem::temp_directory_path() / "meshnav_eval_calib_test";
-  std::filesystem::create_directories(dir);
+  const meshnav::test::TempDir dir("eval_calib_test");
   const auto good = (dir / "good.yaml").string();
   std::ofstream(good) << "- id: 106\n  p_AinG: [1, 2, 3]\n  p_AinG_cov: [0.04, 0, 0, 0, 0.04, 0, 0, 0, 0.09]\n"
                          "- id: 107\n  p_AinG: [4, 5, 6]\n";
@@ -96,5 +96,4 @@ TEST(CalibrationYaml, ReadsEntriesAndNamesMissingKeys) {
     EXPECT_NE(std::string(ex.what()).find("p_AinG"), std::string::npos) << ex.what();
     EXPECT_NE(std::string(ex.what()).find("bad.yaml"), std::string::npos) << ex.what();
   }
-  std::filesystem::remove_all(dir);
 }

@@ -22,7 +22,9 @@ def write(path, text):
 
 class AnchorTracks(unittest.TestCase):
     def setUp(self):
-        self.dir = tempfile.mkdtemp()
+        tmp = tempfile.TemporaryDirectory(prefix="meshnav_plot_run_")
+        self.addCleanup(tmp.cleanup)
+        self.dir = tmp.name
         write(os.path.join(self.dir, "anchors_eval.csv"),
               "id,known,has_truth,true_x,true_y,true_z,init_x,init_y,init_z,final_x,final_y,final_z\n"
               "101,1,1,0,0,0,0,0,0,0,0,0\n"
@@ -87,7 +89,9 @@ class AlignedTruth(unittest.TestCase):
 
 class RangeResiduals(unittest.TestCase):
     def setUp(self):
-        self.dir = tempfile.mkdtemp()
+        tmp = tempfile.TemporaryDirectory(prefix="meshnav_plot_run_")
+        self.addCleanup(tmp.cleanup)
+        self.dir = tmp.name
         # Body at (0, 0, 0) then (2, 0, 0) over t 10..12, yawed 90 deg (q = (0, 0, sin 45, cos 45)):
         # the tag at p_TinI = (1, 0, 0) is at (0, 1, 0) + p_IinG.
         s = math.sqrt(0.5)

@@ -12,6 +12,7 @@
 #include "eval/plotting.h"
 #include "eval/report.h"
 #include "eval/run_evaluation.h"
+#include "tests/support/test_util.h"
 
 namespace fs = std::filesystem;
 using namespace meshnav;
@@ -22,15 +23,12 @@ namespace {
 class RunEvaluationTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    root_ = fs::temp_directory_path() /
-            ("meshnav_eval_test_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(root_);
+    root_ = tmp_.path();
     ds_ = root_ / "dataset";
     run_ = root_ / "run";
     fs::create_directories(ds_);
     fs::create_directories(run_);
   }
-  void TearDown() override { fs::remove_all(root_); }
 
   /// 10 s of ground truth at 60 Hz (circle), estimates at 20 Hz with a constant 0.2 m x offset and
   /// σ = 0.2 m (NEES 1 per sample), two calibrated anchors and a known one.
@@ -85,6 +83,7 @@ class RunEvaluationTest : public ::testing::Test {
     row(6.0, 107, {2, 0.3, 1}, 0.01);  // error 0.3, NEES 9
   }
 
+  meshnav::test::TempDir tmp_{"eval_test"};  // removed after each test
   fs::path root_, ds_, run_;
 };
 

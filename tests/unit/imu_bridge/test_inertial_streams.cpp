@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "imu_bridge/inertial_streams.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 using namespace meshnav::imu;
@@ -14,7 +15,8 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path freshDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("meshnav_imu_" + std::to_string(::getpid()) + "_" + name);
+  static const test::TempDir root("imu");  // removed at exit
+  const fs::path d = root / name;
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

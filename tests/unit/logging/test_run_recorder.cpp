@@ -10,6 +10,7 @@
 #include "common/anchor_init_io.h"
 #include "common/estimate_io.h"
 #include "logging/run_recorder.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 using namespace meshnav::logging;
@@ -18,7 +19,8 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path freshDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("meshnav_log_" + std::to_string(::getpid()) + "_" + name);
+  static const test::TempDir root("log");  // removed at exit
+  const fs::path d = root / name;
   fs::remove_all(d);
   return d;
 }

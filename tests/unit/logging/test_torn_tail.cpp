@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "logging/torn_tail.h"
+#include "tests/support/test_util.h"
 #include "transport/input_journal.h"
 
 using namespace meshnav::logging;
@@ -19,8 +20,7 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path freshFile(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("meshnav_torn_" + std::to_string(::getpid()));
-  fs::create_directories(d);
+  static const meshnav::test::TempDir d("torn");  // removed at exit
   const fs::path f = d / name;
   fs::remove(f);
   return f;
@@ -141,5 +141,4 @@ TEST(TornTail, EventsAppendedAfterACutTornEventAreReadBackByLcm) {
   EXPECT_EQ(events[1].second, std::string(100, 'b'));
   EXPECT_EQ(events[2].second, std::string(100, 'd'));
   EXPECT_EQ(events[3].second, std::string(100, 'e'));
-  fs::remove_all(f.parent_path());
 }

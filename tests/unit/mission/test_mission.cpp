@@ -1,12 +1,11 @@
 /// Tests of the mission file loader: the paper mission, defaults, and errors naming file, line and key.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 
 #include "mission/mission.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav;
 using namespace meshnav::mission;
@@ -96,8 +95,7 @@ TEST(Mission, ErrorsNameFileLineAndKey) {
 }
 
 TEST(Mission, LoadNamesTheFile) {
-  const auto dir = std::filesystem::temp_directory_path() / ("meshnav_mission_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const meshnav::test::TempDir dir("mission_test");
   const std::string path = (dir / "bad.yaml").string();
   std::ofstream(path) << "steps:\n  - {t: 80.0, action: calibrate, anchors: [106]}\n  - {t: 90.0, action: fly}\n";
   try {
@@ -112,5 +110,4 @@ TEST(Mission, LoadNamesTheFile) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("missing.yaml: cannot open"), std::string::npos) << e.what();
   }
-  std::filesystem::remove_all(dir);
 }

@@ -1,7 +1,5 @@
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -9,6 +7,7 @@
 
 #include "common/dataset.h"
 #include "sim/scenario_simulator.h"
+#include "tests/support/test_util.h"
 
 using namespace meshnav::sim;
 namespace fs = std::filesystem;
@@ -50,12 +49,11 @@ TEST(SimScenarioSimulator, SameSeedGivesIdenticalDatasetDifferentSeedsDiffer) {
   EXPECT_TRUE(sameDataset(a.dataset, b.dataset));
   EXPECT_FALSE(sameDataset(a.dataset, c.dataset));
   // And identical files on disk.
-  const fs::path dir = fs::temp_directory_path() / ("meshnav_sim_test_" + std::to_string(::getpid()));
+  const meshnav::test::TempDir dir("sim_test");
   meshnav::writeDataset(a.dataset, (dir / "a").string());
   meshnav::writeDataset(b.dataset, (dir / "b").string());
   for (const char* f : {"imu.csv", "baro.csv", "ranges.csv", "flight_state.csv", "groundtruth.csv", "setup.yaml", "truth.yaml"})
     EXPECT_EQ(readFile(dir / "a" / f), readFile(dir / "b" / f)) << f;
-  fs::remove_all(dir);
 }
 
 TEST(SimScenarioSimulator, RatesCountsAndFlightStates) {
@@ -127,7 +125,7 @@ TEST(SimScenarioSimulator, WrittenDatasetReadsBackCleanly) {
   o.duration_scale = 0.3;
   o.with_initial_pose = false;
   const auto r = ScenarioSimulator(o).run();
-  const fs::path dir = fs::temp_directory_path() / ("meshnav_sim_rt_" + std::to_string(::getpid()));
+  const meshnav::test::TempDir dir("sim_rt");
   meshnav::writeDataset(r.dataset, dir.string());
   meshnav::Diagnostics diag;
   const auto back = meshnav::readDataset(dir.string(), diag, true);
@@ -143,7 +141,6 @@ TEST(SimScenarioSimulator, WrittenDatasetReadsBackCleanly) {
   EXPECT_EQ(back.truth->anchor_positions.size(), 9u);
   EXPECT_NEAR(back.ranges[5].range_m, r.dataset.ranges[5].range_m, 1e-6);
   EXPECT_LT((back.ground_truth[100].p_IinG - r.dataset.ground_truth[100].p_IinG).norm(), 1e-6);
-  fs::remove_all(dir);
 }
 
 TEST(SimScenarioSimulator, RejectsInvalidOptions) {
@@ -177,7 +174,7 @@ TEST(SimScenarioSimulator, WalkWritesNoBaroNoFlightStateNoInitialPoseAndReadsBac
   EXPECT_TRUE(ds.flight_states.empty());
   EXPECT_FALSE(ds.setup.initial_pose.has_value());
   EXPECT_FALSE(r.has_landed_phase);
-  const fs::path dir = fs::temp_directory_path() / ("meshnav_sim_walk_" + std::to_string(::getpid()));
+  const meshnav::test::TempDir dir("sim_walk");
   meshnav::writeDataset(ds, dir.string());
   EXPECT_FALSE(fs::exists(dir / "baro.csv"));
   EXPECT_FALSE(fs::exists(dir / "flight_state.csv"));
@@ -188,7 +185,6 @@ TEST(SimScenarioSimulator, WalkWritesNoBaroNoFlightStateNoInitialPoseAndReadsBac
   EXPECT_TRUE(back.flight_states.empty());
   EXPECT_EQ(back.imu.size(), ds.imu.size());
   EXPECT_EQ(back.ranges.size(), ds.ranges.size());
-  fs::remove_all(dir);
 }
 
 TEST(SimScenarioSimulator, GeneratedScenarioHasTheRequestedDevicesInTheTdma) {

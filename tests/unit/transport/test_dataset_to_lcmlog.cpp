@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/dataset.h"
+#include "tests/support/test_util.h"
 #include "transport/channels.h"
 #include "transport/convert.h"
 
@@ -19,9 +20,15 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// A private temp folder of this test binary, removed at exit.
+const meshnav::test::TempDir& tempRoot() {
+  static const meshnav::test::TempDir root("d2l");
+  return root;
+}
+
 /// A fresh folder for a test's dataset.
 fs::path freshDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / (name + "_" + std::to_string(::getpid()));
+  const fs::path dir = tempRoot() / name;
   fs::remove_all(dir);
   return dir;
 }
@@ -114,6 +121,6 @@ TEST(DatasetToLcmlog, EqualTimesKeepTheCanonicalOrder) {
 }
 
 TEST(DatasetToLcmlog, MissingDatasetFails) {
-  const std::string cmd = std::string(DATASET_TO_LCMLOG) + " --dataset /nonexistent/x --out /tmp/x.lcmlog 2>/dev/null";
+  const std::string cmd = std::string(DATASET_TO_LCMLOG) + " --dataset /nonexistent/x --out " + (tempRoot() / "x.lcmlog").string() + " 2>/dev/null";
   EXPECT_NE(std::system(cmd.c_str()), 0);
 }

@@ -7,12 +7,14 @@
 #include <fstream>
 
 #include "uwb_bridge/line_reader.h"
+#include "tests/support/test_util.h"
 
 using meshnav::uwb::LineReader;
 namespace fs = std::filesystem;
 
 TEST(LineReader, FileWithUnterminatedLastLine) {
-  const fs::path p = fs::temp_directory_path() / ("meshnav_lr_" + std::to_string(::getpid()));
+  const meshnav::test::TempDir dir("lr");
+  const fs::path p = dir / "lines.txt";
   std::ofstream(p) << "1 0 1 4.5\r\n2 0 2 5.0\n\n3 0 3 6.0";
   LineReader r(p.string());
   std::vector<std::string> lines;

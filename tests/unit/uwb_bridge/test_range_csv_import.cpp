@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/support/shared_data.h"
+#include "tests/support/test_util.h"
 
 #include <filesystem>
 #include <fstream>
@@ -28,7 +29,8 @@ int64_t dataRows(const fs::path& p) {
 }
 
 fs::path writeFile(const std::string& name, const std::string& content) {
-  const fs::path p = fs::temp_directory_path() / ("meshnav_uwb_" + std::to_string(::getpid()) + "_" + name);
+  static const meshnav::test::TempDir dir("uwb");  // removed at exit
+  const fs::path p = dir / name;
   std::ofstream(p) << content;
   return p;
 }
