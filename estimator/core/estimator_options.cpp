@@ -136,9 +136,10 @@ const Field kFields[] = {
     {"recovery.enabled", field<&EstimatorOptions::recovery, &RecoveryOptions::enabled>, "re-initialize from ranges and IMU when lost"},
     {"recovery.retry_s", field<&EstimatorOptions::recovery, &RecoveryOptions::retry_s>, "between two attempts while lost or degraded [s]"},
     {"recovery.degraded_disagreement_chi2", field<&EstimatorOptions::recovery, &RecoveryOptions::degraded_disagreement_chi2>, "degraded: re-initialize when the aligned pose disagrees beyond this chi^2 (4 dof), 0 = off [-]"},
-    {"flight_volume.enabled", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::enabled>, "use setup flight_volume against the mirror image of coplanar known anchors on its walls or ceiling"},
+    {"flight_volume.enabled", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::enabled>, "use setup flight_volume: against the mirror image of coplanar known anchors on its walls or ceiling, and to drop initial fits outside it"},
     {"flight_volume.mirror_margin_m", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::mirror_margin_m>, "an estimate this far outside whose mirror image is inside is reflected [m]"},
     {"flight_volume.side_constraint_rate_hz", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::side_constraint_rate_hz>, "truncate the position to the volume's side of the anchors' plane at most this often, 0 = off [Hz]"},
+    {"flight_volume.candidate_margin_m", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::candidate_margin_m>, "initialization: a fit ending farther outside is no candidate [m]"},
     {"time.max_offset_s", field<&EstimatorOptions::time, &TimeGuardOptions::max_offset_s>, "an input stamped farther than this from the current (newest) time is refused and counted [s]"},
     {"time.rebase_after", field<&EstimatorOptions::time, &TimeGuardOptions::rebase_after>, "this many consecutive refused inputs agreeing among themselves move the clock (a real jump) [-]"},
     {"refine.rerun_on_anchor_join", field<&EstimatorOptions::refine, &RefineOptions::rerun_on_anchor_join>, "on ANCHOR_INIT re-run from the oldest stored input with the calibrated anchors uncertain from there"},
@@ -218,8 +219,9 @@ void EstimatorOptions::validate() const {
        "health.* (0 < degraded <= lost fractions <= 1, positive times)");
   need(recovery.retry_s > 0 && recovery.degraded_disagreement_chi2 >= 0,
        "recovery.retry_s > 0, recovery.degraded_disagreement_chi2 >= 0");
-  need(flight_volume.mirror_margin_m >= 0 && flight_volume.side_constraint_rate_hz >= 0,
-       "flight_volume: mirror_margin_m >= 0, side_constraint_rate_hz >= 0");
+  need(flight_volume.mirror_margin_m >= 0 && flight_volume.side_constraint_rate_hz >= 0 &&
+           flight_volume.candidate_margin_m >= 0,
+       "flight_volume: mirror_margin_m >= 0, side_constraint_rate_hz >= 0, candidate_margin_m >= 0");
   need(zupt.stillness_gate_probability > 0 && zupt.stillness_gate_probability < 1,
        "zupt.stillness_gate_probability in (0, 1)");
   need(init.duration_s >= 0.0 && init.min_ranges >= 4, "init.duration_s >= 0, init.min_ranges >= 4");

@@ -211,9 +211,9 @@ struct RecoveryOptions {
   double degraded_disagreement_chi2 = 23.5;
 };
 
-/// The setup's `flight_volume` against the mirror image across coplanar known anchors on its walls
-/// or ceiling (AnchorPlaneMirror, docs/robustness.md "The flight volume"). Used only when the
-/// setup has a flight volume and the known anchors lie in one plane that bounds it.
+/// The setup's `flight_volume` (docs/robustness.md "The flight volume"): initialization drops fits
+/// outside it, and against the mirror image across coplanar known anchors on its walls or ceiling
+/// (AnchorPlaneMirror) the filter keeps to the volume's side of their plane.
 struct FlightVolumeOptions {
   bool enabled = true;
   /// An estimate this far outside the volume whose mirror image is inside is reflected into it [m].
@@ -222,6 +222,9 @@ struct FlightVolumeOptions {
   /// truncated to that side at most this often (Simon's PDF truncation, as a pseudo-measurement
   /// along the plane's normal); 0: never [Hz].
   double side_constraint_rate_hz = 10.0;
+  /// Initialization and re-alignment: a fit that ends farther outside the volume is no candidate
+  /// (neither the pose nor a rival that makes the data ambiguous) [m].
+  double candidate_margin_m = 0.5;
 };
 
 /// Anchor refinement (issue 10): a second pass when a calibrated anchor joins. The calibration used

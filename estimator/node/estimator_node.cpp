@@ -84,10 +84,13 @@ bool baroAligns(const EstimatorOptions& o, const SystemSetup& setup) {
 /// The alignment's options; its height model is the baro's (lever p_IP, no tilt correction, bias
 /// prior baro.init_bias_sigma_m) when the baro aligns, else the height model's.
 MotionAlignerOptions alignerOptionsFor(const EstimatorOptions& o, const SystemSetup& setup) {
-  if (!baroAligns(o, setup)) return alignerOptions(o, heightLever(o, setup));
-  MotionAlignerOptions a = alignerOptions(o, setup.baro_p_IP);
-  a.height_tilt_correction = false;
-  a.sigma_bias_height_m = o.baro.init_bias_sigma_m;
+  MotionAlignerOptions a = alignerOptions(o, baroAligns(o, setup) ? setup.baro_p_IP : heightLever(o, setup));
+  if (baroAligns(o, setup)) {
+    a.height_tilt_correction = false;
+    a.sigma_bias_height_m = o.baro.init_bias_sigma_m;
+  }
+  if (o.flight_volume.enabled) a.flight_volume = setup.flight_volume;
+  a.volume_margin_m = o.flight_volume.candidate_margin_m;
   return a;
 }
 

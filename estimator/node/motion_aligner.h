@@ -35,6 +35,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/setup.h"
 #include "common/types.h"
 #include "estimator/core/imu_state.h"
 
@@ -84,6 +85,10 @@ struct MotionAlignerOptions {
   Eigen::Vector3d p_IH = Eigen::Vector3d::Zero();  ///< rangefinder in the IMU frame [m]
   bool height_tilt_correction = true;  ///< h = s_z / cos(tilt) (else s_z)
   double sigma_bias_height_m = 0.3;   ///< prior σ of the rangefinder's bias around 0 [m]
+  /// The setup's flight volume: a fit that ends farther outside it than `volume_margin_m` is no
+  /// candidate, neither the best nor a rival (a mirror image behind a wall of anchors).
+  std::optional<FlightVolume> flight_volume;
+  double volume_margin_m = 0.5;       ///< [m]
 };
 
 /// The aligned state at the window's end.

@@ -257,6 +257,14 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
   // Multi-start, then keep the distinct local minima.
   Window w;
   if (!fitStarts(bias_gyro_rad_s, &w)) return std::nullopt;
+  if (options_.flight_volume) {  // outside the volume the vehicle stays in: not a pose at all
+    const FlightVolume& v = *options_.flight_volume;
+    std::erase_if(w.cands, [&](const Candidate& c) { return v.distanceOutside(c.end.p_IinG) > options_.volume_margin_m; });
+    if (w.cands.empty()) {
+      reason_ = "motion alignment: every fit of the window ends outside the flight volume";
+      return std::nullopt;
+    }
+  }
   std::vector<Obs>& obs = w.obs;
   std::vector<HeightObs>& heights = w.heights;
   const Increments& end = w.end;

@@ -341,10 +341,19 @@ bool StaticInitializer::fitPoseToRanges(const Eigen::Matrix3d& R_rp, Eigen::Vect
   // its costs decide: two minima must not differ by what a few NLOS ranges happen to add to each
   // (docs/robustness.md, "Outliers in the static fit").
   std::vector<bool> use(ranges_.size(), true);
-  std::vector<FitMinimum> minima = searchMinima(R_rp, use, centroid, FitLoss::kCauchy);
+  // Outside the setup's flight volume a minimum is no pose at all (a mirror image behind a wall).
+  const auto inVolume = [&](std::vector<FitMinimum> m) {
+    if (setup_.flight_volume && options_.flight_volume.enabled)
+      std::erase_if(m, [&](const FitMinimum& x) {
+        return setup_.flight_volume->distanceOutside(x.p) > options_.flight_volume.candidate_margin_m;
+      });
+    if (m.empty()) waiting_for_ = "every fit of the ranges lies outside the flight volume";
+    return m;
+  };
+  std::vector<FitMinimum> minima = inVolume(searchMinima(R_rp, use, centroid, FitLoss::kCauchy));
   if (minima.empty()) return false;
   if (markInliers(R_rp, lowest(minima), use) < 4) return false;
-  minima = refineDistinct(R_rp, use, minima);
+  minima = inVolume(refineDistinct(R_rp, use, minima));
   if (minima.empty()) return false;
   const FitMinimum best = lowest(minima);
   waiting_for_ = ambiguityOf(minima, best, options_.init.ambiguity_chi2);

@@ -99,3 +99,25 @@ TEST(StaticInitializer, CarriedHeightPicksTheTrueSideOfTheAnchorPlane) {
   StaticInitializer init_off(off, scene.setup);
   EXPECT_FALSE(scene.run(init_off, false));
 }
+
+TEST(StaticInitializer, TheFlightVolumeRulesOutTheMirrorImageBehindTheAnchorPlane) {
+  // Anchors on the ceiling at 3 m of a hall 0–3.2 m high, the body landed at 1.0 m: its mirror
+  // image at 5.0 m is outside the hall, so the fit is no longer ambiguous.
+  RestScene scene(3.0, 1.0);
+  scene.setup.flight_volume = FlightVolume{Eigen::Vector3d(-5, -5, 0), Eigen::Vector3d(5, 5, 3.2)};
+  StaticInitializer init(restOptions(), scene.setup);
+  const auto b = scene.run(init, false);
+  ASSERT_TRUE(b) << init.waitingFor();
+  EXPECT_LT((b->imu.p_IinG - scene.p_IinG).norm(), 0.01);
+  // Turned off in the options: the ranges alone cannot tell.
+  EstimatorOptions off = restOptions();
+  off.flight_volume.enabled = false;
+  StaticInitializer init_off(off, scene.setup);
+  EXPECT_FALSE(scene.run(init_off, false));
+  EXPECT_NE(init_off.waitingFor().find("fit the landed ranges alike"), std::string::npos) << init_off.waitingFor();
+  // A volume that holds neither image: refused, saying so.
+  scene.setup.flight_volume = FlightVolume{Eigen::Vector3d(10, 10, 0), Eigen::Vector3d(12, 12, 3.2)};
+  StaticInitializer init_far(restOptions(), scene.setup);
+  EXPECT_FALSE(scene.run(init_far, false));
+  EXPECT_NE(init_far.waitingFor().find("outside the flight volume"), std::string::npos) << init_far.waitingFor();
+}
