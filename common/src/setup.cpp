@@ -202,6 +202,18 @@ void checkIds(SystemSetup& s, const std::string& path, bool imu_given, bool baro
                        "' are the same id " + std::to_string(*std::get<2>(ids[i])));
 }
 
+/// `flight_volume: {min_m, max_m}` (both required), or none.
+std::optional<FlightVolume> readFlightVolume(YamlOptions& y) {
+  if (!y.has("flight_volume")) return std::nullopt;
+  FlightVolume v;  // no sensible default: both corners required
+  y.require("flight_volume.min_m", v.min_m);
+  y.require("flight_volume.max_m", v.max_m);
+  if (!v.min_m.allFinite() || !v.max_m.allFinite() || !((v.max_m - v.min_m).minCoeff() > 0.0) ||
+      (v.max_m - v.min_m).maxCoeff() > plausible::kMaxHeight_m * 100.0)
+    y.fail("flight_volume", "min_m must be below max_m on every axis, both finite and at most 10 km apart [m]");
+  return v;
+}
+
 }  // namespace
 
 std::optional<PairBias> SystemSetup::findPairBias(SensorId a, SensorId b) const {
@@ -264,15 +276,7 @@ SystemSetup loadSetup(const std::string& path) {
     if (!(c.sigma_m > 0.0)) y.fail("carried_height.sigma_m", "must be > 0 [m]");
     s.carried_height = c;
   }
-  if (y.has("flight_volume")) {
-    FlightVolume v;  // no sensible default: both corners required
-    y.require("flight_volume.min_m", v.min_m);
-    y.require("flight_volume.max_m", v.max_m);
-    if (!v.min_m.allFinite() || !v.max_m.allFinite() || !((v.max_m - v.min_m).minCoeff() > 0.0) ||
-        (v.max_m - v.min_m).maxCoeff() > plausible::kMaxHeight_m * 100.0)
-      y.fail("flight_volume", "min_m must be below max_m on every axis, both finite and at most 10 km apart [m]");
-    s.flight_volume = v;
-  }
+  s.flight_volume = readFlightVolume(y);
   y.read("noise.sigma_range", s.noise.sigma_range_m);
   y.read("noise.imu_acc_noise_density", s.noise.imu_acc_noise_density);
   y.read("noise.imu_gyro_noise_density", s.noise.imu_gyro_noise_density);
