@@ -391,6 +391,11 @@ TEST(RobustNode, UpsideDownAnchorFrameIsDetectedAndTakenAsItIs) {
     if (upside_down) {
       for (auto& [id, p] : ds.setup.abs_anchor_positions) p = R_flip * p;
       for (PoseSample& g : ds.ground_truth) g.p_IinG = R_flip * g.p_IinG;
+      if (ds.setup.flight_volume) {  // the hall turns with the frame (y and z negated)
+        const FlightVolume v = *ds.setup.flight_volume;
+        ds.setup.flight_volume = FlightVolume{Eigen::Vector3d(v.min_m.x(), -v.max_m.y(), -v.max_m.z()),
+                                              Eigen::Vector3d(v.max_m.x(), -v.min_m.y(), -v.min_m.z())};
+      }
     }
     EstimatorNode node(EstimatorOptions{}, ds.setup);
     const RunResult res = run(node, ds, 35.0, [](EstimatorNode&, Timestamp) {});

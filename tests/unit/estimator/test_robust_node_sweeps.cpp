@@ -20,18 +20,22 @@ TEST(RobustNode, BaroHeightsKeepAHoverUnderCeilingAnchorsOffTheMirrorImage) {
                                                       0.178, 0.123, 0.017, "fc", 40.0});
   const auto r = sim::ScenarioSimulator(so).run();
   ASSERT_TRUE(r.dataset.setup.baro_reference_pressure_pa);
-  auto runWith = [&](bool use_baro) {
+  // The hall (setup flight_volume) rules the mirror image out as well; off here, to test the
+  // baro heights alone, and then on with the ranges alone.
+  auto runWith = [&](bool use_baro, bool use_volume) {
     EstimatorOptions o;
     o.init.motion_use_baro = use_baro;
+    o.flight_volume.enabled = use_volume;
     EstimatorNode node(o, r.dataset.setup);
     const RunResult res = run(node, r.dataset, 10.0, [](EstimatorNode&, Timestamp) {});
-    std::cout << (use_baro ? "baro heights" : "ranges only") << ": max error after 10 s " << res.max_error_after_m
-              << " m" << std::endl;
+    std::cout << (use_baro ? "baro heights" : "ranges only") << (use_volume ? ", flight volume" : "")
+              << ": max error after 10 s " << res.max_error_after_m << " m" << std::endl;
     EXPECT_TRUE(node.initialized()) << node.waitingFor();
     return res;
   };
-  EXPECT_GT(runWith(false).max_error_after_m, 2.0);  // the mirror image
-  EXPECT_LT(runWith(true).max_error_after_m, 1.0);
+  EXPECT_GT(runWith(false, false).max_error_after_m, 2.0);  // the mirror image
+  EXPECT_LT(runWith(true, false).max_error_after_m, 1.0);
+  EXPECT_LT(runWith(false, true).max_error_after_m, 1.0);  // the mirror image is above the ceiling
 }
 
 TEST(RobustNode, StillnessZuptsLetASmoothHoverDrift) {
@@ -186,9 +190,12 @@ TEST(RobustNode, AConsumerGyroBiasDoesNotAlignAHoverAtAWrongHeight) {
                                                       0.104, 0.143, 0.037, "consumer", 30.0});
   const auto r = sim::ScenarioSimulator(so).run();
   ASSERT_TRUE(r.dataset.setup.baro_reference_pressure_pa);
-  auto runWith = [&](double relinearize_rad) {
+  // The hall (setup flight_volume) puts the mirror image out of the running (below the floor):
+  // off for the alignment's own behaviour, then on.
+  auto runWith = [&](double relinearize_rad, bool use_volume = false) {
     EstimatorOptions o;
     o.init.motion_relinearize_rad = relinearize_rad;
+    o.flight_volume.enabled = use_volume;
     EstimatorNode node(o, r.dataset.setup);
     const RunResult res = run(node, r.dataset, 10.0, [](EstimatorNode&, Timestamp) {});
     std::cout << "relinearize " << relinearize_rad << " rad: " << (node.initialized() ? "initialized" : "refused")
@@ -202,6 +209,9 @@ TEST(RobustNode, AConsumerGyroBiasDoesNotAlignAHoverAtAWrongHeight) {
   const auto [init, err, why] = runWith(EstimatorOptions{}.init.motion_relinearize_rad);
   EXPECT_FALSE(init) << "max error after 10 s " << err << " m";
   EXPECT_NE(why.find("ambiguous"), std::string::npos) << why;
+  const auto [volume_init, volume_err, volume_why] = runWith(EstimatorOptions{}.init.motion_relinearize_rad, true);
+  EXPECT_TRUE(volume_init) << volume_why;
+  EXPECT_LT(volume_err, 0.5);  // 0.236 m (2026-11-27)
 }
 
 TEST(RobustNode, NlosRangesDoNotPickTheStaticFitOfAHoverUnderNearlyCollinearAnchors) {
