@@ -18,9 +18,13 @@
 /// - **Resends** (a lossy link, docs/deployment.md): a CALIB_CMD counts as answered once a
 ///   CALIB_STATUS shows its effect — Collect: its anchors (all: every listed one) no longer `idle`;
 ///   Calibrate: its anchors `calibrated` or `refused` (all: none `collecting`); Abort: none of its
-///   anchors `collecting`. Until then it is sent again (with the current data time) every
-///   `resend_period_s` of data time, at most `max_resends` times ("calib_cmd_resent"); the
-///   calibrator takes a repeated command as a no-op (already calibrated, already collecting).
+///   anchors `collecting`. Until then it is sent again (the same message, with its original issue
+///   time) every `resend_period_s` of data time, at most `max_resends` times ("calib_cmd_resent").
+///   A late CALIB_STATUS (a loaded calibrator: at 10x replay 1 s of data time is 0.1 s of wall
+///   time) thus also causes resends; the calibrator executes a command (issue time, action,
+///   anchors) once and ignores its repeats ("CALIB_CMD:duplicate", calibrator_node.h).
+///   The answer to a Collect or Abort comes with the calibrator's periodic CALIB_STATUS (1 s of
+///   data time): a resend period not above that races it (the mission process uses 2 s).
 /// - **Status** (MISSION_STATUS, the heartbeat) every `status_period_s` of data time and right
 ///   after a step ran: index of the last executed step, step count and a text with the next step
 ///   and the calibrator's per-anchor states from CALIB_STATUS (refusals are also logged).
@@ -48,7 +52,7 @@ struct MissionSinks {
 struct MissionNodeOptions {
   double status_period_s = 1.0;  ///< MISSION_STATUS period in data time [s] (> 0)
   double resend_period_s = 0.0;  ///< unanswered CALIB_CMD sent again after this data time [s] (0 = never; the
-                                 ///< mission process: --resend-period, 1 s)
+                                 ///< mission process: --resend-period, 2 s)
   int max_resends = 30;          ///< ... at most this many times each [-]
 };
 

@@ -209,7 +209,24 @@ void CalibratorNode::onAnchors(const std::vector<AnchorEstimate>& anchors) {
   beliefs_ = std::move(beliefs);  // the message holds every anchor the estimator knows
 }
 
+bool CalibratorNode::isRepeat(const CalibCommand& c) {
+  CommandKey key{c.t.us, static_cast<int>(c.action), c.anchors};
+  if (seen_commands_.count(key)) {
+    diag_.report("CALIB_CMD:duplicate", "command issued at t=" + formatSeconds(c.t) +
+                                            " came again (a resend or a duplicated datagram); already executed, ignored");
+    return true;
+  }
+  seen_commands_.insert(key);
+  command_order_.push_back(std::move(key));
+  if (command_order_.size() > kMaxCommandKeys) {
+    seen_commands_.erase(command_order_.front());
+    command_order_.pop_front();
+  }
+  return false;
+}
+
 void CalibratorNode::onCommand(const CalibCommand& c) {
+  if (isRepeat(c)) return;
   std::vector<SensorId> ids;
   for (SensorId id : c.anchors) {
     if (id <= 0 || setup_.isTag(id) || setup_.isKnownAnchor(id) || id == setup_.imu_id || id == setup_.baro_id) {

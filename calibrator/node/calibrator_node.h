@@ -33,6 +33,12 @@
 ///    reason, and collecting goes on.
 ///  - Abort: stop collecting the listed (or all uncalibrated) anchors and drop their buffers; with
 ///    an empty list also anchors seen later are not collected until the next Collect.
+///  - **Repeats.** A command is identified by (issue time `t`, action, anchor list). The mission
+///    re-sends an unanswered command with its original `t` (mission_node.h, resends); a command
+///    whose identity was already executed (among the last `kMaxCommandKeys`) is a no-op, counted
+///    as "CALIB_CMD:duplicate". So a late answer never makes a re-sent Collect forget a
+///    calibration or drop collected ranges, a re-sent Abort never stops a later Collect, and no
+///    anchor is calibrated (ANCHOR_INIT) twice by one command. A new command (new `t`) still acts.
 ///
 /// **Automatic mode** (CalibratorNodeOptions::auto_mode, used when no mission is given): criterion
 /// in calibrator_node_options.h, checked every `auto_check_period_s` of data time.
@@ -115,6 +121,8 @@ class CalibratorNode {
   const CalibratorOptions& options() const { return calibrator_.options(); }
   /// Poses held in the history.
   size_t poseHistorySize() const { return poses_.size(); }
+  /// Identities of executed commands kept to recognise a re-sent one.
+  static constexpr size_t kMaxCommandKeys = 1024;
 
  private:
   enum class State { Idle, Collecting, Calibrated, Refused };
@@ -157,6 +165,9 @@ class CalibratorNode {
   void keepResult(CalibrationResult res);
   void pruneOldTagRanges();
   void publishStatus();
+  /// True (counted, logged) when a command with the identity of `c` was executed before; else
+  /// remembers it.
+  bool isRepeat(const CalibCommand& c);
 
   CalibratorNodeOptions node_options_;
   SystemSetup setup_;
@@ -169,6 +180,9 @@ class CalibratorNode {
   std::map<SensorId, AnchorEstimate> beliefs_;
   std::map<SensorId, Track> tracks_;
   std::set<std::tuple<int64_t, SensorId, SensorId>> seen_ranges_;  ///< (µs, ids) within time_max_offset
+  using CommandKey = std::tuple<int64_t, int, std::vector<SensorId>>;  ///< (t µs, action, anchors)
+  std::set<CommandKey> seen_commands_;     ///< executed commands (at most kMaxCommandKeys) ...
+  std::deque<CommandKey> command_order_;   ///< ... oldest first, for eviction
   bool collect_new_anchors_ = true;
   std::vector<CalibrationResult> results_;
   std::optional<Timestamp> newest_;

@@ -34,7 +34,8 @@ void declareMissionProcessOptions(Cli& cli, MissionProcessConfig& c) {
       ->check(cli::positive());
   cli.option("resend-period", c.resend_period_s,
              "data seconds after which a CALIB_CMD whose effect no CALIB_STATUS shows yet is sent again (a lossy "
-             "link; at most 30 times; 0 = never)")
+             "link; at most 30 times; 0 = never; keep it above the calibrator's CALIB_STATUS period, 1 s, which may be "
+             "what carries the answer)")
       ->type_name("S")
       ->check(cli::nonNegative());
   cli.option("heartbeat", c.heartbeat_s, "wall seconds between heartbeat MISSION_STATUS")

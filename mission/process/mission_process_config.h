@@ -32,7 +32,8 @@ struct MissionProcessConfig {
   double linger_s = 10.0;                       ///< --linger: wall time to wait for the calibrator's answer to the last step [s]
   double heartbeat_s = 1.0;                     ///< --heartbeat: wall time between MISSION_STATUS heartbeats [s]
   double status_period_s = 1.0;                 ///< --status-period: MISSION_STATUS period in data time [s]
-  double resend_period_s = 1.0;                 ///< --resend-period: unanswered CALIB_CMD sent again [s] data time
+  double resend_period_s = 2.0;                 ///< --resend-period: unanswered CALIB_CMD sent again [s] data time
+                                               ///< (> the calibrator's 1 s CALIB_STATUS period, which may carry the answer)
   bool print_config = false;                    ///< --print-config
   std::string t0_text = "auto";                 ///< --t0 as given (S or auto), read by finishMissionProcessConfig
   std::string time_from_text = "RANGE";         ///< --time-from as given, read by finishMissionProcessConfig

@@ -129,7 +129,8 @@ void MissionNode::resendUnanswered() {
       continue;
     }
     if (now_ - it->last >= period) {
-      it->cmd.t = now_;
+      // The same command: its issue time stays, so the calibrator executes it once (a late
+      // answer is no loss, and a re-sent Collect never restarts what a later step did).
       it->last = now_;
       ++it->resends;
       diag_.count("calib_cmd_resent");

@@ -106,11 +106,23 @@ grep -q "^  CALIB_STATUS: {messages:" "$OUT/summary.yaml" || fail "the logger sa
 grep -q "CALIB_CMD:decode_error: 3" "$OUT/summary.yaml" || fail "the calibrator did not count 3 malformed CALIB_CMD"
 if [[ "$MODE" == mission ]]; then
   grep -q "^  MISSION_STATUS: {messages:" "$OUT/summary.yaml" || fail "the logger saw no MISSION_STATUS"
-  grep -q "^  CALIB_CMD: {messages: 6," "$OUT/summary.yaml" || fail "CALIB_CMD: not 3 commands + 3 malformed"
+  # The mission sends 3 commands (collect-all, two calibrate steps) and re-sends one whose answer
+  # (CALIB_STATUS) has not come within --resend-period (2 s of data time: 0.2 s of wall time at
+  # 10x, which a loaded machine may exceed). A resend is by design (a lost and a late command look the
+  # same); the requirement is that it changes nothing: the calibrator executes it once (counted
+  # as CALIB_CMD:duplicate) and every anchor is calibrated exactly once (5 ANCHOR_INIT below).
+  resent=$(grep -c "\[mission\].*CALIB_CMD sent again" "$WORK/launch.log")
+  grep -q "^  CALIB_CMD: {messages: $((6 + resent))," "$OUT/summary.yaml" ||
+    fail "CALIB_CMD: not 3 commands + $resent resent + 3 malformed"
+  dup=$(sed -n 's/^    CALIB_CMD:duplicate: \([0-9]*\)$/\1/p' "$OUT/summary.yaml")
+  (( ${dup:-0} <= resent )) || fail "the calibrator saw ${dup:-0} repeated commands, the mission re-sent $resent"
+  echo "  the mission re-sent $resent CALIB_CMD; the calibrator ignored ${dup:-0} as already executed"
   grep -q "^mission_status:.*CALIB_STATUS:decode_error=2" "$OUT/summary.yaml" || fail "the mission did not count 2 malformed CALIB_STATUS"
   grep "^mission_status:" "$OUT/summary.yaml" | cut -c1-200 | sed 's/^/  /'
 fi
 grep -q "^  ANCHOR_INIT: {messages: 5," "$OUT/summary.yaml" || fail "the logger did not see 5 ANCHOR_INIT"
+# With the 5 ids checked below, each anchor was calibrated (and handed to the estimator) once.
+grep -q "^    calibrations_ok: 5$" "$OUT/summary.yaml" || fail "the calibrator did not calibrate exactly 5 times"
 grep -q "initialized: true" "$OUT/summary.yaml" || fail "the estimator never initialized"
 grep -E "^  [A-Z_]+: \{messages" "$OUT/summary.yaml" | sed 's/^/  /'
 echo "  estimate ends at t = $(tail -n 1 "$OUT/estimate.csv" | cut -d, -f1) s"

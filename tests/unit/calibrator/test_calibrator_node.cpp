@@ -40,8 +40,9 @@ PoseEstimate asEstimate(const PoseSample& p) {
   return e;
 }
 
-CalibCommand command(CalibCommand::Action a, std::vector<SensorId> ids) {
+CalibCommand command(CalibCommand::Action a, std::vector<SensorId> ids, double t_s = 0.0) {
   CalibCommand c;
+  c.t = Timestamp::fromSec(t_s);
   c.action = a;
   c.anchors = std::move(ids);
   return c;
@@ -91,6 +92,16 @@ void replay(CalibratorNode& node, const Dataset& ds, std::vector<TimedCommand> c
     }
   }
   while (ic < cmds.size()) node.onCommand(cmds[ic++].cmd);
+}
+
+/// Poses and ranges of seed 1 with from_s < t <= to_s.
+Dataset slice(double from_s, double to_s) {
+  Dataset d;
+  for (const auto& p : seed1().dataset.ground_truth)
+    if (p.t.sec() > from_s && p.t.sec() <= to_s) d.ground_truth.push_back(p);
+  for (const auto& r : seed1().dataset.ranges)
+    if (r.t.sec() > from_s && r.t.sec() <= to_s) d.ranges.push_back(r);
+  return d;
 }
 
 double positionError(const AnchorInit& a) {
@@ -359,7 +370,7 @@ TEST(CalibratorNode, RangesWithoutAPoseWaitUntilThePosesArrive) {
   // All ranges up to 80 s, but no pose yet (the estimator is late).
   for (const auto& r : seed1().dataset.ranges)
     if (r.t.sec() <= 80.0) node.onRange(r);
-  node.onCommand(command(CalibCommand::Action::Calibrate, {106}));
+  node.onCommand(command(CalibCommand::Action::Calibrate, {106}, 80.0));
   EXPECT_TRUE(out.inits.empty());
   const CalibStatus st = node.status();
   EXPECT_GT(st.counters.at("ranges_waiting_for_pose"), 200);
@@ -370,7 +381,7 @@ TEST(CalibratorNode, RangesWithoutAPoseWaitUntilThePosesArrive) {
   // The poses arrive: the same ranges are now used.
   for (const auto& p : seed1().dataset.ground_truth)
     if (p.t.sec() <= 80.1) node.onPose(asEstimate(p));
-  node.onCommand(command(CalibCommand::Action::Calibrate, {106}));
+  node.onCommand(command(CalibCommand::Action::Calibrate, {106}, 80.1));  // a new command
   ASSERT_EQ(out.inits.size(), 1u);
   EXPECT_LT(positionError(out.inits[0]), 0.3);
 }
@@ -496,6 +507,44 @@ TEST(CalibratorNode, CollectOnACalibratedAnchorForgetsItsCalibration) {
   EXPECT_EQ(anchorStatus(node, 106).state, "collecting");
   EXPECT_EQ(anchorStatus(node, 106).n_ranges, 0);
   EXPECT_TRUE(node.calibratedAnchors().empty());
+}
+
+TEST(CalibratorNode, AResentCommandIsExecutedOnceAndNeverCalibratesAnAnchorTwice) {
+  // The mission re-sends a command whose answer (CALIB_STATUS) is late, with its issue time; a
+  // network may duplicate a datagram. Either way the calibrator executes the command once.
+  Outputs out;
+  CalibratorNode node(CalibratorOptions{}, setup(), sinksInto(out));
+  const CalibCommand collect = command(CalibCommand::Action::Collect, {106}, 10.0);
+  const CalibCommand calibrate = command(CalibCommand::Action::Calibrate, {106, 107}, 80.0);
+  const CalibCommand abort = command(CalibCommand::Action::Abort, {108}, 80.0);
+  replay(node, slice(-1.0, 10.0), {});
+  node.onCommand(collect);
+  replay(node, slice(10.0, 80.0), {});
+  const int64_t collected = anchorStatus(node, 106).n_ranges;
+  EXPECT_GT(collected, 300);
+  node.onCommand(collect);  // the Collect again (its answer was late): the buffer stays
+  EXPECT_EQ(anchorStatus(node, 106).n_ranges, collected);
+  node.onCommand(calibrate);
+  ASSERT_EQ(out.inits.size(), 2u);
+  node.onCommand(abort);
+  EXPECT_EQ(anchorStatus(node, 108).state, "idle");
+  node.onCommand(command(CalibCommand::Action::Collect, {108}, 80.5));  // a later step
+  // Late resends of all three: no calibration forgotten, none repeated, 108 not aborted again.
+  for (int k = 0; k < 3; ++k) {
+    node.onCommand(collect);
+    node.onCommand(calibrate);
+    node.onCommand(abort);
+  }
+  EXPECT_EQ(out.inits.size(), 2u);
+  EXPECT_EQ(anchorStatus(node, 106).state, "calibrated");
+  EXPECT_EQ(anchorStatus(node, 107).state, "calibrated");
+  EXPECT_EQ(anchorStatus(node, 108).state, "collecting");
+  EXPECT_EQ(node.diagnostics().get("CALIB_CMD:duplicate"), 10);
+  EXPECT_EQ(node.diagnostics().get("calibrations_ok"), 2);
+  EXPECT_EQ(node.diagnostics().get("calibrate_already_calibrated"), 0);
+  // A new command (a new issue time) acts: Collect re-collects a calibrated anchor.
+  node.onCommand(command(CalibCommand::Action::Collect, {106}, 81.0));
+  EXPECT_EQ(anchorStatus(node, 106).state, "collecting");
 }
 
 TEST(CalibratorNode, StatusHeartbeatAtOneHertzOfDataTime) {

@@ -180,9 +180,9 @@ TEST(MissionNode, CommandsWithoutAnAnswerAreSentAgainUntilTheStatusShowsTheirEff
   node.onTime(Timestamp::fromSec(0.5));
   EXPECT_EQ(rec.calib.size(), 1u);  // not yet due
   node.onTime(Timestamp::fromSec(1.0));
-  ASSERT_EQ(rec.calib.size(), 2u);  // lost? sent again, with the current data time
+  ASSERT_EQ(rec.calib.size(), 2u);  // lost? sent again, with its issue time: the same command
   EXPECT_EQ(rec.calib[1].action, CalibCommand::Action::Collect);
-  EXPECT_DOUBLE_EQ(rec.calib[1].t.sec(), 1.0);
+  EXPECT_DOUBLE_EQ(rec.calib[1].t.sec(), 0.0);
   status({{106, "idle"}, {107, "idle"}});  // a status from before the command: not its effect
   node.onTime(Timestamp::fromSec(2.0));
   EXPECT_EQ(rec.calib.size(), 3u);
@@ -196,6 +196,7 @@ TEST(MissionNode, CommandsWithoutAnAnswerAreSentAgainUntilTheStatusShowsTheirEff
   node.onTime(Timestamp::fromSec(81.0));
   ASSERT_EQ(rec.calib.size(), 5u);  // 107 not answered yet: the whole command again
   EXPECT_EQ(rec.calib[4].anchors, (std::vector<SensorId>{106, 107}));
+  EXPECT_EQ(rec.calib[4].t.us, rec.calib[3].t.us);  // issued at 80 s
   status({{106, "calibrated"}, {107, "refused"}});  // a refusal is an answer
   node.onTime(Timestamp::fromSec(85.0));
   EXPECT_EQ(rec.calib.size(), 5u);
