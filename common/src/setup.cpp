@@ -277,6 +277,13 @@ SystemSetup loadSetup(const std::string& path) {
     s.carried_height = c;
   }
   s.flight_volume = readFlightVolume(y);
+  // A volume in another frame than the anchors would rule the true pose out: every known anchor
+  // must lie in it (within 1 m: anchors hang on its walls and ceiling).
+  for (const auto& [id, p] : s.abs_anchor_positions)
+    if (s.flight_volume && s.flight_volume->distanceOutside(p) > 1.0)
+      y.fail("flight_volume", "does not hold known anchor " + std::to_string(id) + " (" +
+                                  std::to_string(s.flight_volume->distanceOutside(p)) +
+                                  " m outside): the volume and the anchors must be in the same frame G [m]");
   y.read("noise.sigma_range", s.noise.sigma_range_m);
   y.read("noise.imu_acc_noise_density", s.noise.imu_acc_noise_density);
   y.read("noise.imu_gyro_noise_density", s.noise.imu_gyro_noise_density);

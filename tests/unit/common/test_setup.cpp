@@ -170,6 +170,8 @@ TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
   EXPECT_NE(error(base + "carried_height: {height_m: 1.2, sigma: 0.3}\n").find("unknown key 'carried_height.sigma'"),
             std::string::npos);
   EXPECT_NE(error(base + "flight_volume: {min_m: [0, 0, 0]}\n").find("flight_volume.max_m"), std::string::npos);
+  EXPECT_NE(error(base + "flight_volume: {min_m: [10, 10, 0], max_m: [15, 15, 3]}\n").find("does not hold known anchor 101"),
+            std::string::npos);
   EXPECT_NE(error(base + "flight_volume: {min_m: [0, 0, 0], max_m: [5, 5, 0]}\n").find("key 'flight_volume' min_m must be below max_m"),
             std::string::npos);
   EXPECT_NE(error(base + "flight_volume: {min_m: [0, 0, 0], max_m: [5, .inf, 3]}\n").find("flight_volume"),
