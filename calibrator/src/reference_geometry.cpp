@@ -1,6 +1,7 @@
 #include "calibrator/reference_geometry.h"
 
-#include <Eigen/Eigenvalues>
+#include "common/principal_axes.h"
+
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -50,15 +51,7 @@ GeometryReport checkReferenceGeometry(const CalibrationProblem& pb, const Calibr
                fmt(" (grid %.2f m), need at least %.0f", res, options.min_distinct_positions);
     return r;
   }
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& p : pts) mean += p;
-  mean /= static_cast<double>(pts.size());
-  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
-  for (const auto& p : pts) C += (p - mean) * (p - mean).transpose();
-  C /= static_cast<double>(pts.size());
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(C);
-  const Eigen::Vector3d ev = es.eigenvalues().cwiseMax(0.0);  // ascending
-  r.rms_spread_m = Eigen::Vector3d(std::sqrt(ev(2)), std::sqrt(ev(1)), std::sqrt(ev(0)));
+  r.rms_spread_m = principalAxes(pts).rms_m;
   if (r.rms_spread_m(1) < options.min_line_spread_m) {
     r.status = CalibrationStatus::DegenerateGeometry;
     r.reason = fmt("reference positions are collinear (RMS off their line %.3f m < %.3f m)", r.rms_spread_m(1),

@@ -1,6 +1,7 @@
 #include "estimator/node/anchor_plane_mirror.h"
 
-#include <Eigen/SVD>
+#include "common/principal_axes.h"
+
 #include <cmath>
 
 namespace meshnav::estimator {
@@ -8,17 +9,13 @@ namespace meshnav::estimator {
 std::optional<AnchorPlaneMirror> AnchorPlaneMirror::of(const std::map<SensorId, Eigen::Vector3d>& anchors,
                                                        const FlightVolume& volume) {
   if (anchors.size() < 3) return std::nullopt;
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (const auto& [id, p] : anchors) c += p;
-  c /= static_cast<double>(anchors.size());
-  Eigen::MatrixXd X(anchors.size(), 3);
-  int i = 0;
-  for (const auto& [id, p] : anchors) X.row(i++) = (p - c).transpose();
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(X, Eigen::ComputeFullV);
-  const double rms_off = svd.singularValues()(2) / std::sqrt(static_cast<double>(anchors.size()));
+  std::vector<Eigen::Vector3d> points;
+  for (const auto& [id, p] : anchors) points.push_back(p);
+  const PrincipalAxes pa = principalAxes(points);
   // Anchors on one line span no plane (the normal is then arbitrary, and the ambiguity a circle).
-  if (rms_off > kCoplanarRmsM || svd.singularValues()(1) < 1e-6) return std::nullopt;
-  const Eigen::Vector3d n = svd.matrixV().col(2);
+  if (pa.rms_m(2) > kCoplanarRmsM || pa.rms_m(1) < 1e-6) return std::nullopt;
+  const Eigen::Vector3d& c = pa.centroid;
+  const Eigen::Vector3d n = pa.axes.col(2);
   // The volume's far side from the plane: every corner must be on the centre's side (or nearly).
   const double centre_side = n.dot(0.5 * (volume.min_m + volume.max_m) - c) >= 0.0 ? 1.0 : -1.0;
   for (int k = 0; k < 8; ++k) {
