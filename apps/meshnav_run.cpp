@@ -180,6 +180,11 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
     for (const auto& a : pipe.anchorInits()) ids += (ids.empty() ? "" : ",") + std::to_string(a.id);
     spdlog::info("calibration: {} anchors initialized ({}), results in calibration.yaml", pipe.anchorInits().size(),
                  ids.empty() ? std::string("none") : ids);
+    // The anchors left out, each with why (a refusal, or what automatic calibration waits for).
+    for (const auto& a : cal->status().anchors)
+      if (a.state != "calibrated")
+        spdlog::warn("calibration: anchor {} not calibrated ({}, {} ranges from {} references){}", a.id, a.state,
+                     a.n_ranges, a.n_refs, a.reason.empty() ? std::string() : ": " + a.reason);
   }
   writeStatus(node.status(), wall_s, data_s, (out_dir / "status.txt").string());
   return report(node, data_s, wall_s, out_dir.string(), o.allow_lost);

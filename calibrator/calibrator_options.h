@@ -67,6 +67,17 @@ struct CalibratorOptions {
   double min_plane_spread_m = 0.15;  ///< RMS distance of moving references from their best plane
   double min_line_spread_m = 0.3;    ///< RMS distance of moving references from their best line
   double max_position_sigma_m = 3.0; ///< larger 1σ (largest axis) → ill-conditioned, refuse
+  /// Coplanar moving references (a walk, a level flight) leave the anchor's side of their plane
+  /// open. A stationary reference (a known or calibrated anchor ranging to it) at least this far
+  /// off that plane can tell the side: the anchor is then fitted on both sides and the better fit
+  /// kept (`mirror_min_cost_gap`). ≤ 0: coplanar references are refused as before [m].
+  double mirror_reference_min_offset_m = 0.5;
+  /// The worse side's robust cost (Ceres, ½ Σ ρ) must exceed the better one's by this much, else
+  /// the calibration is refused as mirror-ambiguous [-].
+  double mirror_min_cost_gap = 10.0;
+  /// Undecided sides at most this far apart (an anchor near the plane) are not refused: the better
+  /// one is kept with its variance along the normal widened by their distance squared [m].
+  double mirror_merge_max_m = 0.5;
 
   // --- observation building ----------------------------------------------------------------
   bool use_range_variance = false;   ///< use the range's own R [m²] as σ_d² when > 0

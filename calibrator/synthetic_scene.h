@@ -13,7 +13,9 @@
 
 namespace meshnav::calib {
 
-enum class SyntheticPath { Spiral, Planar, Line, Hover };
+/// Spiral: the paper's upward spiral; Planar: the same circle at a constant 2 m; Walk: that circle
+/// at a hand-held 1.2 m with a gait bob of ±0.12 m (nearly coplanar); Line; Hover.
+enum class SyntheticPath { Spiral, Planar, Walk, Line, Hover };
 
 struct SyntheticSceneConfig {
   Eigen::Vector3d p_AinG{-1.772, 0.943, 3.256};  ///< true unknown anchor (paper's 106) [m]

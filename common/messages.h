@@ -64,7 +64,7 @@ struct CalibAnchorStatus {
   std::string state;      ///< "collecting", "calibrated", "refused"
   int64_t n_ranges = 0;   ///< ranges collected involving this anchor
   int32_t n_refs = 0;     ///< distinct reference devices
-  std::string reason;     ///< refusal reason or "" (e.g. "too few measurements: 12 < 50")
+  std::string reason;     ///< refusal reason, what automatic calibration waits for, or ""
 };
 
 /// CALIB_STATUS: progress and refusals of the calibrator, also its heartbeat.

@@ -124,14 +124,28 @@ void CalibratorNode::checkAuto(SensorId x, Track& tr) {
   tr.next_auto_check = *newest_ + Duration::fromSec(node_options_.auto_check_period_s);
   Built built = buildObservations(x, tr);
   const auto& opt = calibrator_.options();
+  // What the criterion waits for, kept as the collecting anchor's reason (CALIB_STATUS, the end
+  // of meshnav_run): an anchor that is never calibrated says why. A refused anchor keeps its
+  // refusal as the reason.
+  const auto waiting = [&](const std::string& what) {
+    if (tr.state == State::Collecting) tr.reason = "automatic calibration waits: " + what;
+  };
   // 1. enough usable ranges.
-  if (static_cast<int>(built.obs.size()) < node_options_.auto_min_ranges) return;
+  if (static_cast<int>(built.obs.size()) < node_options_.auto_min_ranges) {
+    waiting(std::to_string(built.obs.size()) + " ranges with a reference position, needs " +
+            std::to_string(node_options_.auto_min_ranges));
+    return;
+  }
   // 2. enough reference devices with enough ranges each.
   std::map<SensorId, int> per_ref;
   for (const auto& o : built.obs) ++per_ref[o.ref_id];
   int n_refs = 0;
   for (const auto& [id, n] : per_ref) n_refs += n >= opt.min_measurements_per_reference ? 1 : 0;
-  if (n_refs < node_options_.auto_min_references) return;
+  if (n_refs < node_options_.auto_min_references) {
+    waiting(std::to_string(n_refs) + " reference devices with " + std::to_string(opt.min_measurements_per_reference) +
+            " ranges each, needs " + std::to_string(node_options_.auto_min_references));
+    return;
+  }
   // 3. the library's refusal checks with the stricter spreads: the tags span a volume.
   CalibratorOptions strict = opt;
   strict.min_plane_spread_m = std::max(opt.min_plane_spread_m, node_options_.auto_min_plane_spread_m);
@@ -140,6 +154,7 @@ void CalibratorNode::checkAuto(SensorId x, Track& tr) {
   const GeometryReport geo = checkReferenceGeometry(pb, strict);
   if (geo.status != CalibrationStatus::Ok) {
     spdlog::debug("calibrator: anchor {} not ready for automatic calibration: {}", x, geo.reason);
+    waiting(geo.reason);
     return;
   }
   calibrateAnchor(x, tr, std::move(built), true);

@@ -16,6 +16,115 @@ namespace meshnav::calib {
 
 namespace {
 
+/// Prefix of a linear-step failure on coplanar moving references (their rows carry nothing along
+/// the plane's normal when the references lie exactly in it).
+std::string coplanarNote(const GeometryReport& geo) {
+  if (!geo.mirror) return {};
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "reference positions are coplanar (RMS off their plane %.3f m), ", geo.rms_spread_m(2));
+  return buf;
+}
+
+/// Evidence of the stationary references for an anchor at p: Σ_r ½ ((z̃_r − β_r‖p − p_R‖ − γ_r)/σ_r)²
+/// over the stationary references whose γ has a prior (γ_r, β_r its prior means, z̃_r the median of
+/// their ranges, σ_r² = σ_γ² + σ_d²/n_r): their γ marginalized over its prior. The moving
+/// references are left out: mirrored across their plane they fit alike, and what they still tell
+/// apart (their small height changes) is the estimated trajectory's error as much as the anchor's.
+double stationaryEvidence(const CalibrationProblem& pb, const Eigen::Vector3d& p, double sigma_range_m) {
+  double cost = 0.0;
+  for (const auto& slot : pb.slots()) {
+    if (slot.moving || slot.obs.empty() || !(slot.prior.sigma_gamma_m > 0.0)) continue;
+    Eigen::Vector3d p_R = Eigen::Vector3d::Zero();
+    std::vector<double> z;
+    for (int i : slot.obs) {
+      p_R += pb.observations()[static_cast<size_t>(i)].p_RinG;
+      z.push_back(pb.observations()[static_cast<size_t>(i)].z_m);
+    }
+    p_R /= static_cast<double>(slot.obs.size());
+    auto mid = z.begin() + static_cast<long>(z.size() / 2);
+    std::nth_element(z.begin(), mid, z.end());
+    const double var = slot.prior.sigma_gamma_m * slot.prior.sigma_gamma_m +
+                       sigma_range_m * sigma_range_m / static_cast<double>(slot.obs.size());
+    const double r = *mid - slot.prior.beta * (p - p_R).norm() - slot.prior.gamma_m;
+    cost += 0.5 * r * r / var;
+  }
+  return cost;
+}
+
+/// The side of a mirror plane (coplanar moving references) the anchor is on. `ref` and its mirror
+/// image are both refined on every usable range; the side is then decided by the stationary
+/// references alone (stationaryEvidence), whose evidence must differ by `mirror_min_cost_gap`.
+/// Both refinements landing on one solution far from the plane is no evidence either: the side is
+/// then compared against that solution's mirror image. On success `ref` is the chosen side's
+/// refinement; else `why` says what is ambiguous.
+bool pickMirrorSide(const CalibrationProblem& pb, const NonlinearRefiner& refiner, const MirrorPlane& plane,
+                    const CalibratorOptions& options, RefineResult& ref, double& extra_normal_var_m2,
+                    std::string& why) {
+  extra_normal_var_m2 = 0.0;
+  std::vector<bool> all(pb.observations().size());
+  for (int i = 0; i < static_cast<int>(all.size()); ++i) all[static_cast<size_t>(i)] = pb.slotOf(i) >= 0;
+  AnchorParams mirrored = ref.params;
+  mirrored.p_AinG = plane.reflect(ref.params.p_AinG);
+  const RefineResult a = refiner.refine(pb, ref.params, all);
+  const RefineResult b = refiner.refine(pb, mirrored, all);
+  if (!a.converged && !b.converged) {
+    why = "mirror check: neither side's refinement converged";
+    return false;
+  }
+  const RefineResult& first = a.converged ? a : b;
+  const Eigen::Vector3d p1 = first.params.p_AinG;
+  const bool distinct = a.converged && b.converged && (a.params.p_AinG - b.params.p_AinG).norm() >= 2.0 * options.sigma_range_m;
+  const Eigen::Vector3d p2 = distinct ? (&first == &a ? b : a).params.p_AinG : plane.reflect(p1);
+  if ((p1 - p2).norm() < 2.0 * options.sigma_range_m) {  // on the plane: both sides are one solution
+    ref.params = first.params;
+    ref.iterations += a.iterations + b.iterations;
+    return true;
+  }
+  const double e1 = stationaryEvidence(pb, p1, options.sigma_range_m);
+  const double e2 = stationaryEvidence(pb, p2, options.sigma_range_m);
+  const bool decided = std::abs(e1 - e2) >= options.mirror_min_cost_gap && (e1 <= e2 || distinct);
+  const double d = (p1 - p2).norm();
+  if (!decided && d <= options.mirror_merge_max_m) {
+    // Undecided but close: the better side, its covariance widened by d² along the normal so that
+    // the other side lies within 1σ of it.
+    extra_normal_var_m2 = d * d;
+  } else if (!decided) {
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "mirror-ambiguous: the moving references span a plane and the stationary ones (up to %.2f m off "
+                  "it) do not tell the side of the two %.2f m apart (evidence %.1f and %.1f, gap below %.1f)",
+                  plane.reference_offset_m, d, e1, e2, options.mirror_min_cost_gap);
+    why = buf;
+    return false;
+  }
+  const int iterations = ref.iterations + a.iterations + b.iterations;
+  ref = (e1 <= e2 || !distinct) ? first : (&first == &a ? b : a);
+  ref.iterations = iterations;
+  return true;
+}
+
+/// The linear start: RANSAC around the optimal double step (its inliers in `use`), or the step on
+/// every usable range. False with `why` when no solution was found.
+bool linearStep(const CalibrationProblem& pb, const CalibratorOptions& options, std::vector<bool>& use,
+                LinearSolution& lin, int& ransac_iterations, std::string& why) {
+  use.assign(pb.observations().size(), false);
+  for (int i = 0; i < static_cast<int>(use.size()); ++i) use[static_cast<size_t>(i)] = pb.slotOf(i) >= 0;
+  if (options.ransac) {
+    RansacResult rr = RansacSolver(options).run(pb, options.ransac_seed);
+    ransac_iterations = rr.iterations;
+    if (!rr.ok) {
+      why = "RANSAC: " + rr.reason;
+      return false;
+    }
+    use = rr.inliers;
+    lin = rr.solution;
+    return true;
+  }
+  lin = OptimalDoubleSolver(options).solve(pb);
+  if (!lin.ok) why = "linear step: " + lin.reason;
+  return lin.ok;
+}
+
 /// Final inlier test at x: |r_i|/σ_eff,i < k·max(1, s_robust), s_robust = 1.4826·median |r/σ_eff|
 /// over the candidate set (so an under-stated σ_d does not turn good ranges into outliers).
 std::vector<bool> classifyFinal(const CalibrationProblem& pb, const AnchorParams& x, const std::vector<bool>& candidates,
@@ -152,26 +261,23 @@ CalibrationResult AnchorCalibrator::calibrate(SensorId anchor_id, const std::vec
   if (geo.status != CalibrationStatus::Ok) return refuse(geo.status, geo.reason);
 
   // 1. Linear step, on RANSAC inliers or on everything.
-  std::vector<bool> use(pb.observations().size());
-  for (int i = 0; i < static_cast<int>(use.size()); ++i) use[static_cast<size_t>(i)] = pb.slotOf(i) >= 0;
+  std::vector<bool> use;
   LinearSolution lin;
-  if (options_.ransac) {
-    const RansacSolver ransac(options_);
-    RansacResult rr = ransac.run(pb, options_.ransac_seed);
-    res.ransac_iterations = rr.iterations;
-    if (!rr.ok) return refuse(CalibrationStatus::DegenerateGeometry, "RANSAC: " + rr.reason);
-    use = rr.inliers;
-    lin = rr.solution;
-  } else {
-    lin = OptimalDoubleSolver(options_).solve(pb);
-    if (!lin.ok) return refuse(CalibrationStatus::DegenerateGeometry, "linear step: " + lin.reason);
-  }
+  std::string linear_failure;
+  if (!linearStep(pb, options_, use, lin, res.ransac_iterations, linear_failure))
+    return refuse(CalibrationStatus::DegenerateGeometry, coplanarNote(geo) + linear_failure);
   res.p_AinG_linear = lin.params.p_AinG;
 
   // 2. Refinement; with RANSAC a second round on the inliers of the refined model.
   const NonlinearRefiner refiner(options_);
   RefineResult ref = refiner.refine(pb, lin.params, use);
   if (!ref.converged) return refuse(CalibrationStatus::IllConditioned, "refinement failed: " + ref.message);
+  double extra_normal_var_m2 = 0.0;
+  if (geo.mirror) {
+    std::string why;
+    if (!pickMirrorSide(pb, refiner, *geo.mirror, options_, ref, extra_normal_var_m2, why))
+      return refuse(CalibrationStatus::DegenerateGeometry, why);
+  }
   res.lm_iterations = ref.iterations;
   std::vector<bool> inl = classifyFinal(pb, ref.params, {}, options_.outlier_threshold_sigmas);
   if (options_.ransac && inl != use) {
@@ -185,9 +291,11 @@ CalibrationResult AnchorCalibrator::calibrate(SensorId anchor_id, const std::vec
   const AnchorParams& x = ref.params;
 
   // 3. Covariance on the final inliers.
-  const CovarianceEstimate cov = estimateCovariance(pb, x, inl, options_.scale_covariance_by_residuals,
-                                                    options_.correlated_reference_fraction);
+  CovarianceEstimate cov = estimateCovariance(pb, x, inl, options_.scale_covariance_by_residuals,
+                                              options_.correlated_reference_fraction);
   if (!cov.ok) return refuse(CalibrationStatus::IllConditioned, "information matrix is singular");
+  if (extra_normal_var_m2 > 0.0)  // an undecided mirror side (pickMirrorSide)
+    cov.P.block<3, 3>(0, 0) += extra_normal_var_m2 * geo.mirror->normal * geo.mirror->normal.transpose();
   const Eigen::Matrix3d Pp = cov.P.block<3, 3>(0, 0);
   const double sig_max = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Pp).eigenvalues()(2)));
   if (!(sig_max <= options_.max_position_sigma_m)) {

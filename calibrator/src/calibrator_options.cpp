@@ -62,6 +62,9 @@ const OptionField<CalibratorOptions, Ref> kFields[] = {
     {"min_plane_spread", at<&CalibratorOptions::min_plane_spread_m>},
     {"min_line_spread", at<&CalibratorOptions::min_line_spread_m>},
     {"max_position_sigma", at<&CalibratorOptions::max_position_sigma_m>},
+    {"mirror_reference_min_offset", at<&CalibratorOptions::mirror_reference_min_offset_m>},
+    {"mirror_min_cost_gap", at<&CalibratorOptions::mirror_min_cost_gap>},
+    {"mirror_merge_max", at<&CalibratorOptions::mirror_merge_max_m>},
     {"use_range_variance", at<&CalibratorOptions::use_range_variance>},
     {"max_pose_gap", at<&CalibratorOptions::max_pose_gap_s>},
     {"min_tag_position_sigma", at<&CalibratorOptions::min_tag_position_sigma_m>},
@@ -102,6 +105,7 @@ void CalibratorOptions::validate() const {
   positive(ransac_threshold_sigmas, "ransac_threshold_sigmas");
   positive(outlier_threshold_sigmas, "outlier_threshold_sigmas");
   positive(distinct_position_resolution_m, "distinct_position_resolution");
+  if (!(mirror_min_cost_gap >= 0.0)) throw std::runtime_error("key 'calibrator.mirror_min_cost_gap' must be >= 0");
   if (!(ransac_confidence > 0.0 && ransac_confidence < 1.0))
     throw std::runtime_error("key 'calibrator.ransac_confidence' must be in (0, 1)");
   if (ransac_min_iterations < 1 || ransac_max_iterations < ransac_min_iterations)

@@ -2,6 +2,7 @@
 
 #include "common/principal_axes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -14,6 +15,18 @@ std::string fmt(const char* f, double a, double b) {
   char buf[160];
   std::snprintf(buf, sizeof buf, f, a, b);
   return buf;
+}
+/// Largest distance from the plane (c, n) of a stationary reference (mean of its positions).
+double stationaryOffset(const CalibrationProblem& pb, const Eigen::Vector3d& c, const Eigen::Vector3d& n) {
+  double best = 0.0;
+  for (const auto& s : pb.slots()) {
+    if (s.moving || s.obs.empty()) continue;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int i : s.obs) mean += pb.observations()[static_cast<size_t>(i)].p_RinG;
+    mean /= static_cast<double>(s.obs.size());
+    best = std::max(best, std::abs((mean - c).dot(n)));
+  }
+  return best;
 }
 }  // namespace
 
@@ -51,7 +64,8 @@ GeometryReport checkReferenceGeometry(const CalibrationProblem& pb, const Calibr
                fmt(" (grid %.2f m), need at least %.0f", res, options.min_distinct_positions);
     return r;
   }
-  r.rms_spread_m = principalAxes(pts).rms_m;
+  const PrincipalAxes axes = principalAxes(pts);
+  r.rms_spread_m = axes.rms_m;
   if (r.rms_spread_m(1) < options.min_line_spread_m) {
     r.status = CalibrationStatus::DegenerateGeometry;
     r.reason = fmt("reference positions are collinear (RMS off their line %.3f m < %.3f m)", r.rms_spread_m(1),
@@ -59,9 +73,17 @@ GeometryReport checkReferenceGeometry(const CalibrationProblem& pb, const Calibr
     return r;
   }
   if (r.rms_spread_m(2) < options.min_plane_spread_m) {
+    // A stationary reference off the plane can tell the anchor's side of it (calibrate() fits both).
+    const double off = stationaryOffset(pb, axes.centroid, axes.axes.col(2));
+    if (options.mirror_reference_min_offset_m > 0.0 && off >= options.mirror_reference_min_offset_m) {
+      r.mirror = MirrorPlane{axes.centroid, axes.axes.col(2), off};
+      return r;
+    }
     r.status = CalibrationStatus::DegenerateGeometry;
     r.reason = fmt("reference positions are coplanar (RMS off their plane %.3f m < %.3f m)", r.rms_spread_m(2),
-                   options.min_plane_spread_m);
+                   options.min_plane_spread_m) +
+               fmt(" and no stationary reference is %.2f m off it (largest %.2f m)",
+                   options.mirror_reference_min_offset_m, off);
     return r;
   }
   return r;

@@ -39,6 +39,10 @@ SyntheticScene makeSyntheticScene(const SyntheticSceneConfig& cfg) {
         p = Eigen::Vector3d(0.3 + 2.0 * std::cos(a), 2.5 * std::sin(a), 2.0);
         yaw = a + M_PI / 2;
         break;
+      case SyntheticPath::Walk:
+        p = Eigen::Vector3d(0.3 + 2.0 * std::cos(a), 2.5 * std::sin(a), 1.2 + 0.12 * std::sin(2.0 * M_PI * 1.8 * t));
+        yaw = a + M_PI / 2;
+        break;
       case SyntheticPath::Line:
         p = Eigen::Vector3d(-2.0 + 4.0 * t / std::max(1.0, cfg.duration_s), 0.5, 2.0);
         yaw = 0.0;

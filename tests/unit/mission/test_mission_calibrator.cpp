@@ -158,6 +158,8 @@ steps:
     EXPECT_EQ(run.calibrations_ok, 5);
     EXPECT_LT(run.max_error_m, 0.3);
     EXPECT_EQ(run.duplicates, run.resent);  // in process nothing is lost: every resend is a repeat
-    if (lag_s >= 3.0) EXPECT_GT(run.resent, 3);
+    if (lag_s >= 3.0) {
+      EXPECT_GT(run.resent, 3);
+    }
   }
 }
