@@ -2,16 +2,20 @@
 """Robustness sweep (issue 8, item 2): random or listed scenarios through the whole pipeline.
 
 Every scenario is simulated with meshnav_sim (docs/scenarios.md), flown with
-`meshnav_run --no-calibration` (known anchors only) and evaluated with `meshnav_eval --json`.
-Per run: position RMSE [m], max position error after the first 10 s [m], orientation RMSE [deg],
-position ANEES, diverged (max error after 10 s > 1 m) and recoveries (the `recovery` counter of
-the run's status.txt, 0 when absent). meshnav_run gets --allow-lost, so a run that ends lost is
+`meshnav_run --no-calibration` (known anchors only; with --calibration auto, the unknown anchors
+are calibrated fly-by and fused, as `meshnav_run` does without a mission) and evaluated with
+`meshnav_eval --json`. Per run: position RMSE [m], max position error after the first 10 s [m],
+orientation RMSE [deg], position ANEES, diverged (max error after 10 s > 1 m) and recoveries (the
+`recovery` counter of the run's status.txt, 0 when absent); with --calibration auto also the
+anchors calibrated of those unknown, the largest final anchor error [m] and final anchor NEES
+(3 dof), and a bad anchor (final error > 0.5 m) fails the sweep like a divergence. meshnav_run gets --allow-lost, so a run that ends lost is
 still scored; a run that never initialized is REFUSED with the estimator's reason (the designed
 answer when the data cannot fix the pose) and is not a divergence. Writes robustness.csv and
 error_cdf.png into --out, prints a table, and exits 1 when any run diverged or a process failed
 (2 on usage errors).
 
   robustness.py --runs N --seed S [--jobs 2] [--out DIR] [--strategy S] [--config FILE] [--duration SEC]
+                [--calibration off|auto]
   robustness.py --scenarios FILE [--jobs 2] [--out DIR] [--strategy S]
 """
 
@@ -33,6 +37,8 @@ LAYOUTS = ["paper", "walls", "one-wall", "ceiling", "random"]
 IMU_GRADES = ["consumer", "fc", "tactical"]
 DIVERGENCE_M = 1.0      # max position error after SKIP_S that counts as diverged [m]
 SKIP_S = 10.0           # initial transient left out of the max error [s]
+BAD_ANCHOR_M = 0.5      # final error of a calibrated anchor that counts as a bad anchor [m]
+ANCHOR_NEES_BOUND = 13.93  # chi^2(3) at 99.7 %: a final anchor NEES above it is overconfident
 SCENARIO_KEYS = {"name", "seed", "trajectory", "hall", "anchor_layout", "tags", "known", "unknown",
                  "sigma_range", "outliers", "drop", "imu_grade", "duration", "bias_max"}
 
@@ -136,6 +142,16 @@ def read_recoveries(path):
     return 0
 
 
+def anchor_metrics(m):
+    """Calibrated anchors of meshnav_eval's JSON: their count, largest final error [m] and NEES."""
+    est = [a for a in (m.get("anchors") or {}).get("per_anchor", []) if not a.get("known", True)]
+    errs = [a["final"]["error_m"] for a in est if a.get("final") and a["final"].get("error_m") is not None]
+    nees = [a["final"]["nees"] for a in est if a.get("final") and a["final"].get("nees") is not None]
+    return {"anchors_calibrated": len(est), "anchor_err_max_m": max(errs) if errs else float("nan"),
+            "anchor_nees_max": max(nees) if nees else float("nan"),
+            "anchor_errors_m": errs, "anchor_nees": nees}
+
+
 def metrics_of(metrics_json, errors_csv, status_txt):
     """The sweep's figures of one evaluated run; raises when the run has no pose metrics."""
     with open(metrics_json) as f:
@@ -155,6 +171,7 @@ def metrics_of(metrics_json, errors_csv, status_txt):
         "diverged": not (max_late <= DIVERGENCE_M),
         "recoveries": read_recoveries(status_txt),
         "errors": late,
+        **anchor_metrics(m),
     }
 
 
@@ -181,7 +198,7 @@ def run_command(cmd, log_path):
         return subprocess.call(cmd, stdout=log, stderr=subprocess.STDOUT)
 
 
-def run_scenario(sc, out_root, bin_dir, strategy, config=None):
+def run_scenario(sc, out_root, bin_dir, strategy, config=None, calibration="off"):
     """Simulate, run, evaluate one scenario; returns a result dict (never raises)."""
     base = os.path.join(out_root, sc["name"])
     dataset, run = os.path.join(base, "dataset"), os.path.join(base, "run")
@@ -191,8 +208,8 @@ def run_scenario(sc, out_root, bin_dir, strategy, config=None):
     steps = [
         ("meshnav_sim", [os.path.join(bin_dir, "meshnav_sim"), "--out", dataset] + sim_args(sc)),
         # --allow-lost: a run that ends lost is still evaluated (and counts as diverged by its error).
-        ("meshnav_run", [os.path.join(bin_dir, "meshnav_run"), "--dataset", dataset, "--out", run, "--no-calibration",
-                         "--allow-lost"]
+        ("meshnav_run", [os.path.join(bin_dir, "meshnav_run"), "--dataset", dataset, "--out", run, "--allow-lost"]
+         + (["--no-calibration"] if calibration == "off" else [])
          + (["--strategy", strategy] if strategy else []) + (["--config", config] if config else [])),
         ("meshnav_eval", [os.path.join(bin_dir, "meshnav_eval"), "--dataset", dataset, "--run", run, "--no-plots",
                           "--json", os.path.join(run, "metrics.json")]),
@@ -229,9 +246,30 @@ def fmt(v, digits):
 
 COLUMNS = ["name", "trajectory", "hall_m", "layout", "tags", "known", "unknown", "sigma_m", "outliers", "drop",
            "imu", "pos_rmse_m", "max_err_10s_m", "ori_rmse_deg", "pos_anees", "diverged", "recoveries", "status"]
+# With --calibration auto, before "status": anchors calibrated of those unknown, the largest final
+# anchor error and final anchor NEES of the run.
+ANCHOR_COLUMNS = ["anchors", "anchor_err_max_m", "anchor_nees_max"]
 
 
-def row_of(r):
+def columns(calibration):
+    return COLUMNS[:-1] + ANCHOR_COLUMNS + COLUMNS[-1:] if calibration == "auto" else COLUMNS
+
+
+def is_bad_anchor_run(r):
+    return r["ok"] and r.get("anchor_err_max_m", float("nan")) > BAD_ANCHOR_M
+
+
+def row_of(r, calibration="off"):
+    row = base_row_of(r)
+    if calibration != "auto":
+        return row
+    sc, ok = r["scenario"], r["ok"]
+    anchors = ["%d/%d" % (r["anchors_calibrated"], sc.get("unknown", 5)), fmt(r["anchor_err_max_m"], 3),
+               fmt(r["anchor_nees_max"], 1)] if ok else ["-", "-", "-"]
+    return row[:-1] + anchors + row[-1:]
+
+
+def base_row_of(r):
     sc = r["scenario"]
     ok = r["ok"]
     return [sc["name"], sc.get("trajectory", "spiral"), hall_text(sc), sc.get("anchor_layout", "paper"),
@@ -244,10 +282,11 @@ def row_of(r):
             "ok" if ok else ("REFUSED: " if r.get("refused") else "FAILED: ") + r["error"]]
 
 
-def print_table(results):
-    rows = [COLUMNS] + [row_of(r) for r in results]
-    widths = [max(len(row[i]) for row in rows) for i in range(len(COLUMNS))]
-    text_columns = {0, 1, 2, 3, 10, len(COLUMNS) - 1}  # left-aligned; numbers right-aligned
+def print_table(results, calibration="off"):
+    cols = columns(calibration)
+    rows = [cols] + [row_of(r, calibration) for r in results]
+    widths = [max(len(row[i]) for row in rows) for i in range(len(cols))]
+    text_columns = {0, 1, 2, 3, 10, len(cols) - 1}  # left-aligned; numbers right-aligned
     for k, row in enumerate(rows):
         cells = [c.ljust(w) if i in text_columns else c.rjust(w) for i, (c, w) in enumerate(zip(row, widths))]
         print("  ".join(cells).rstrip())
@@ -255,13 +294,13 @@ def print_table(results):
             print("  ".join("-" * w for w in widths))
 
 
-def write_csv(results, path):
+def write_csv(results, path, calibration="off"):
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(COLUMNS + ["seed", "duration_s", "wall_s"])
+        w.writerow(columns(calibration) + ["seed", "duration_s", "wall_s"])
         for r in results:
             sc = r["scenario"]
-            w.writerow(row_of(r) + [sc.get("seed", 1), sc.get("duration", ""), "%.1f" % r["wall_s"]])
+            w.writerow(row_of(r, calibration) + [sc.get("seed", 1), sc.get("duration", ""), "%.1f" % r["wall_s"]])
 
 
 def write_cdf_png(results, path):
@@ -309,6 +348,9 @@ def parse_args(argv):
     p.add_argument("--strategy", help="meshnav_run --strategy, checked by meshnav_run (default: its own)")
     p.add_argument("--config", help="estimator options YAML for meshnav_run --config (default: its built-in defaults)")
     p.add_argument("--duration", type=float, default=90.0, help="sequence length of drawn scenarios [s] (default 90)")
+    p.add_argument("--calibration", choices=["off", "auto"], default="off",
+                   help="off: known anchors only (default); auto: the unknown anchors are calibrated fly-by and "
+                        "fused, and the anchors are scored too")
     p.add_argument("--bin", default=os.path.join(os.environ.get("MESHNAV_BUILD_DIR", os.path.join(ROOT, "build")), "bin"),
                    help="folder of meshnav_sim, meshnav_run, meshnav_eval (default build/bin)")
     p.add_argument("--list", action="store_true", help="print the scenarios as YAML and exit")
@@ -330,6 +372,21 @@ def percentile(values, q):
     k = (len(v) - 1) * q / 100.0
     lo, hi = int(k), min(int(k) + 1, len(v) - 1)
     return v[lo] + (v[hi] - v[lo]) * (k - lo)
+
+
+def anchor_summary_lines(results):
+    """With --calibration auto: anchors calibrated of those unknown, final anchor errors and NEES."""
+    scored = [r for r in results if r["ok"]]
+    unknown = sum(int(r["scenario"].get("unknown", 5)) for r in scored)
+    errs = [e for r in scored for e in r.get("anchor_errors_m", [])]
+    nees = [n for r in scored for n in r.get("anchor_nees", [])]
+    if not errs:
+        return ["anchors: none calibrated of %d unknown" % unknown]
+    return ["anchors: %d calibrated of %d unknown in the scored runs; final error median %.3f m, 95th percentile "
+            "%.3f m, max %.3f m; final NEES <= %.2f for %.1f %%; %d runs with a bad anchor (final error > %.1f m)"
+            % (len(errs), unknown, percentile(errs, 50), percentile(errs, 95), max(errs), ANCHOR_NEES_BOUND,
+               100.0 * sum(n <= ANCHOR_NEES_BOUND for n in nees) / max(1, len(nees)),
+               sum(is_bad_anchor_run(r) for r in results), BAD_ANCHOR_M)]
 
 
 def summary_lines(results):
@@ -372,7 +429,8 @@ def main(argv):
     print("robustness: %d scenarios, %d in parallel, results in %s" % (len(scenarios), a.jobs, a.out), flush=True)
     results, lock = [None] * len(scenarios), threading.Lock()
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as pool:
-        futures = {pool.submit(run_scenario, sc, a.out, a.bin, a.strategy, a.config): i for i, sc in enumerate(scenarios)}
+        futures = {pool.submit(run_scenario, sc, a.out, a.bin, a.strategy, a.config, a.calibration): i
+                   for i, sc in enumerate(scenarios)}
         for done, fut in enumerate(concurrent.futures.as_completed(futures), 1):
             i = futures[fut]
             r = results[i] = fut.result()
@@ -384,12 +442,12 @@ def main(argv):
                 print("[%d/%d] %s (%s): %s%s, %.0f s" % (done, len(scenarios), r["scenario"]["name"],
                       r["scenario"].get("trajectory", "spiral"), figures, state, r["wall_s"]), flush=True)
     print()
-    print_table(results)
-    write_csv(results, os.path.join(a.out, "robustness.csv"))
+    print_table(results, a.calibration)
+    write_csv(results, os.path.join(a.out, "robustness.csv"), a.calibration)
     png = os.path.join(a.out, "error_cdf.png")
     wrote_png = write_cdf_png(results, png)
     print()
-    for line in summary_lines(results):
+    for line in summary_lines(results) + (anchor_summary_lines(results) if a.calibration == "auto" else []):
         print(line)
     n_refused = sum(r["refused"] for r in results)
     n_failed = sum(not r["ok"] and not r["refused"] for r in results)
@@ -398,7 +456,8 @@ def main(argv):
           "initialize (pose not determined by the data); wrote %s%s"
           % (len(results), n_div, SKIP_S, DIVERGENCE_M, n_failed, n_refused, os.path.join(a.out, "robustness.csv"),
              " and " + png if wrote_png else ""))
-    return 1 if (n_div or n_failed) else 0
+    n_bad_anchor = sum(is_bad_anchor_run(r) for r in results) if a.calibration == "auto" else 0
+    return 1 if (n_div or n_failed or n_bad_anchor) else 0
 
 
 if __name__ == "__main__":

@@ -91,6 +91,42 @@ class MetricsTest(unittest.TestCase):
                 robustness.metrics_of(empty_pose, early_big, status)
 
 
+class AnchorMetricsTest(unittest.TestCase):
+    """--calibration auto: the calibrated anchors of meshnav_eval's JSON, the columns, a bad anchor."""
+
+    def eval_json(self, final_errors):
+        anchors = [{"id": 101, "known": True, "final": {"error_m": 0.0, "nees": None}}]
+        anchors += [{"id": 106 + i, "known": False, "final": {"error_m": e, "nees": 2.0 + 10 * i}}
+                    for i, e in enumerate(final_errors)]
+        return {"pose": {"position": {"rmse_m": 0.1, "anees": 3.0}, "orientation": {"rmse_deg": 1.0}},
+                "anchors": {"per_anchor": anchors}}
+
+    def test_known_anchors_are_not_scored_and_the_worst_calibrated_one_is(self):
+        m = robustness.anchor_metrics(self.eval_json([0.05, 0.62]))
+        self.assertEqual(m["anchors_calibrated"], 2)
+        self.assertAlmostEqual(m["anchor_err_max_m"], 0.62)
+        self.assertAlmostEqual(m["anchor_nees_max"], 12.0)
+        none = robustness.anchor_metrics(self.eval_json([]))
+        self.assertEqual(none["anchors_calibrated"], 0)
+        self.assertNotEqual(none["anchor_err_max_m"], none["anchor_err_max_m"])  # NaN: nothing to score
+
+    def test_a_bad_anchor_fails_the_run_and_shows_in_the_columns(self):
+        sc = {"name": "r", "unknown": 3}
+        good = dict(ok=True, scenario=sc, pos_rmse_m=0.1, max_err_after_10s_m=0.2, ori_rmse_deg=1.0, pos_anees=3.0,
+                    diverged=False, recoveries=0, refused=False, error="",
+                    **robustness.anchor_metrics(self.eval_json([0.05, 0.1])))
+        bad = dict(good, **robustness.anchor_metrics(self.eval_json([0.05, 0.62])))
+        self.assertFalse(robustness.is_bad_anchor_run(good))
+        self.assertTrue(robustness.is_bad_anchor_run(bad))
+        cols = robustness.columns("auto")
+        row = robustness.row_of(bad, "auto")
+        self.assertEqual(len(row), len(cols))
+        self.assertEqual(row[cols.index("anchors")], "2/3")
+        self.assertEqual(row[cols.index("anchor_err_max_m")], "0.620")
+        self.assertEqual(robustness.row_of(bad, "off"), robustness.base_row_of(bad))  # the table without anchors
+        self.assertIn("1 runs with a bad anchor", robustness.anchor_summary_lines([good, bad])[0])
+
+
 class UsageTest(unittest.TestCase):
     def test_usage_errors_and_missing_binaries(self):
         with self.assertRaises(SystemExit) as e:
