@@ -152,7 +152,9 @@ class CalibratorNode {
   bool isReference(SensorId id) const;
   bool isUnknownAnchor(SensorId id, UwbType type) const;
 
-  void calibrateAnchor(SensorId x, Track& track, Built built, bool automatic);
+  /// Calibrates x from `built`, with `options` instead of the calibrator's own when given.
+  void calibrateAnchor(SensorId x, Track& track, Built built, bool automatic,
+                       const CalibratorOptions* options = nullptr);
   void startCollecting(SensorId x, Track& track);
   void stopCollecting(Track& track);
   void addRange(SensorId x, Track& track, const RangeSample& r);

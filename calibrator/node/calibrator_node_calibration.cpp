@@ -77,11 +77,13 @@ CalibratorNode::Built CalibratorNode::buildObservations(SensorId x, Track& tr) {
 // Calibration
 // --------------------------------------------------------------------------------------------
 
-void CalibratorNode::calibrateAnchor(SensorId x, Track& tr, Built built, bool automatic) {
+void CalibratorNode::calibrateAnchor(SensorId x, Track& tr, Built built, bool automatic,
+                                     const CalibratorOptions* options) {
   last_waiting_for_pose_ = built.waiting_for_pose;
   last_waiting_for_reference_ = built.waiting_for_reference;
   const Timestamp stamp = newest_.value_or(Timestamp{});
-  CalibrationResult res = calibrator_.calibrate(x, built.obs, prior_source_.priors(x), stamp);
+  CalibrationResult res = (options ? AnchorCalibrator(*options) : calibrator_)
+                              .calibrate(x, built.obs, prior_source_.priors(x), stamp);
   const char* how = automatic ? "automatic" : "commanded";
   if (res.ok()) {
     std::string refs;
@@ -157,6 +159,9 @@ void CalibratorNode::checkAuto(SensorId x, Track& tr) {
     waiting(geo.reason);
     return;
   }
-  calibrateAnchor(x, tr, std::move(built), true);
+  // With the strict spreads also in the calibration: references that pass the check only as
+  // coplanar with stationary references off their plane must be calibrated as such (the side
+  // decided by those references), not as a volume by the looser library spreads.
+  calibrateAnchor(x, tr, std::move(built), true, &strict);
 }
 }  // namespace meshnav::calib

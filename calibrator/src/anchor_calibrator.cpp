@@ -27,7 +27,8 @@ std::string coplanarNote(const GeometryReport& geo) {
 
 /// Evidence of the stationary references for an anchor at p: Σ_r ½ ((z̃_r − β_r‖p − p_R‖ − γ_r)/σ_r)²
 /// over the stationary references whose γ has a prior (γ_r, β_r its prior means, z̃_r the median of
-/// their ranges, σ_r² = σ_γ² + σ_d²/n_r): their γ marginalized over its prior. The moving
+/// their ranges, σ_r² = σ_γ² + σ_d²/n_r + uᵀΣ_R u with Σ_R the reference position's covariance, a
+/// calibrated anchor's, and u the direction to p): their γ marginalized over its prior. The moving
 /// references are left out: mirrored across their plane they fit alike, and what they still tell
 /// apart (their small height changes) is the estimated trajectory's error as much as the anchor's.
 double stationaryEvidence(const CalibrationProblem& pb, const Eigen::Vector3d& p, double sigma_range_m) {
@@ -35,16 +36,22 @@ double stationaryEvidence(const CalibrationProblem& pb, const Eigen::Vector3d& p
   for (const auto& slot : pb.slots()) {
     if (slot.moving || slot.obs.empty() || !(slot.prior.sigma_gamma_m > 0.0)) continue;
     Eigen::Vector3d p_R = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d cov_R = Eigen::Matrix3d::Zero();
     std::vector<double> z;
     for (int i : slot.obs) {
-      p_R += pb.observations()[static_cast<size_t>(i)].p_RinG;
-      z.push_back(pb.observations()[static_cast<size_t>(i)].z_m);
+      const auto& o = pb.observations()[static_cast<size_t>(i)];
+      p_R += o.p_RinG;
+      cov_R += o.cov_p_RinG_m2;
+      z.push_back(o.z_m);
     }
-    p_R /= static_cast<double>(slot.obs.size());
+    const double n = static_cast<double>(slot.obs.size());
+    p_R /= n;
+    cov_R /= n;  // one reference position: its uncertainty does not average out
     auto mid = z.begin() + static_cast<long>(z.size() / 2);
     std::nth_element(z.begin(), mid, z.end());
-    const double var = slot.prior.sigma_gamma_m * slot.prior.sigma_gamma_m +
-                       sigma_range_m * sigma_range_m / static_cast<double>(slot.obs.size());
+    const Eigen::Vector3d u = (p - p_R).normalized();
+    const double var = slot.prior.sigma_gamma_m * slot.prior.sigma_gamma_m + sigma_range_m * sigma_range_m / n +
+                       u.dot(cov_R * u);
     const double r = *mid - slot.prior.beta * (p - p_R).norm() - slot.prior.gamma_m;
     cost += 0.5 * r * r / var;
   }
