@@ -76,8 +76,10 @@ struct CalibratorOptions {
   /// the calibration is refused as mirror-ambiguous [-].
   double mirror_min_cost_gap = 10.0;
   /// Undecided sides at most this far apart (an anchor near the plane) are not refused: the better
-  /// one is kept with its variance along the normal widened by their distance squared [m].
-  double mirror_merge_max_m = 0.5;
+  /// one is kept with its variance along the normal widened by their distance squared. Off (0) by
+  /// default: the filter's refinement of such an anchor from the same coplanar tags turned
+  /// overconfident on the random walks (docs/calibration.md) [m].
+  double mirror_merge_max_m = 0.0;
 
   // --- observation building ----------------------------------------------------------------
   bool use_range_variance = false;   ///< use the range's own R [m²] as σ_d² when > 0

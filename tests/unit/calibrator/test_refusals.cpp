@@ -159,9 +159,12 @@ TEST(MirrorSide, AnUndecidedSideIsRefusedFarFromThePlaneAndWidenedNearIt) {
   const Eigen::Vector3d far(-1.772, 0.943, 3.256);
   expectRefused(AnchorCalibrator(strict).calibrate(106, makeSyntheticScene(walkScene(far, 1)).observations),
                 CalibrationStatus::DegenerateGeometry, "mirror-ambiguous");
-  // ...near it (0.2 m above: the sides 0.4 m apart) the anchor is kept, its variance along the
-  // normal widened to cover the other side.
+  // ...and so they are near it (0.2 m above: the sides 0.4 m apart) by default; with
+  // mirror_merge_max the anchor is kept, its variance along the normal widened to cover the other side.
   const Eigen::Vector3d near(-1.772, 0.943, 1.4);
+  expectRefused(AnchorCalibrator(strict).calibrate(106, makeSyntheticScene(walkScene(near, 1)).observations),
+                CalibrationStatus::DegenerateGeometry, "mirror-ambiguous");
+  strict.mirror_merge_max_m = 0.5;
   const auto r = AnchorCalibrator(strict).calibrate(106, makeSyntheticScene(walkScene(near, 1)).observations);
   ASSERT_TRUE(r.ok()) << r.reason;
   EXPECT_LT((r.p_AinG - near).norm(), 0.5);
