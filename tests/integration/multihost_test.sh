@@ -11,6 +11,10 @@
 #   0, the mission finishes, anchors 106-110 calibrated within 0.3 m, the logged estimate's
 #   position RMSE <= 0.15 m, losses and duplicates counted per channel by the switch, duplicated
 #   ranges dropped by the estimator (RANGE:duplicate), the two clock offsets estimated within their own bound (half the smallest round trip, <= 20 ms).
+# Every mode: the switch (the network) no more than 100 ms behind its fault model (switch.yaml
+#   "behind"; it runs at real-time priority, scripts/multihost_netns.sh). A switch seconds behind
+#   delivered ranges 12 s late and a CALIB_CMD after the run on a loaded CI machine: that run
+#   tested the machine's load, not meshnav, and now fails saying so.
 # MODE kill: clean links, real time; anchors calibrated at 50 s (tests/integration/data/
 #   mission_calibrate_50s.yaml); kill -9 of the estimator at t = 60 s; the run is stopped at 75 s.
 #   Checks: the supervisor restarts it, POSE again within 2 s, position error <= 0.3 m from 10 s
@@ -121,6 +125,14 @@ OUT="$WORK/out"
 LOGS="$WORK/logs"
 [[ -s "$LOGS/switch.yaml" ]] || fail "the switch wrote no counters"
 sed -n '/^channels:/,$p' "$LOGS/switch.yaml" | sed 's/^/  /'
+# The switch's own lag (copies sent after their delivery time because it was not scheduled): a run
+# whose network was seconds behind does not test the product (see scripts/multihost_netns.sh).
+behind=$(grep "^behind: " "$LOGS/switch.yaml") || fail "no behind: line in switch.yaml"
+echo "  switch $behind"
+behind_ms=$(sed 's/.*max_ms: \([0-9]*\).*/\1/' <<< "$behind")
+# 100 ms of wall time: under the estimator's 1 s window of data time at 4x (250 ms), and five times
+# the most the switch fell behind in 12 runs at real-time priority on a loaded machine (20 ms).
+(( behind_ms <= 100 )) || fail "the switch fell $behind_ms ms behind its fault model (the machine is overloaded): the run does not test meshnav"
 for f in summary.yaml estimate.csv anchors.csv calibration.yaml; do
   [[ -s "$OUT/$f" ]] || fail "no $OUT/$f"
 done
@@ -148,17 +160,23 @@ elif [[ "$MODE" == faults ]]; then
   dups=$(grep -o "RANGE:duplicate=[0-9]*" "$LOGS/uav.log" | tail -n 1 | cut -d= -f2)
   (( ${dups:-0} > 0 )) || fail "the estimator counted no duplicated range"
   echo "  estimator: ${dups} duplicated ranges dropped"
+  # theta = reference clock - the anchor computer's clock [ms]: anchor107's clock is off by +40 ms
+  # (theta -40), anchor109's by -25 ms (theta +25). The bridges log theta's estimate and its bound.
   for a in 107:-40 109:25; do
     id=${a%%:*}; want=${a##*:}
     line=$(grep -o "time sync: offset [-+0-9.]* ms (± [0-9.]* ms)" "$LOGS/anchor$id.log" | tail -n 1)
     got=$(awk '{print $4}' <<< "$line"); bound=$(sed 's/.*(± \([0-9.]*\) ms)/\1/' <<< "$line")
     [[ -n "$got" && -n "$bound" ]] || fail "anchor$id reported no clock offset"
     # The exchange with the smallest round trip bounds the error by half of it (delays are not
-    # negative): the estimate must be inside its own bound, and that bound tight (20 ± 10 ms each
-    # way gives round trips of 20-60 ms). 0.1 ms for the log's rounding.
-    awk -v g="$got" -v w="$want" -v b="$bound" 'BEGIN { d = g - w; if (d < 0) d = -d; exit !(d <= b + 0.1 && b <= 20) }' \
-      || fail "anchor$id: clock offset $got ms (± $bound ms), injected $(( -want )) ms"
-    echo "  anchor$id: estimated offset $got ms (± $bound ms; its clock is off by $(( -want )) ms)"
+    # negative): the estimate must be inside its own bound (0.1 ms for the log's rounding) ...
+    awk -v g="$got" -v w="$want" -v b="$bound" 'BEGIN { d = g - w; if (d < 0) d = -d; exit !(d <= b + 0.1) }' \
+      || fail "anchor$id: offset estimate $got ms, true theta $want ms (its clock off by $(( -want )) ms): outside its own bound ± $bound ms"
+    # ... and that bound tight: 20 ± 10 ms each way gives round trips of 20-60 ms, half of them
+    # under 40 ms, so the best of the last 16 exchanges is under 40 ms (bound 20 ms) unless the
+    # network held the datagrams longer than --netem says (the switch's "behind" above).
+    awk -v b="$bound" 'BEGIN { exit !(b <= 20) }' \
+      || fail "anchor$id: offset estimate $got ms (true $want ms) but its bound ± $bound ms > 20 ms: no round trip under 40 ms among the last exchanges"
+    echo "  anchor$id: estimated offset $got ms (± $bound ms; true $want ms: its clock is off by $(( -want )) ms)"
   done
   "$BIN/meshnav_check_flyby" --truth "$WORK/data/truth.yaml" --anchor-ids $ANCHORS \
     --anchor-init "$OUT/calibration.yaml" --estimate "$OUT/estimate.csv" \

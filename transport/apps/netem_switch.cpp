@@ -7,6 +7,8 @@
 ///
 /// Counted per LCM channel (the datagram's header) and written to --summary at exit (SIGINT /
 /// SIGTERM): datagrams received from the hosts, and per forwarded copy delivered, lost, duplicated.
+/// A copy's delay counts from the datagram's arrival in the kernel; copies sent past their delivery
+/// time because the switch was not scheduled are counted too ("behind", transport/netem/switch_io.h).
 #include <arpa/inet.h>
 #include <net/if.h>
 #include <netinet/in.h>
@@ -27,6 +29,7 @@
 
 #include "common/cli.h"
 #include "transport/netem/link_faults.h"
+#include "transport/netem/switch_io.h"
 #include "transport/replay/clock.h"
 #include "transport/stop_signal.h"
 
@@ -63,6 +66,9 @@ int openPort(Port& p, const std::string& group, int udp_port) {
     throw std::runtime_error("SO_BINDTODEVICE " + p.name + ": " + strerror(errno));
   int rcvbuf = 4 << 20;
   setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
+  // The kernel's arrival time of each datagram: one that waited in the socket while the switch was
+  // not scheduled is delayed from when it arrived, not from when it was read.
+  netem::enableReceiveStamps(fd);
   sockaddr_in addr{};
   addr.sin_family = AF_INET;
   addr.sin_port = htons(static_cast<uint16_t>(udp_port));
@@ -146,7 +152,10 @@ class Switch {
     out << "# meshnav_netem_switch: datagrams per LCM channel. received = sent by a host; lost, duplicated,\n"
            "# delivered count the copies towards the other "
         << ports_.size() - 1 << " hosts each.\nfaults: \"" << faults_.toString() << "\"\nports: " << ports_.size()
-        << "\nchannels:\n";
+        << "\n# copies the switch sent more than " << netem::SwitchLag::kLateUs / 1000
+        << " ms after their delivery time (it was not scheduled: a loaded machine, not --netem)\n"
+        << "behind: {copies: " << lag_.sent << ", late: " << lag_.late
+        << ", max_ms: " << lag_.max_us / 1000 << "}\nchannels:\n";
     for (const auto& [ch, c] : counts_)
       out << "  " << ch << ": {received: " << c.received << ", lost: " << c.lost << ", duplicated: " << c.duplicated
           << ", delivered: " << c.delivered << "}\n";
@@ -159,6 +168,7 @@ class Switch {
   void sendDue(int64_t now) {
     while (!queue_.empty() && queue_.top().due_us <= now) {
       const Pending& p = queue_.top();
+      lag_.add(now - p.due_us);
       if (sendto(ports_[p.port].fd, p.data->data(), p.data->size(), 0, reinterpret_cast<sockaddr*>(&dest_),
                  sizeof dest_) < 0)
         ++port_errors_[ports_[p.port].name + ":send_error"];
@@ -168,7 +178,8 @@ class Switch {
   /// Reads every waiting datagram of port `i` and queues its copies towards the other ports.
   void receiveFrom(size_t i, int64_t now) {
     while (true) {
-      const ssize_t got = recv(fds_[i].fd, buf_.data(), buf_.size(), MSG_DONTWAIT);
+      int64_t arrived = now;
+      const ssize_t got = netem::receiveStamped(fds_[i].fd, buf_, now, arrived);
       if (got < 0) break;
       std::string ch = netem::lcmChannelOf(buf_.data(), static_cast<size_t>(got));
       if (ch.empty()) ch = "(fragments)";
@@ -182,7 +193,7 @@ class Switch {
         if (d.size() > 1) ++c.duplicated;
         for (int64_t delay : d) {
           ++c.delivered;
-          queue_.push({now + delay, order_++, j, data});
+          queue_.push({arrived + delay, order_++, j, data});
         }
       }
     }
@@ -195,6 +206,7 @@ class Switch {
   std::priority_queue<Pending, std::vector<Pending>, std::greater<>> queue_;
   std::map<std::string, ChannelCount> counts_;
   std::map<std::string, int64_t> port_errors_;
+  netem::SwitchLag lag_;
   uint64_t order_ = 0;
   std::vector<uint8_t> buf_ = std::vector<uint8_t>(70000);
   sockaddr_in dest_{};

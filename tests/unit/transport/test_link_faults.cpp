@@ -1,10 +1,18 @@
 // The link fault model of the multi-host tests (transport/netem/link_faults.h): netem's words,
-// the drawn loss, duplication, delay and reordering, and the channel of an LCM datagram.
+// the drawn loss, duplication, delay and reordering, and the channel of an LCM datagram; the
+// switch's receive stamps and its own lag (switch_io.h).
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cstring>
+#include <thread>
 
 #include "transport/netem/link_faults.h"
+#include "transport/netem/switch_io.h"
 
 using namespace meshnav::netem;
 
@@ -87,4 +95,49 @@ TEST(LinkFaults, ChannelOfLcmDatagrams) {
   EXPECT_EQ(lcmChannelOf(junk, sizeof junk), "?");
   shortmsg.resize(10);  // channel without its terminating NUL
   EXPECT_EQ(lcmChannelOf(shortmsg.data(), shortmsg.size()), "?");
+}
+
+// The switch's own lag (transport/netem/switch_io.h): copies sent past their delivery time.
+TEST(SwitchLag, CountsCopiesSentPastTheirTime) {
+  SwitchLag lag;
+  lag.add(-5);                          // early: the queue's top was not due yet (not sent)
+  lag.add(0);                           // on time
+  lag.add(SwitchLag::kLateUs);          // at the limit: not late
+  lag.add(SwitchLag::kLateUs + 1);      // late
+  lag.add(9'500'000);                   // the CI run's switch, 9.5 s behind
+  EXPECT_EQ(lag.sent, 5);
+  EXPECT_EQ(lag.late, 2);
+  EXPECT_EQ(lag.max_us, 9'500'000);
+}
+
+// A datagram's delay counts from its arrival in the kernel: one read 80 ms after it arrived (the
+// switch was not scheduled) carries its arrival time, not the read time.
+TEST(SwitchLag, ReceiveTimeIsTheKernelsArrivalTime) {
+  const int rx = socket(AF_INET, SOCK_DGRAM, 0), tx = socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(rx, 0);
+  ASSERT_GE(tx, 0);
+  ASSERT_TRUE(enableReceiveStamps(rx));
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(bind(rx, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  socklen_t len = sizeof addr;
+  ASSERT_EQ(getsockname(rx, reinterpret_cast<sockaddr*>(&addr), &len), 0);
+  std::vector<uint8_t> buf(100);
+  int64_t arrived = 0;
+  EXPECT_LT(receiveStamped(rx, buf, 0, arrived), 0);  // nothing waiting: no wait either
+  const auto wall = [] {
+    return std::chrono::duration_cast<std::chrono::microseconds>(
+               std::chrono::system_clock::now().time_since_epoch()).count();
+  };
+  const int64_t sent = wall();
+  ASSERT_EQ(sendto(tx, "LC02", 4, 0, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 4);
+  std::this_thread::sleep_for(std::chrono::milliseconds(80));
+  const int64_t read_at = wall();
+  ASSERT_EQ(receiveStamped(rx, buf, read_at, arrived), 4);
+  EXPECT_EQ(std::memcmp(buf.data(), "LC02", 4), 0);
+  EXPECT_GE(arrived, sent - 1000);     // the system clock's and the kernel stamp's rounding
+  EXPECT_LE(arrived, read_at - 70'000);  // 80 ms before the read, less scheduling slack
+  close(rx);
+  close(tx);
 }
