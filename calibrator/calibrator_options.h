@@ -72,6 +72,15 @@ struct CalibratorOptions {
   /// off that plane can tell the side: the anchor is then fitted on both sides and the better fit
   /// kept (`mirror_min_cost_gap`). ≤ 0: coplanar references are refused as before [m].
   double mirror_reference_min_offset_m = 0.5;
+  /// ...only while the moving references lie this close to their plane (RMS): a plane that well
+  /// defined is the one the mirror image is taken across. Between this and `min_plane_spread_m`
+  /// (automatic mode asks 0.5 m) the references are refused (waited for) as before: e.g. a take-off
+  /// and a level flight tilt the best plane, and its mirror image is not the ambiguity [m].
+  double mirror_max_plane_spread_m = 0.15;
+  /// A side-decided anchor whose σ along the plane's normal exceeds this is refused (waited for):
+  /// seen from coplanar references its distance from the plane enters the ranges to second order
+  /// only, and a weakly fixed one was found 2.8σ off on a sweep run (seed-4 run067) [m].
+  double mirror_max_normal_sigma_m = 0.15;
   /// The worse side's robust cost (Ceres, ½ Σ ρ) must exceed the better one's by this much, else
   /// the calibration is refused as mirror-ambiguous [-].
   double mirror_min_cost_gap = 10.0;

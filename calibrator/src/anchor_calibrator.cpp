@@ -132,6 +132,24 @@ bool linearStep(const CalibrationProblem& pb, const CalibratorOptions& options, 
   return lin.ok;
 }
 
+/// A side-decided anchor's covariance: widened along the plane's normal by `extra_var_m2` (an
+/// undecided side kept, mirror_merge_max), then refused (false, `why`) when its σ along the normal
+/// exceeds `mirror_max_normal_sigma_m`.
+bool mirrorCovariance(const MirrorPlane& plane, double extra_var_m2, const CalibratorOptions& options,
+                      CovarianceEstimate& cov, std::string& why) {
+  const Eigen::Vector3d& n = plane.normal;
+  cov.P.block<3, 3>(0, 0) += extra_var_m2 * n * n.transpose();
+  const double sigma_n = std::sqrt(std::max(0.0, n.dot(cov.P.block<3, 3>(0, 0) * n)));
+  if (sigma_n <= options.mirror_max_normal_sigma_m) return true;
+  char buf[200];
+  std::snprintf(buf, sizeof buf,
+                "reference positions are coplanar and the distance from their plane is weakly fixed (sigma %.2f m "
+                "along its normal > %.2f m)",
+                sigma_n, options.mirror_max_normal_sigma_m);
+  why = buf;
+  return false;
+}
+
 /// Final inlier test at x: |r_i|/σ_eff,i < k·max(1, s_robust), s_robust = 1.4826·median |r/σ_eff|
 /// over the candidate set (so an under-stated σ_d does not turn good ranges into outliers).
 std::vector<bool> classifyFinal(const CalibrationProblem& pb, const AnchorParams& x, const std::vector<bool>& candidates,
@@ -301,8 +319,8 @@ CalibrationResult AnchorCalibrator::calibrate(SensorId anchor_id, const std::vec
   CovarianceEstimate cov = estimateCovariance(pb, x, inl, options_.scale_covariance_by_residuals,
                                               options_.correlated_reference_fraction);
   if (!cov.ok) return refuse(CalibrationStatus::IllConditioned, "information matrix is singular");
-  if (extra_normal_var_m2 > 0.0)  // an undecided mirror side (pickMirrorSide)
-    cov.P.block<3, 3>(0, 0) += extra_normal_var_m2 * geo.mirror->normal * geo.mirror->normal.transpose();
+  if (std::string why; geo.mirror && !mirrorCovariance(*geo.mirror, extra_normal_var_m2, options_, cov, why))
+    return refuse(CalibrationStatus::IllConditioned, why);
   const Eigen::Matrix3d Pp = cov.P.block<3, 3>(0, 0);
   const double sig_max = std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(Pp).eigenvalues()(2)));
   if (!(sig_max <= options_.max_position_sigma_m)) {

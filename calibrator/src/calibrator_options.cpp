@@ -63,6 +63,8 @@ const OptionField<CalibratorOptions, Ref> kFields[] = {
     {"min_line_spread", at<&CalibratorOptions::min_line_spread_m>},
     {"max_position_sigma", at<&CalibratorOptions::max_position_sigma_m>},
     {"mirror_reference_min_offset", at<&CalibratorOptions::mirror_reference_min_offset_m>},
+    {"mirror_max_plane_spread", at<&CalibratorOptions::mirror_max_plane_spread_m>},
+    {"mirror_max_normal_sigma", at<&CalibratorOptions::mirror_max_normal_sigma_m>},
     {"mirror_min_cost_gap", at<&CalibratorOptions::mirror_min_cost_gap>},
     {"mirror_merge_max", at<&CalibratorOptions::mirror_merge_max_m>},
     {"use_range_variance", at<&CalibratorOptions::use_range_variance>},

@@ -75,7 +75,8 @@ GeometryReport checkReferenceGeometry(const CalibrationProblem& pb, const Calibr
   if (r.rms_spread_m(2) < options.min_plane_spread_m) {
     // A stationary reference off the plane can tell the anchor's side of it (calibrate() fits both).
     const double off = stationaryOffset(pb, axes.centroid, axes.axes.col(2));
-    if (options.mirror_reference_min_offset_m > 0.0 && off >= options.mirror_reference_min_offset_m) {
+    if (options.mirror_reference_min_offset_m > 0.0 && off >= options.mirror_reference_min_offset_m &&
+        r.rms_spread_m(2) < options.mirror_max_plane_spread_m) {
       r.mirror = MirrorPlane{axes.centroid, axes.axes.col(2), off};
       return r;
     }
