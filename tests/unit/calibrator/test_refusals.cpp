@@ -172,3 +172,14 @@ TEST(MirrorSide, AnUndecidedSideIsRefusedFarFromThePlaneAndWidenedNearIt) {
   EXPECT_GT(std::sqrt(r.cov_p_m2(2, 2)), 0.25);  // ≥ the distance between the sides (≈ 0.4 m) minus noise
   EXPECT_LT(neesOf(r, near), 13.93);
 }
+
+TEST(MirrorSide, OnlyAWellDefinedPlaneAndAWellFixedDistanceFromItAreTaken) {
+  const auto obs = makeSyntheticScene(walkScene({-1.772, 0.943, 3.256}, 1)).observations;  // RMS off plane ≈ 0.085 m
+  CalibratorOptions loose_plane;
+  loose_plane.mirror_max_plane_spread_m = 0.05;  // the walk's plane counts as not well defined: refused as before
+  expectRefused(AnchorCalibrator(loose_plane).calibrate(106, obs), CalibrationStatus::DegenerateGeometry, "coplanar");
+  CalibratorOptions tight_sigma;
+  tight_sigma.mirror_max_normal_sigma_m = 0.01;  // the side is found, but its distance from the plane is not this well fixed
+  expectRefused(AnchorCalibrator(tight_sigma).calibrate(106, obs), CalibrationStatus::IllConditioned, "weakly fixed");
+  EXPECT_TRUE(AnchorCalibrator({}).calibrate(106, obs).ok());  // the defaults take it
+}
