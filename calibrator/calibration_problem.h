@@ -18,6 +18,7 @@ struct ReferenceSlot {
   SensorId id = 0;
   ReferencePrior prior;
   bool moving = false;         ///< positions spread more than `moving_min_spread_m`: carries geometry
+  Eigen::Vector3d p_mean_RinG = Eigen::Vector3d::Zero();  ///< mean of its positions (a stationary one's place) [m]
   bool estimate_beta = false;  ///< β_R free (moving and ranges spread enough); else fixed to prior
   std::vector<int> obs;        ///< indices into observations(), sorted by time
 };

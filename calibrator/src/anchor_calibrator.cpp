@@ -16,6 +16,13 @@ namespace meshnav::calib {
 
 namespace {
 
+/// True for every observation whose reference has a slot (is not ignored).
+std::vector<bool> usableRanges(const CalibrationProblem& pb) {
+  std::vector<bool> use(pb.observations().size());
+  for (int i = 0; i < static_cast<int>(use.size()); ++i) use[static_cast<size_t>(i)] = pb.slotOf(i) >= 0;
+  return use;
+}
+
 /// Prefix of a linear-step failure on coplanar moving references (their rows carry nothing along
 /// the plane's normal when the references lie exactly in it).
 std::string coplanarNote(const GeometryReport& geo) {
@@ -35,17 +42,15 @@ double stationaryEvidence(const CalibrationProblem& pb, const Eigen::Vector3d& p
   double cost = 0.0;
   for (const auto& slot : pb.slots()) {
     if (slot.moving || slot.obs.empty() || !(slot.prior.sigma_gamma_m > 0.0)) continue;
-    Eigen::Vector3d p_R = Eigen::Vector3d::Zero();
+    const Eigen::Vector3d& p_R = slot.p_mean_RinG;
     Eigen::Matrix3d cov_R = Eigen::Matrix3d::Zero();
     std::vector<double> z;
     for (int i : slot.obs) {
       const auto& o = pb.observations()[static_cast<size_t>(i)];
-      p_R += o.p_RinG;
       cov_R += o.cov_p_RinG_m2;
       z.push_back(o.z_m);
     }
     const double n = static_cast<double>(slot.obs.size());
-    p_R /= n;
     cov_R /= n;  // one reference position: its uncertainty does not average out
     auto mid = z.begin() + static_cast<long>(z.size() / 2);
     std::nth_element(z.begin(), mid, z.end());
@@ -68,8 +73,7 @@ bool pickMirrorSide(const CalibrationProblem& pb, const NonlinearRefiner& refine
                     const CalibratorOptions& options, RefineResult& ref, double& extra_normal_var_m2,
                     std::string& why) {
   extra_normal_var_m2 = 0.0;
-  std::vector<bool> all(pb.observations().size());
-  for (int i = 0; i < static_cast<int>(all.size()); ++i) all[static_cast<size_t>(i)] = pb.slotOf(i) >= 0;
+  const std::vector<bool> all = usableRanges(pb);
   AnchorParams mirrored = ref.params;
   mirrored.p_AinG = plane.reflect(ref.params.p_AinG);
   const RefineResult a = refiner.refine(pb, ref.params, all);
@@ -78,10 +82,11 @@ bool pickMirrorSide(const CalibrationProblem& pb, const NonlinearRefiner& refine
     why = "mirror check: neither side's refinement converged";
     return false;
   }
-  const RefineResult& first = a.converged ? a : b;
+  const RefineResult& first = a.converged ? a : b;  // the other, b, only when both converged
+  const bool distinct = a.converged && b.converged &&
+                        (a.params.p_AinG - b.params.p_AinG).norm() >= 2.0 * options.sigma_range_m;
   const Eigen::Vector3d p1 = first.params.p_AinG;
-  const bool distinct = a.converged && b.converged && (a.params.p_AinG - b.params.p_AinG).norm() >= 2.0 * options.sigma_range_m;
-  const Eigen::Vector3d p2 = distinct ? (&first == &a ? b : a).params.p_AinG : plane.reflect(p1);
+  const Eigen::Vector3d p2 = distinct ? b.params.p_AinG : plane.reflect(p1);
   if ((p1 - p2).norm() < 2.0 * options.sigma_range_m) {  // on the plane: both sides are one solution
     ref.params = first.params;
     ref.iterations += a.iterations + b.iterations;
@@ -105,7 +110,7 @@ bool pickMirrorSide(const CalibrationProblem& pb, const NonlinearRefiner& refine
     return false;
   }
   const int iterations = ref.iterations + a.iterations + b.iterations;
-  ref = (e1 <= e2 || !distinct) ? first : (&first == &a ? b : a);
+  ref = (e1 <= e2 || !distinct) ? first : b;
   ref.iterations = iterations;
   return true;
 }
@@ -114,8 +119,7 @@ bool pickMirrorSide(const CalibrationProblem& pb, const NonlinearRefiner& refine
 /// every usable range. False with `why` when no solution was found.
 bool linearStep(const CalibrationProblem& pb, const CalibratorOptions& options, std::vector<bool>& use,
                 LinearSolution& lin, int& ransac_iterations, std::string& why) {
-  use.assign(pb.observations().size(), false);
-  for (int i = 0; i < static_cast<int>(use.size()); ++i) use[static_cast<size_t>(i)] = pb.slotOf(i) >= 0;
+  use = usableRanges(pb);
   if (options.ransac) {
     RansacResult rr = RansacSolver(options).run(pb, options.ransac_seed);
     ransac_iterations = rr.iterations;

@@ -46,6 +46,7 @@ CalibrationProblem::CalibrationProblem(SensorId anchor_id, std::vector<CalibObse
     spread2 /= static_cast<double>(idx.size());
     z_var /= static_cast<double>(idx.size());
     s.moving = std::sqrt(spread2) > options.moving_min_spread_m;
+    s.p_mean_RinG = mean;
     s.estimate_beta = options.estimate_beta && s.moving && std::sqrt(z_var) >= options.beta_min_range_spread_m;
     const int slot = static_cast<int>(slots_.size());
     for (int i : idx) slot_of_[static_cast<size_t>(i)] = slot;

@@ -16,16 +16,11 @@ std::string fmt(const char* f, double a, double b) {
   std::snprintf(buf, sizeof buf, f, a, b);
   return buf;
 }
-/// Largest distance from the plane (c, n) of a stationary reference (mean of its positions).
+/// Largest distance from the plane (c, n) of a stationary reference (the mean of its positions).
 double stationaryOffset(const CalibrationProblem& pb, const Eigen::Vector3d& c, const Eigen::Vector3d& n) {
   double best = 0.0;
-  for (const auto& s : pb.slots()) {
-    if (s.moving || s.obs.empty()) continue;
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int i : s.obs) mean += pb.observations()[static_cast<size_t>(i)].p_RinG;
-    mean /= static_cast<double>(s.obs.size());
-    best = std::max(best, std::abs((mean - c).dot(n)));
-  }
+  for (const auto& s : pb.slots())
+    if (!s.moving && !s.obs.empty()) best = std::max(best, std::abs((s.p_mean_RinG - c).dot(n)));
   return best;
 }
 }  // namespace
