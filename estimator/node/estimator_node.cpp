@@ -16,6 +16,7 @@
 #include <cmath>
 
 #include "estimator/filter/strategy_factory.h"
+#include "estimator/imu/imu_readings.h"
 #include "estimator/node/node_internals.h"
 
 namespace meshnav::estimator {
@@ -38,6 +39,7 @@ EstimatorNode::Snapshot EstimatorNode::Snapshot::copy() const {
   s.filter = filter ? filter->clone() : nullptr;
   s.network = network;
   s.last_imu = last_imu;
+  s.prev_imu = prev_imu;
   s.landed = landed;
   s.last_zupt = last_zupt;
   s.rest_rate = rest_rate;
@@ -320,7 +322,9 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
 void EstimatorNode::propagateTo(Timestamp t) {
   if (!cur_.last_imu || t <= cur_.filter->state().t) return;
   ScopedStepTimer timer(timings_, "propagate");
-  propagateFilter(cur_.last_imu->acc_m_s2, cur_.last_imu->gyro_rad_s, t);
+  const ImuReading u =
+      readingPast(*cur_.last_imu, cur_.prev_imu, cur_.filter->state().t, t, options_.imu.max_dt_s);
+  propagateFilter(u.acc_m_s2, u.gyro_rad_s, t);
 }
 
 void EstimatorNode::processImu(const ImuSample& s, bool first) {
@@ -333,17 +337,13 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
               " s; propagated on held readings with inflated noise");
   if (s.t > t0) {
     // Readings interpolated to the middle of [t0, s.t] (held when no earlier reading).
-    Eigen::Vector3d acc = s.acc_m_s2, gyro = s.gyro_rad_s;
-    if (cur_.last_imu && s.t > cur_.last_imu->t) {
-      const double alpha = 0.5 * ((t0 - cur_.last_imu->t).sec() + (s.t - cur_.last_imu->t).sec()) /
-                           (s.t - cur_.last_imu->t).sec();
-      acc = (1.0 - alpha) * cur_.last_imu->acc_m_s2 + alpha * s.acc_m_s2;
-      gyro = (1.0 - alpha) * cur_.last_imu->gyro_rad_s + alpha * s.gyro_rad_s;
-    }
+    const ImuReading u =
+        cur_.last_imu ? readingBetween(*cur_.last_imu, s, t0, s.t) : ImuReading{s.acc_m_s2, s.gyro_rad_s};
     ScopedStepTimer timer(timings_, "propagate");
-    propagateFilter(acc, gyro, s.t);
+    propagateFilter(u.acc_m_s2, u.gyro_rad_s, s.t);
   }
   const std::optional<ImuSample> previous = cur_.last_imu;
+  cur_.prev_imu = previous;
   cur_.last_imu = s;
   if (!have_flight_state_) cur_.landed = landedAt(s.t);
   if (cur_.landed && previous && s.t > previous->t)

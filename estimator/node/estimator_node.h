@@ -23,7 +23,8 @@
 ///   datagrams, a sender that retransmits) is dropped and counted ("RANGE:duplicate", ...), so a
 ///   range is never fused twice; keys are kept over the out-of-sequence window.
 /// - IMU samples propagate (inputs interpolated to the middle of the step); baro and range
-///   updates propagate to their own time with the latest reading held. While landed a
+///   updates propagate to their own time with the readings extrapolated along the last two
+///   samples (propagateTo). While landed a
 ///   zero-velocity update runs at `zupt.rate_hz` with the latest IMU reading.
 /// - ANCHOR_INIT and ESTIMATOR_CMD apply at max(their time, newest time).
 /// - Re-run on an anchor join (RefineOptions, estimator_node_rerun.cpp): inputs that leave the
@@ -154,6 +155,7 @@ class EstimatorNode {
     std::unique_ptr<FusionStrategy> filter;
     std::shared_ptr<const UwbNetwork> network;
     std::optional<ImuSample> last_imu;
+    std::optional<ImuSample> prev_imu;  ///< the sample before last_imu (propagateTo's slope)
     bool landed = true;
     Timestamp last_zupt;
     RestRateMean rest_rate;  ///< gyro readings since last_zupt while landed (the ZUPT's ω row)
@@ -212,6 +214,8 @@ class EstimatorNode {
   /// At most `uwb.dah_joint_max_anchors` anchors stay in it (boundJointSetAnchors).
   void joinAnchorSet(SensorId id);
   void applyCommand(const EstimatorCommand& c, bool first);
+  /// Propagates to a measurement's time `t` past the last IMU sample, with the readings
+  /// extrapolated along the last two samples to the step's middle (readingPast, imu_readings.h).
   void propagateTo(Timestamp t);
   /// Propagation with held readings; the part beyond `imu.max_dt_s` after the last IMU sample
   /// gets the gap noise.

@@ -125,6 +125,7 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   resume_kept_.reset();
   cur_.filter = std::move(filter);
   cur_.last_imu = b.last_imu;
+  cur_.prev_imu.reset();
   cur_.landed = b.landed;
   cur_.last_zupt = b.t;
   cur_.rest_rate.reset();
@@ -459,6 +460,7 @@ void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp 
   });
   cur_.filter = std::move(f);
   cur_.last_imu = last_imu;
+  cur_.prev_imu.reset();
   cur_.last_zupt = t;
   cur_.rest_rate.reset();
   history_.clear();  // a rewind must not restore the state before the re-initialization
