@@ -39,6 +39,7 @@ const Field kFields[] = {
     {"imu.acc_bias_rw", field<&EstimatorOptions::imu, &ImuNoiseOptions::acc_bias_rw>, "[m/s^3/sqrt(Hz)]"},
     {"imu.gyro_bias_rw", field<&EstimatorOptions::imu, &ImuNoiseOptions::gyro_bias_rw>, "[rad/s^2/sqrt(Hz)]"},
     {"imu.max_dt_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::max_dt_s>, "longer IMU gaps are counted as imu_gap and inflated [s]"},
+    {"imu.extrapolate_max_period_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::extrapolate_max_period_s>, "readings between samples extrapolated when the last two are at most this far apart, else held; 0 = always held [s]"},
     {"imu.gap_sigma_acc_m_s2", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_sigma_acc_m_s2>, "held-reading error during a gap [m/s^2/sqrt(s)]"},
     {"imu.gap_sigma_gyro_rad_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_sigma_gyro_rad_s>, "held-reading error during a gap [rad/s/sqrt(s)]"},
     {"init.duration_s", field<&EstimatorOptions::init, &InitOptions::duration_s>, "landed data before initializing [s]"},
@@ -205,6 +206,7 @@ void EstimatorOptions::validate() const {
   need(imu.acc_noise_density > 0 && imu.gyro_noise_density > 0 && imu.acc_bias_rw >= 0 && imu.gyro_bias_rw >= 0,
        "imu noise densities > 0");
   need(imu.max_dt_s > 0.0, "imu.max_dt_s > 0");
+  need(imu.extrapolate_max_period_s >= 0.0, "imu.extrapolate_max_period_s >= 0");
   need(imu.gap_sigma_acc_m_s2 >= 0.0 && imu.gap_sigma_gyro_rad_s >= 0.0, "imu.gap_sigma_* >= 0");
   need(init.static_max_sigma_yaw_deg > 0 && init.ambiguity_chi2 > 0 && init.motion_window_s >= init.motion_min_span_s &&
            init.motion_min_span_s > 0 && init.motion_min_ranges >= 8 && init.motion_max_sigma_yaw_deg > 0 &&

@@ -22,6 +22,10 @@ struct ImuNoiseOptions {
   double acc_bias_rw = 0.002;         ///< σ_ba [m/s³/√Hz]
   double gyro_bias_rw = 0.0002;       ///< σ_bω [rad/s²/√Hz]
   double max_dt_s = 0.1;              ///< a longer IMU gap is counted ("imu_gap") and inflated [s]
+  /// An update between two samples propagates on the readings extrapolated along the last two
+  /// samples when these are at most this far apart, else on the last one held (imu_readings.h):
+  /// a slope over a longer span says nothing about the next few ms. 0: always held [s]
+  double extrapolate_max_period_s = 0.02;
   /// Beyond `max_dt_s` after the last IMU sample the filter runs on held readings; their error is
   /// modelled as white noise of these densities (docs/robustness.md, "IMU gaps").
   double gap_sigma_acc_m_s2 = 1.0;    ///< [m/s²/√s]

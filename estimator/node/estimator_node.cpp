@@ -322,9 +322,14 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
 void EstimatorNode::propagateTo(Timestamp t) {
   if (!cur_.last_imu || t <= cur_.filter->state().t) return;
   ScopedStepTimer timer(timings_, "propagate");
-  const ImuReading u =
-      readingPast(*cur_.last_imu, cur_.prev_imu, cur_.filter->state().t, t, options_.imu.max_dt_s);
+  const Timestamp t0 = cur_.filter->state().t;
+  const ImuReading u = readingPast(*cur_.last_imu, cur_.prev_imu, t0, t, options_.imu.extrapolate_max_period_s);
   propagateFilter(u.acc_m_s2, u.gyro_rad_s, t);
+  if (u.extra_noise_scale > 0.0) {  // the extrapolated reading's own noise (imu_readings.h)
+    const double q = u.extra_noise_scale * cur_.noise_adapter.scale();
+    cur_.filter->addImuNoise(node_internal::whiteImuNoise(q * std::pow(options_.imu.acc_noise_density, 2),
+                                                          q * std::pow(options_.imu.gyro_noise_density, 2), (t - t0).sec()));
+  }
 }
 
 void EstimatorNode::processImu(const ImuSample& s, bool first) {
