@@ -328,7 +328,8 @@ void EstimatorNode::propagateTo(Timestamp t) {
   if (u.extra_noise_scale > 0.0) {  // the extrapolated reading's own noise (imu_readings.h)
     const double q = u.extra_noise_scale * cur_.noise_adapter.scale();
     cur_.filter->addImuNoise(node_internal::whiteImuNoise(q * std::pow(options_.imu.acc_noise_density, 2),
-                                                          q * std::pow(options_.imu.gyro_noise_density, 2), (t - t0).sec()));
+                                                          q * std::pow(options_.imu.gyro_noise_density, 2),
+                                                          (t - t0).sec()));
   }
 }
 

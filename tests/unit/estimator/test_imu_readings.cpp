@@ -51,13 +51,17 @@ TEST(ImuReadings, ExtrapolatedPastTheLastSampleWithinOnePeriod) {
   EXPECT_NEAR(readingPast(last, prev, at(0.018), at(0.020), 0.1).acc_m_s2.x(), 1.038, 1e-12);
 }
 
-TEST(ImuReadings, FollowsTheSlopeAtMostOnePeriodAhead) {
+TEST(ImuReadings, FollowsTheSlopeOnlyWhileTheNextSampleIsDue) {
   // u(t) = 1 + 200 t sampled at 0.010 and 0.015 (period 5 ms); the next sample is late.
   const ImuSample prev = sample(0.010, 3.0, 0.5), last = sample(0.015, 4.0, 1.0);
-  // [0.015, 0.0201]: the end is taken at 0.020, so the middle at 0.0175.
+  // [0.015, 0.0201] (jitter): the end is taken at 0.020, so the middle at 0.0175.
   EXPECT_NEAR(readingPast(last, prev, at(0.015), at(0.0201), 0.1).acc_m_s2.x(), 4.5, 1e-12);
-  // [0.021, 0.030], wholly beyond one period: the reading one period ahead.
-  EXPECT_NEAR(readingPast(last, prev, at(0.021), at(0.030), 0.1).acc_m_s2.x(), 5.0, 1e-12);
+  // [0.019, 0.0248], within two periods (one sample dropped): the ends taken at most at 0.020,
+  // the middle at 0.0195.
+  EXPECT_NEAR(readingPast(last, prev, at(0.019), at(0.0248), 0.1).acc_m_s2.x(), 4.9, 1e-12);
+  // [0.021, 0.030], beyond two periods: samples missing, possibly an IMU gap; held.
+  EXPECT_EQ(readingPast(last, prev, at(0.021), at(0.030), 0.1).acc_m_s2.x(), 4.0);
+  EXPECT_EQ(readingPast(last, prev, at(0.021), at(0.030), 0.1).extra_noise_scale, 0.0);
 }
 
 TEST(ImuReadings, HeldWhereExtrapolationIsNotAllowed) {
@@ -102,7 +106,8 @@ std::pair<double, double> walkDeadReckoning(bool extrapolate, double phase_s) {
       Timestamp t0 = imu[k].t;
       const Timestamp range_t = Timestamp::fromSec(phase_s + 0.01 * std::ceil((imu[k].t.sec() - phase_s) / 0.01));
       if (range_t > imu[k].t && range_t < imu[k + 1].t) {
-        const ImuReading u = extrapolate ? readingPast(imu[k], imu[k - 1], t0, range_t, ImuNoiseOptions{}.extrapolate_max_period_s)
+        const double max_period_s = ImuNoiseOptions{}.extrapolate_max_period_s;
+        const ImuReading u = extrapolate ? readingPast(imu[k], imu[k - 1], t0, range_t, max_period_s)
                                          : ImuReading{imu[k].acc_m_s2, imu[k].gyro_rad_s};
         prop.propagate(x, u.acc_m_s2, u.gyro_rad_s, (range_t - t0).sec(), nullptr, nullptr);
         t0 = range_t;
