@@ -16,7 +16,6 @@
 #include <cmath>
 
 #include "estimator/filter/strategy_factory.h"
-#include "estimator/imu/imu_readings.h"
 #include "estimator/node/node_internals.h"
 
 namespace meshnav::estimator {
@@ -322,15 +321,9 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
 void EstimatorNode::propagateTo(Timestamp t) {
   if (!cur_.last_imu || t <= cur_.filter->state().t) return;
   ScopedStepTimer timer(timings_, "propagate");
-  const Timestamp t0 = cur_.filter->state().t;
-  const ImuReading u = readingPast(*cur_.last_imu, cur_.prev_imu, t0, t, options_.imu.extrapolate_max_period_s);
-  propagateFilter(u.acc_m_s2, u.gyro_rad_s, t);
-  if (u.extra_noise_scale > 0.0) {  // the extrapolated reading's own noise (imu_readings.h)
-    const double q = u.extra_noise_scale * cur_.noise_adapter.scale();
-    cur_.filter->addImuNoise(node_internal::whiteImuNoise(q * std::pow(options_.imu.acc_noise_density, 2),
-                                                          q * std::pow(options_.imu.gyro_noise_density, 2),
-                                                          (t - t0).sec()));
-  }
+  propagateFilter(readingPast(*cur_.last_imu, cur_.prev_imu, cur_.filter->state().t, t,
+                              options_.imu.extrapolate_max_period_s),
+                  t);
 }
 
 void EstimatorNode::processImu(const ImuSample& s, bool first) {
@@ -346,7 +339,7 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
     const ImuReading u =
         cur_.last_imu ? readingBetween(*cur_.last_imu, s, t0, s.t) : ImuReading{s.acc_m_s2, s.gyro_rad_s};
     ScopedStepTimer timer(timings_, "propagate");
-    propagateFilter(u.acc_m_s2, u.gyro_rad_s, s.t);
+    propagateFilter(u, s.t);
   }
   const std::optional<ImuSample> previous = cur_.last_imu;
   cur_.prev_imu = previous;

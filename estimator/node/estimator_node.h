@@ -69,6 +69,7 @@
 #include "estimator/node/checkpoint.h"
 #include "estimator/node/estimator_input.h"
 #include "estimator/health/health_monitor.h"
+#include "estimator/imu/imu_readings.h"
 #include "estimator/imu/process_noise_adapter.h"
 #include "estimator/node/anchor_plane_mirror.h"
 #include "estimator/node/motion_aligner.h"
@@ -217,9 +218,9 @@ class EstimatorNode {
   /// Propagates to a measurement's time `t` past the last IMU sample, with the readings
   /// extrapolated along the last two samples to the step's middle (readingPast, imu_readings.h).
   void propagateTo(Timestamp t);
-  /// Propagation with held readings; the part beyond `imu.max_dt_s` after the last IMU sample
-  /// gets the gap noise.
-  void propagateFilter(const Eigen::Vector3d& acc, const Eigen::Vector3d& gyro, Timestamp t);
+  /// Propagation on the readings `u` held over [filter time, t], with λ's and `u`'s extra white
+  /// noise; the part beyond `imu.max_dt_s` after the last IMU sample gets the gap noise.
+  void propagateFilter(const ImuReading& u, Timestamp t);
   /// Feeds the aligner (and stillness) with an input in arrival order.
   void feedAligner(const EstimatorInput& in);
   void tryMotionInitialization(Timestamp t);

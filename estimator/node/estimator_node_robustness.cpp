@@ -310,12 +310,14 @@ InitialBelief EstimatorNode::beliefFromAlignment(const AlignmentResult& r) const
   return b;
 }
 
-void EstimatorNode::propagateFilter(const Eigen::Vector3d& acc, const Eigen::Vector3d& gyro, Timestamp t) {
+void EstimatorNode::propagateFilter(const ImuReading& u, Timestamp t) {
   FusionStrategy& f = *cur_.filter;
   const Timestamp t0 = f.state().t;
-  f.propagate(acc, gyro, t);
-  // The IMU noise beyond its stated densities that the range innovations show (λ − 1 of it).
-  const double extra = cur_.noise_adapter.scale() - 1.0;
+  f.propagate(u.acc_m_s2, u.gyro_rad_s, t);
+  // The IMU noise beyond its stated densities that the range innovations show (λ − 1 of it), and
+  // an extrapolated reading's own excess (λ times its extra_noise_scale), in one addition.
+  const double lambda = cur_.noise_adapter.scale();
+  const double extra = lambda - 1.0 + lambda * u.extra_noise_scale;
   if (extra > 0.0 && t > t0)
     f.addImuNoise(whiteImuNoise(extra * std::pow(options_.imu.acc_noise_density, 2),
                                 extra * std::pow(options_.imu.gyro_noise_density, 2), (t - t0).sec()));
