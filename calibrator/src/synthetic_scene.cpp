@@ -5,6 +5,36 @@
 
 namespace meshnav::calib {
 
+namespace {
+/// IMU position and yaw along the configured path at time t [s].
+void bodyOnPath(const SyntheticSceneConfig& cfg, double t, Eigen::Vector3d& p, double& yaw) {
+  const double turns_per_s = 3.0 / 120.0;
+  const double a = 2.0 * M_PI * turns_per_s * t;
+  switch (cfg.path) {
+    case SyntheticPath::Spiral:
+      p = Eigen::Vector3d(0.3 + 2.0 * std::cos(a), 2.5 * std::sin(a), 1.0 + 7.0 * t / 120.0);
+      yaw = a + M_PI / 2;
+      break;
+    case SyntheticPath::Planar:
+      p = Eigen::Vector3d(0.3 + 2.0 * std::cos(a), 2.5 * std::sin(a), 2.0);
+      yaw = a + M_PI / 2;
+      break;
+    case SyntheticPath::Walk:
+      p = Eigen::Vector3d(0.3 + 2.0 * std::cos(a), 2.5 * std::sin(a), 1.2 + 0.12 * std::sin(2.0 * M_PI * 1.8 * t));
+      yaw = a + M_PI / 2;
+      break;
+    case SyntheticPath::Line:
+      p = Eigen::Vector3d(-2.0 + 4.0 * t / std::max(1.0, cfg.duration_s), 0.5, 2.0);
+      yaw = 0.0;
+      break;
+    case SyntheticPath::Hover:
+      p = Eigen::Vector3d(0.3, 0.0, 2.0);
+      yaw = 0.0;
+      break;
+  }
+}
+}  // namespace
+
 SyntheticScene makeSyntheticScene(const SyntheticSceneConfig& cfg) {
   SyntheticScene sc;
   sc.p_AinG = cfg.p_AinG;
@@ -26,34 +56,6 @@ SyntheticScene makeSyntheticScene(const SyntheticSceneConfig& cfg) {
     sc.beta[r] = tags.count(r) ? 1.0 + cfg.beta_sigma * n01(rng) : 1.0;
   }
 
-  // IMU position and yaw along the path at time t.
-  auto body = [&](double t, Eigen::Vector3d& p, double& yaw) {
-    const double turns_per_s = 3.0 / 120.0;
-    const double a = 2.0 * M_PI * turns_per_s * t;
-    switch (cfg.path) {
-      case SyntheticPath::Spiral:
-        p = Eigen::Vector3d(0.3 + 2.0 * std::cos(a), 2.5 * std::sin(a), 1.0 + 7.0 * t / 120.0);
-        yaw = a + M_PI / 2;
-        break;
-      case SyntheticPath::Planar:
-        p = Eigen::Vector3d(0.3 + 2.0 * std::cos(a), 2.5 * std::sin(a), 2.0);
-        yaw = a + M_PI / 2;
-        break;
-      case SyntheticPath::Walk:
-        p = Eigen::Vector3d(0.3 + 2.0 * std::cos(a), 2.5 * std::sin(a), 1.2 + 0.12 * std::sin(2.0 * M_PI * 1.8 * t));
-        yaw = a + M_PI / 2;
-        break;
-      case SyntheticPath::Line:
-        p = Eigen::Vector3d(-2.0 + 4.0 * t / std::max(1.0, cfg.duration_s), 0.5, 2.0);
-        yaw = 0.0;
-        break;
-      case SyntheticPath::Hover:
-        p = Eigen::Vector3d(0.3, 0.0, 2.0);
-        yaw = 0.0;
-        break;
-    }
-  };
-
   const int n = cfg.n_ranges;
   for (int k = 0; k < n; ++k) {
     const double t = cfg.duration_s * (k + 0.5) / n;
@@ -63,7 +65,7 @@ SyntheticScene makeSyntheticScene(const SyntheticSceneConfig& cfg) {
     if (is_tag) {
       Eigen::Vector3d p = Eigen::Vector3d::Zero();
       double yaw = 0.0;
-      body(t, p, yaw);
+      bodyOnPath(cfg, t, p, yaw);
       p_ref = p + Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * tags.at(r);
     } else {
       p_ref = anchors.at(r);

@@ -214,6 +214,45 @@ std::optional<FlightVolume> readFlightVolume(YamlOptions& y) {
   return v;
 }
 
+/// `abs_anchor_sigmas: {id: sigma_m}` of anchors listed in abs_anchor_positions.
+void readAnchorSigmas(const YAML::Node& sig, const std::string& path, SystemSetup& s) {
+  if (!sig || sig.IsNull()) return;
+  if (!sig.IsMap()) fail(path, "key 'abs_anchor_sigmas' must be a map {id: sigma_m}");
+  for (const auto& kv : sig) {
+    const SensorId id = deviceId(kv.first, path, "abs_anchor_sigmas");
+    if (!s.abs_anchor_positions.count(id)) {
+      fail(path, "key 'abs_anchor_sigmas." + std::to_string(id) + "' names an anchor missing in abs_anchor_positions");
+    }
+    const double v = num(kv.second, path, "abs_anchor_sigmas." + std::to_string(id));
+    if (v < 0) fail(path, "key 'abs_anchor_sigmas." + std::to_string(id) + "' must be >= 0 [m]");
+    s.abs_anchor_sigmas_m[id] = v;
+  }
+}
+
+/// `noise:` (every key optional: the estimator's and simulator's own defaults apply).
+NoiseFigures readNoise(YamlOptions& y) {
+  NoiseFigures n;
+  y.read("noise.sigma_range", n.sigma_range_m);
+  y.read("noise.imu_acc_noise_density", n.imu_acc_noise_density);
+  y.read("noise.imu_gyro_noise_density", n.imu_gyro_noise_density);
+  y.read("noise.imu_acc_bias_rw", n.imu_acc_bias_rw);
+  y.read("noise.imu_gyro_bias_rw", n.imu_gyro_bias_rw);
+  y.read("noise.imu_acc_bias_sigma", n.imu_acc_bias_sigma);
+  y.read("noise.imu_gyro_bias_sigma", n.imu_gyro_bias_sigma);
+  y.read("noise.baro_pressure_sigma", n.baro_pressure_sigma_pa);
+  for (const auto& [key, v] : {std::pair{"noise.sigma_range", n.sigma_range_m},
+                               {"noise.imu_acc_bias_sigma", n.imu_acc_bias_sigma},
+                               {"noise.imu_gyro_bias_sigma", n.imu_gyro_bias_sigma},
+                               {"noise.imu_acc_noise_density", n.imu_acc_noise_density},
+                               {"noise.imu_gyro_noise_density", n.imu_gyro_noise_density},
+                               {"noise.baro_pressure_sigma", n.baro_pressure_sigma_pa}})
+    if (v && !(*v > 0.0)) y.fail(key, "must be > 0");
+  for (const auto& [key, v] : {std::pair{"noise.imu_acc_bias_rw", n.imu_acc_bias_rw},
+                               {"noise.imu_gyro_bias_rw", n.imu_gyro_bias_rw}})
+    if (v && !(*v >= 0.0)) y.fail(key, "must be >= 0");
+  return n;
+}
+
 }  // namespace
 
 std::optional<PairBias> SystemSetup::findPairBias(SensorId a, SensorId b) const {
@@ -238,18 +277,7 @@ SystemSetup loadSetup(const std::string& path) {
   y.read("height_id", s.height_id);
   s.rel_tag_positions = idVecMap(y.take("rel_tag_positions"), path, "rel_tag_positions");
   s.abs_anchor_positions = idVecMap(y.take("abs_anchor_positions"), path, "abs_anchor_positions");
-  if (const auto sig = y.take("abs_anchor_sigmas"); sig && !sig.IsNull()) {
-    if (!sig.IsMap()) fail(path, "key 'abs_anchor_sigmas' must be a map {id: sigma_m}");
-    for (const auto& kv : sig) {
-      const SensorId id = deviceId(kv.first, path, "abs_anchor_sigmas");
-      if (!s.abs_anchor_positions.count(id)) {
-        fail(path, "key 'abs_anchor_sigmas." + std::to_string(id) + "' names an anchor missing in abs_anchor_positions");
-      }
-      const double v = num(kv.second, path, "abs_anchor_sigmas." + std::to_string(id));
-      if (v < 0) fail(path, "key 'abs_anchor_sigmas." + std::to_string(id) + "' must be >= 0 [m]");
-      s.abs_anchor_sigmas_m[id] = v;
-    }
-  }
+  readAnchorSigmas(y.take("abs_anchor_sigmas"), path, s);
   s.pair_biases = readPairBiases(y.take("pair_biases"), path, "pair_biases");
   y.read("baro.p_IP", s.baro_p_IP);
   y.read("baro.reference_pressure", s.baro_reference_pressure_pa);
@@ -284,24 +312,7 @@ SystemSetup loadSetup(const std::string& path) {
       y.fail("flight_volume", "does not hold known anchor " + std::to_string(id) + " (" +
                                   std::to_string(s.flight_volume->distanceOutside(p)) +
                                   " m outside): the volume and the anchors must be in the same frame G [m]");
-  y.read("noise.sigma_range", s.noise.sigma_range_m);
-  y.read("noise.imu_acc_noise_density", s.noise.imu_acc_noise_density);
-  y.read("noise.imu_gyro_noise_density", s.noise.imu_gyro_noise_density);
-  y.read("noise.imu_acc_bias_rw", s.noise.imu_acc_bias_rw);
-  y.read("noise.imu_gyro_bias_rw", s.noise.imu_gyro_bias_rw);
-  y.read("noise.imu_acc_bias_sigma", s.noise.imu_acc_bias_sigma);
-  y.read("noise.imu_gyro_bias_sigma", s.noise.imu_gyro_bias_sigma);
-  y.read("noise.baro_pressure_sigma", s.noise.baro_pressure_sigma_pa);
-  for (const auto& [key, v] : {std::pair{"noise.sigma_range", s.noise.sigma_range_m},
-                               {"noise.imu_acc_bias_sigma", s.noise.imu_acc_bias_sigma},
-                               {"noise.imu_gyro_bias_sigma", s.noise.imu_gyro_bias_sigma},
-                               {"noise.imu_acc_noise_density", s.noise.imu_acc_noise_density},
-                               {"noise.imu_gyro_noise_density", s.noise.imu_gyro_noise_density},
-                               {"noise.baro_pressure_sigma", s.noise.baro_pressure_sigma_pa}})
-    if (v && !(*v > 0.0)) y.fail(key, "must be > 0");
-  for (const auto& [key, v] : {std::pair{"noise.imu_acc_bias_rw", s.noise.imu_acc_bias_rw},
-                               {"noise.imu_gyro_bias_rw", s.noise.imu_gyro_bias_rw}})
-    if (v && !(*v >= 0.0)) y.fail(key, "must be >= 0");
+  s.noise = readNoise(y);
   y.rejectUnknown();
   checkIds(s, path, y.has("imu_id"), y.has("baro_id"), y.has("height_id"));
   return s;
