@@ -87,6 +87,8 @@ const Field kFields[] = {
     {"uwb.enabled", field<&EstimatorOptions::uwb, &UwbOptions::enabled>, ""},
     {"uwb.sigma_range_m", field<&EstimatorOptions::uwb, &UwbOptions::sigma_range_m>, "fallback range sigma [m]"},
     {"uwb.gate_probability", field<&EstimatorOptions::uwb, &UwbOptions::gate_probability>, "chi^2 gate, 0 = off [-]"},
+    {"uwb.huber_k", field<&EstimatorOptions::uwb, &UwbOptions::huber_k>, "Huber threshold of the range update in innovation sigmas, 0 = off [-]"},
+    {"uwb.huber_max_prior_ratio", field<&EstimatorOptions::uwb, &UwbOptions::huber_max_prior_ratio>, "Huber weighting only while H P H^T / R of the range is at most this [-]"},
     {"uwb.use_corrected_range", field<&EstimatorOptions::uwb, &UwbOptions::use_corrected_range>, "fuse range_corr instead of range_raw"},
     {"uwb.max_range_m", field<&EstimatorOptions::uwb, &UwbOptions::max_range_m>, "longer ranges are bad input [m]"},
     {"uwb.estimate_tag_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_tag_biases>, "estimate tag-anchor gamma (setup anchors, sigma_gamma > 0) as states"},
@@ -242,6 +244,7 @@ void EstimatorOptions::validate() const {
   need(init.motion_max_window_s >= init.motion_window_s, "init.motion_max_window_s >= init.motion_window_s");
   need(uwb.sigma_range_m > 0 && uwb.max_range_m > 0, "uwb.sigma_range_m > 0, uwb.max_range_m > 0");
   need(uwb.gate_probability >= 0 && uwb.gate_probability < 1, "uwb.gate_probability in [0, 1)");
+  need(uwb.huber_k >= 0 && uwb.huber_max_prior_ratio >= 0, "uwb.huber_k >= 0, uwb.huber_max_prior_ratio >= 0");
   need(process_noise.batch >= 5 && process_noise.upper_ratio > 1.0 && process_noise.lower_ratio > 0.0 &&
            process_noise.lower_ratio < 1.0 && process_noise.max_grow > 1.0 && process_noise.max_shrink > 1.0 &&
            process_noise.max_scale >= 1.0 && process_noise.max_prior_ratio > 0.0 &&

@@ -119,6 +119,10 @@ struct UwbOptions {
   bool enabled = true;
   double sigma_range_m = 0.15;           ///< fallback range σ [m]
   double gate_probability = 0.997;       ///< χ² gate (0: no gating) [-]
+  /// Huber threshold of the range update in innovation σ's (Linearization::huber_k; 0: off).
+  double huber_k = 0.0;
+  /// ... while H P Hᵀ / R of the range is at most this (Linearization::huber_max_prior_ratio) [-]
+  double huber_max_prior_ratio = 1.0;
   bool use_corrected_range = false;      ///< fuse range_corr instead of range_raw
   double max_range_m = 100.0;            ///< longer ranges are bad input [m]
   /// Estimate γ of tag–setup-anchor pairs whose a-priori bias has sigma_gamma > 0 as states of the

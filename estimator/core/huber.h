@@ -25,6 +25,14 @@ inline double weight(double e) {
   return a <= kThreshold ? 1.0 : kThreshold / a;
 }
 
+/// Factor on the innovation covariance S of a Huber-weighted Kalman update with threshold k
+/// (Linearization::huber_k): max(1, √NIS / k); 1 when k ≤ 0 (off), NIS is not finite or the
+/// state's share of S, prior_ratio = tr(H P Hᵀ) / tr(R), exceeds max_prior_ratio.
+inline double innovationInflation(double nis, double k, double prior_ratio, double max_prior_ratio) {
+  if (!(k > 0.0) || !std::isfinite(nis) || nis <= k * k || !(prior_ratio <= max_prior_ratio)) return 1.0;
+  return std::sqrt(nis) / k;
+}
+
 /// Robust variance factor of normalized residuals |e_i| = |r_i|/σ_i: max(1, (1.4826 · median|e|)²),
 /// 1 when the ranges fit as well as their stated σ; 1 with fewer than 8 residuals. Used to scale a
 /// fit's covariance and its cost margins when the ranges fit worse than σ says.

@@ -1,5 +1,7 @@
 #include "estimator/filter/dense_ekf_update.h"
 
+#include "estimator/core/huber.h"
+
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <stdexcept>
@@ -24,10 +26,16 @@ DenseUpdateOutput denseEkfUpdate(Eigen::MatrixXd& P, const StateLayout& layout, 
     S.noalias() += jb.H * U.middleRows(b.offset, b.dim);
   }
   S = 0.5 * (S + S.transpose()).eval();
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
+  Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
   DenseUpdateOutput out;
   out.nis = lin.residual.dot(ldlt.solve(lin.residual));
   if (!std::isfinite(out.nis) || (nis_gate > 0.0 && out.nis > nis_gate)) return out;
+  const double prior_ratio = (S.trace() - lin.R.trace()) / lin.R.trace();
+  if (const double inflate = huber::innovationInflation(out.nis, lin.huber_k, prior_ratio, lin.huber_max_prior_ratio);
+      inflate > 1.0) {
+    S *= inflate;  // R_eff = R + S (inflate − 1): the Joseph form below uses S = H P Hᵀ + R_eff
+    ldlt.compute(S);
+  }
   out.K = ldlt.solve(U.transpose()).transpose();  // n × m
   out.dx = out.K * lin.residual;
   if (joseph_form) {

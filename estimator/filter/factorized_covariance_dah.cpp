@@ -17,6 +17,7 @@
 #include <string>
 #include <type_traits>
 
+#include "estimator/core/huber.h"
 #include "estimator/core/imu_state.h"
 #include "estimator/filter/dense_ekf_update.h"
 #include "estimator/filter/factorized_covariance_internals.h"
@@ -256,6 +257,8 @@ class DahUpdate {
     const double r = lin_.residual(0);
     res->nis = r * (invertible_ ? r / s_ : 0.0);
     if (!std::isfinite(res->nis) || (nis_gate > 0.0 && res->nis > nis_gate)) return false;
+    s_ *= huber::innovationInflation(res->nis, lin_.huber_k, (s_ - lin_.R(0, 0)) / lin_.R(0, 0),
+                                     lin_.huber_max_prior_ratio);  // Linearization::huber_k
     Kv_.resize(n_);
     for (int i = 0; i < n_; ++i) Kv_(i) = invertible_ ? U_(i) / s_ : 0.0;
     // Element (i, j) and (j, i) in one pass over the upper triangle, then symmetrized.

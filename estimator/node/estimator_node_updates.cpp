@@ -108,6 +108,8 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
     event(first, RangeModel::statusName(st));
     return;
   }
+  lin.huber_k = options_.uwb.huber_k;
+  lin.huber_max_prior_ratio = options_.uwb.huber_max_prior_ratio;
   const bool tag_range = cur_.network->isTag(z.a) || cur_.network->isTag(z.b);
   bool count = first;
   if (tag_range && !reentryAdmit(s, cur_.network->isTag(z.a) ? z.b : z.a, lin, first, &count)) return;

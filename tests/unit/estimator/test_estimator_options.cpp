@@ -92,6 +92,9 @@ TEST(EstimatorOptions, UnknownKeysAndBadValuesNameFileAndKey) {
   EXPECT_NE(e.find("confirm_batches >= 1"), std::string::npos) << e;
   e = loadError("opts_pn_at_once.yaml", "process_noise:\n  grow_at_once_ratio: 2.0\n");  // below upper_ratio
   EXPECT_NE(e.find("grow_at_once_ratio >= upper_ratio"), std::string::npos) << e;
+  e = loadError("opts_huber.yaml", "uwb:\n  huber_k: -1\n");
+  EXPECT_NE(e.find("uwb.huber_k >= 0"), std::string::npos) << e;
+  EXPECT_EQ(loadError("opts_huber_on.yaml", "uwb:\n  huber_k: 2\n  huber_max_prior_ratio: 0.5\n"), "");
   EXPECT_EQ(loadError("opts_pn_no_ratchet.yaml", "process_noise:\n  min_accepted_fraction: 0.5\n  confirm_batches: 2\n"), "");
   e = loadError("opts_joint_max.yaml", "uwb:\n  dah_joint_max_anchors: -1\n");
   EXPECT_NE(e.find("uwb.dah_joint_max_anchors >= 0"), std::string::npos) << e;

@@ -1,0 +1,114 @@
+/// The Huber-weighted update (Linearization::huber_k): in every strategy it equals the plain
+/// update with R_eff = R + S (√NIS / k − 1), reports the NIS of the stated R, and is the plain
+/// update where it must be (within k, above the prior-ratio bound, gated, switched off).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "estimator/core/huber.h"
+#include "estimator/filter/centralized_ekf.h"
+#include "estimator/filter/modular_filter.h"
+#include "modular_test_helpers.h"
+
+using namespace meshnav;
+using namespace meshnav::estimator;
+
+namespace {
+
+std::unique_ptr<FusionStrategy> makeStrategy(const std::string& name, double sigma_imu_p_m) {
+  const ImuPropagator prop(9.81, ImuNoiseOptions{});
+  std::unique_ptr<FusionStrategy> f;
+  if (name == "centralized")
+    f = std::make_unique<CentralizedEkf>(prop, KindRandomWalks{}, true);
+  else
+    f = std::make_unique<ModularFilter>(name == "dp" ? ModularFilter::Mode::DP : ModularFilter::Mode::DAH, prop,
+                                        KindRandomWalks{}, true);
+  ImuState x;
+  x.p_IinG = {0.5, -0.2, 1.5};
+  ImuMatrix P = ImuMatrix::Identity() * 1e-4;
+  P.block<3, 3>(ImuErr::kP, ImuErr::kP) = Eigen::Matrix3d::Identity() * sigma_imu_p_m * sigma_imu_p_m;
+  f->reset(1, x, P, Timestamp{});
+  f->addInstance<AnchorKind>(106, AnchorState{Eigen::Vector3d(-1.772, 0.943, 3.256)}, Eigen::Matrix3d::Identity() * 1e-4);
+  return f;
+}
+
+/// S = H P Hᵀ + R of `lin` in `f` (one range: IMU position and anchor 106).
+double innovationVariance(const FusionStrategy& f, const Linearization& lin) {
+  double s = lin.R(0, 0);
+  for (const auto& a : lin.blocks)
+    for (const auto& b : lin.blocks) s += (a.H * f.covariance(a.id, b.id) * b.H.transpose())(0, 0);
+  return s;
+}
+
+}  // namespace
+
+TEST(HuberUpdate, InflationIsRootNisOverKBeyondKAndOneElsewhere) {
+  EXPECT_DOUBLE_EQ(huber::innovationInflation(9.0, 2.0, 0.5, 1.0), 1.5);
+  EXPECT_DOUBLE_EQ(huber::innovationInflation(3.0, 2.0, 0.5, 1.0), 1.0);  // within k = 2
+  EXPECT_DOUBLE_EQ(huber::innovationInflation(9.0, 0.0, 0.5, 1.0), 1.0);  // off
+  EXPECT_DOUBLE_EQ(huber::innovationInflation(9.0, 2.0, 1.5, 1.0), 1.0);  // the state's error dominates S
+  EXPECT_DOUBLE_EQ(huber::innovationInflation(NAN, 2.0, 0.5, 1.0), 1.0);
+  EXPECT_DOUBLE_EQ(huber::innovationInflation(9.0, 2.0, NAN, 1.0), 1.0);
+}
+
+TEST(HuberUpdate, EqualsThePlainUpdateWithTheInflatedNoiseInEveryStrategy) {
+  for (const std::string name : {"centralized", "dp", "dah"}) {
+    SCOPED_TRACE(name);
+    auto huber = makeStrategy(name, 0.05);  // H P Hᵀ ≈ 0.0026 against R = 0.01: ratio 0.26
+    auto plain = huber->clone();
+    Linearization lin = test::imuAnchorRange(huber->state(), 106, 4.0);
+    const double S = innovationVariance(*huber, lin), r = lin.residual(0);
+    ASSERT_LT((S - lin.R(0, 0)) / lin.R(0, 0), 1.0);
+    const double e = std::abs(r) / std::sqrt(S);
+    ASSERT_GT(e, 2.5) << "the test range must be beyond k";
+    lin.huber_k = 2.0;
+    lin.huber_max_prior_ratio = 1.0;
+    Linearization lin_eff = test::imuAnchorRange(plain->state(), 106, 4.0);
+    lin_eff.R(0, 0) += S * (e / 2.0 - 1.0);
+    const UpdateResult rh = huber->update(lin, 0.0), rp = plain->update(lin_eff, 0.0);
+    ASSERT_TRUE(rh.accepted && rp.accepted);
+    EXPECT_NEAR(rh.nis, r * r / S, 1e-12) << "the NIS of the stated R";
+    EXPECT_LT(test::relativeDifference(*huber, *plain), 1e-12);
+    // Against the plain update with the stated R, the step δx = P Hᵀ ν / S shrinks by k / e.
+    auto stated = makeStrategy(name, 0.05);
+    ASSERT_TRUE(stated->update(test::imuAnchorRange(stated->state(), 106, 4.0), 0.0).accepted);
+    const Eigen::Vector3d p0(0.5, -0.2, 1.5);
+    EXPECT_NEAR((huber->state().imu.p_IinG - p0).norm() / (stated->state().imu.p_IinG - p0).norm(), 2.0 / e, 1e-9);
+  }
+}
+
+/// A Huber update (k = 2, bound 1) of the range to anchor 106 measured as `z(state)` with the IMU
+/// position at σ `sigma_p_m` leaves exactly the state and covariances of the plain update.
+void expectThePlainUpdate(const std::string& name, double sigma_p_m, double (*z)(const FusionStrategy&)) {
+  auto huber = makeStrategy(name, sigma_p_m);
+  auto plain = huber->clone();
+  Linearization lin = test::imuAnchorRange(huber->state(), 106, z(*huber));
+  const Linearization lin_plain = lin;
+  lin.huber_k = 2.0;
+  lin.huber_max_prior_ratio = 1.0;
+  ASSERT_TRUE(huber->update(lin, 0.0).accepted && plain->update(lin_plain, 0.0).accepted);
+  EXPECT_EQ(test::relativeDifference(*huber, *plain), 0.0);
+}
+
+TEST(HuberUpdate, IsThePlainUpdateWithinKAboveThePriorRatioOrWhenGated) {
+  for (const std::string name : {"centralized", "dp", "dah"}) {
+    SCOPED_TRACE(name);
+    // Within k: the range agrees to 1.5 σ.
+    expectThePlainUpdate(name, 0.05, [](const FusionStrategy& f) {
+      const Linearization lin = test::imuAnchorRange(f.state(), 106, 0.0);
+      return -lin.residual(0) + 1.5 * std::sqrt(innovationVariance(f, lin));
+    });
+    // The state's share of S above the bound (σ_p 0.3 m: H P Hᵀ / R ≈ 9).
+    expectThePlainUpdate(name, 0.3, [](const FusionStrategy&) { return 4.0; });
+    // Gated: nothing changes, and the NIS is still reported.
+    auto huber = makeStrategy(name, 0.05);
+    auto before = huber->clone();
+    Linearization lin = test::imuAnchorRange(huber->state(), 106, 4.0);
+    lin.huber_k = 2.0;
+    const UpdateResult r = huber->update(lin, 9.0);
+    EXPECT_FALSE(r.accepted);
+    EXPECT_GT(r.nis, 9.0);
+    EXPECT_EQ(test::relativeDifference(*huber, *before), 0.0);
+  }
+}
