@@ -2,7 +2,8 @@
 /// @file huber.h
 /// @brief Huber loss of a normalized residual e = r/σ, for the range fits of initialization
 /// (StaticInitializer, MotionAligner): quadratic within k, linear beyond, so NLOS outliers do not
-/// pick the minimum. Iteratively reweighted least squares uses weight(e) = ρ'(e) / (2e).
+/// pick the minimum; and the weight of the filter's optional Huber range update
+/// (innovationInflation, Linearization::huber_k). Iteratively reweighted least squares uses weight(e) = ρ'(e) / (2e).
 
 #include <algorithm>
 #include <cmath>

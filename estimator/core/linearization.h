@@ -21,9 +21,10 @@ struct Linearization {
   Eigen::VectorXd residual;        ///< r = z − h(x̂)
   Eigen::MatrixXd R;               ///< measurement noise covariance
   std::vector<JacobianBlock> blocks;
-  /// > 0: Huber-weighted update (docs/robustness.md, "Ranges that pass the gate"): with
-  /// e = √NIS beyond k, the innovation covariance S is taken as S·e/k (R grows by S·(e/k − 1)),
-  /// so the update moves the state by at most k innovation σ's and shrinks P less. The reported
+  /// > 0: Huber-weighted update of a scalar measurement (docs/robustness.md, "Ranges that pass the
+  /// gate"; ignored for m > 1): with e = √NIS beyond k, the innovation covariance S is taken as
+  /// S·e/k (R grows by S·(e/k − 1)), so the step is k/e of the plain one (the innovation clipped
+  /// to k√S) and P shrinks less. The reported
   /// NIS and the gate stay those of the stated R. 0: the plain update. Only while the state's
   /// share of S is small, tr(H P Hᵀ) ≤ huber_max_prior_ratio · tr(R): then a large innovation is
   /// the measurement's; beyond, it is more likely the state's own error, which the update must

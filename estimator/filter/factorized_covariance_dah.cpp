@@ -232,7 +232,7 @@ class DahUpdate {
   }
 
   /// The EKF update of Σ_PP. Scalar (the arithmetic of denseEkfUpdate with m = 1): u = Σ_PP hᵀ,
-  /// s = h u + R, NIS = r² / s, K = u / s, Joseph form P ← P − K uᵀ − u Kᵀ + K s Kᵀ (or
+  /// s = h u + R, NIS = r² / s (gated), then s scaled by huber::innovationInflation (R_eff), K = u / s, Joseph form P ← P − K uᵀ − u Kᵀ + K s Kᵀ (or
   /// P ← P − K uᵀ), symmetrized. Vector: denseEkfUpdate. Fills `res`; false when gated (or the NIS
   /// is not finite).
   bool ekfUpdate(double nis_gate, bool joseph, FactorizedCovariance::Result* res) {
@@ -257,8 +257,9 @@ class DahUpdate {
     const double r = lin_.residual(0);
     res->nis = r * (invertible_ ? r / s_ : 0.0);
     if (!std::isfinite(res->nis) || (nis_gate > 0.0 && res->nis > nis_gate)) return false;
-    s_ *= huber::innovationInflation(res->nis, lin_.huber_k, (s_ - lin_.R(0, 0)) / lin_.R(0, 0),
-                                     lin_.huber_max_prior_ratio);  // Linearization::huber_k
+    if (lin_.huber_k > 0.0)
+      s_ *= huber::innovationInflation(res->nis, lin_.huber_k, (s_ - lin_.R(0, 0)) / lin_.R(0, 0),
+                                       lin_.huber_max_prior_ratio);  // Linearization::huber_k
     Kv_.resize(n_);
     for (int i = 0; i < n_; ++i) Kv_(i) = invertible_ ? U_(i) / s_ : 0.0;
     // Element (i, j) and (j, i) in one pass over the upper triangle, then symmetrized.
@@ -318,7 +319,6 @@ class DahUpdate {
     if (!out.accepted) return false;
     res->dx = std::move(out.dx);
     K_ = std::move(out.K);
-    S_ = std::move(out.S);
     accept(res);
     return true;
   }
@@ -439,7 +439,7 @@ class DahUpdate {
   Vec U_, Kv_;  ///< scalar update: Σ_PP hᵀ and the gain
   double s_ = 0.0;
   bool invertible_ = false;
-  MatrixXd K_, S_;  ///< vector update: gain and innovation covariance
+  MatrixXd K_;  ///< vector update: gain
   PerPart<Factor> Linv_{};
   PerPart<bool> has_inv_{};
 };

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <memory>
+#include <stdexcept>
 
 #include "estimator/core/huber.h"
 #include "estimator/filter/centralized_ekf.h"
@@ -30,7 +31,20 @@ std::unique_ptr<FusionStrategy> makeStrategy(const std::string& name, double sig
   P.block<3, 3>(ImuErr::kP, ImuErr::kP) = Eigen::Matrix3d::Identity() * sigma_imu_p_m * sigma_imu_p_m;
   f->reset(1, x, P, Timestamp{});
   f->addInstance<AnchorKind>(106, AnchorState{Eigen::Vector3d(-1.772, 0.943, 3.256)}, Eigen::Matrix3d::Identity() * 1e-4);
+  f->addInstance<AnchorKind>(107, AnchorState{Eigen::Vector3d(-2.021, 1.814, 1.732)}, Eigen::Matrix3d::Identity() * 1e-2);
+  // A plain range to 107 correlates it with the IMU: a later IMU–106 update then has a participant
+  // with a partner outside it, so DAH folds its correction into the IMU's pending factor.
+  const Linearization to107 = test::imuAnchorRange(f->state(), 107, 2.9);
+  if (!f->update(to107, 0.0).accepted) throw std::logic_error("the correlating range was not fused");
   return f;
+}
+
+/// Largest difference of the IMU–anchor and anchor–anchor covariances of `a` and `b`.
+double crossDifference(const FusionStrategy& a, const FusionStrategy& b) {
+  double d = 0.0;
+  for (auto [i, j] : {std::pair<SensorId, SensorId>{1, 106}, {1, 107}, {106, 107}})
+    d = std::max(d, (a.covariance(i, j) - b.covariance(i, j)).cwiseAbs().maxCoeff());
+  return d;
 }
 
 /// S = H P Hᵀ + R of `lin` in `f` (one range: IMU position and anchor 106).
@@ -50,15 +64,19 @@ TEST(HuberUpdate, InflationIsRootNisOverKBeyondKAndOneElsewhere) {
   EXPECT_DOUBLE_EQ(huber::innovationInflation(9.0, 2.0, 1.5, 1.0), 1.0);  // the state's error dominates S
   EXPECT_DOUBLE_EQ(huber::innovationInflation(NAN, 2.0, 0.5, 1.0), 1.0);
   EXPECT_DOUBLE_EQ(huber::innovationInflation(9.0, 2.0, NAN, 1.0), 1.0);
+  EXPECT_DOUBLE_EQ(huber::innovationInflation(9.0, 2.0, INFINITY, 1.0), 1.0);  // R = 0
+  EXPECT_DOUBLE_EQ(huber::innovationInflation(4.0, 2.0, 0.5, 1.0), 1.0);  // NIS = k²: still quadratic
+  EXPECT_DOUBLE_EQ(huber::innovationInflation(16.0, 2.0, 1.0, 1.0), 2.0);  // ratio at the bound: weighted
 }
 
 TEST(HuberUpdate, EqualsThePlainUpdateWithTheInflatedNoiseInEveryStrategy) {
   for (const std::string name : {"centralized", "dp", "dah"}) {
     SCOPED_TRACE(name);
-    auto huber = makeStrategy(name, 0.05);  // H P Hᵀ ≈ 0.0026 against R = 0.01: ratio 0.26
-    auto plain = huber->clone();
-    Linearization lin = test::imuAnchorRange(huber->state(), 106, 4.0);
-    const double S = innovationVariance(*huber, lin), r = lin.residual(0);
+    auto robust = makeStrategy(name, 0.05);  // H P Hᵀ ≈ 0.0026 against R = 0.01: ratio 0.26
+    auto plain = robust->clone();
+    const Eigen::Vector3d p0 = robust->state().imu.p_IinG;
+    Linearization lin = test::imuAnchorRange(robust->state(), 106, 4.0);
+    const double S = innovationVariance(*robust, lin), r = lin.residual(0);
     ASSERT_LT((S - lin.R(0, 0)) / lin.R(0, 0), 1.0);
     const double e = std::abs(r) / std::sqrt(S);
     ASSERT_GT(e, 2.5) << "the test range must be beyond k";
@@ -66,29 +84,37 @@ TEST(HuberUpdate, EqualsThePlainUpdateWithTheInflatedNoiseInEveryStrategy) {
     lin.huber_max_prior_ratio = 1.0;
     Linearization lin_eff = test::imuAnchorRange(plain->state(), 106, 4.0);
     lin_eff.R(0, 0) += S * (e / 2.0 - 1.0);
-    const UpdateResult rh = huber->update(lin, 0.0), rp = plain->update(lin_eff, 0.0);
+    const UpdateResult rh = robust->update(lin, 0.0), rp = plain->update(lin_eff, 0.0);
     ASSERT_TRUE(rh.accepted && rp.accepted);
     EXPECT_NEAR(rh.nis, r * r / S, 1e-12) << "the NIS of the stated R";
-    EXPECT_LT(test::relativeDifference(*huber, *plain), 1e-12);
+    EXPECT_LT(test::relativeDifference(*robust, *plain), 1e-12);
+    EXPECT_LT(crossDifference(*robust, *plain), 1e-15);
     // Against the plain update with the stated R, the step δx = P Hᵀ ν / S shrinks by k / e.
     auto stated = makeStrategy(name, 0.05);
     ASSERT_TRUE(stated->update(test::imuAnchorRange(stated->state(), 106, 4.0), 0.0).accepted);
-    const Eigen::Vector3d p0(0.5, -0.2, 1.5);
-    EXPECT_NEAR((huber->state().imu.p_IinG - p0).norm() / (stated->state().imu.p_IinG - p0).norm(), 2.0 / e, 1e-9);
+    EXPECT_NEAR((robust->state().imu.p_IinG - p0).norm() / (stated->state().imu.p_IinG - p0).norm(), 2.0 / e, 1e-9);
   }
 }
 
 /// A Huber update (k = 2, bound 1) of the range to anchor 106 measured as `z(state)` with the IMU
 /// position at σ `sigma_p_m` leaves exactly the state and covariances of the plain update.
-void expectThePlainUpdate(const std::string& name, double sigma_p_m, double (*z)(const FusionStrategy&)) {
-  auto huber = makeStrategy(name, sigma_p_m);
-  auto plain = huber->clone();
-  Linearization lin = test::imuAnchorRange(huber->state(), 106, z(*huber));
+/// `beyond_k`: the range is beyond k (so only the prior-ratio bound can keep it plain), else within.
+void expectThePlainUpdate(const std::string& name, double sigma_p_m, double (*z)(const FusionStrategy&), bool beyond_k) {
+  auto robust = makeStrategy(name, sigma_p_m);
+  auto plain = robust->clone();
+  Linearization lin = test::imuAnchorRange(robust->state(), 106, z(*robust));
+  const double S = innovationVariance(*robust, lin), e = std::abs(lin.residual(0)) / std::sqrt(S);
+  const double prior_ratio = (S - lin.R(0, 0)) / lin.R(0, 0);
+  if (beyond_k)
+    ASSERT_TRUE(e > 2.0 && prior_ratio > 1.0) << "e " << e << ", H P Hᵀ / R " << prior_ratio;
+  else
+    ASSERT_TRUE(e < 2.0 && prior_ratio < 1.0) << "e " << e << ", H P Hᵀ / R " << prior_ratio;
   const Linearization lin_plain = lin;
   lin.huber_k = 2.0;
   lin.huber_max_prior_ratio = 1.0;
-  ASSERT_TRUE(huber->update(lin, 0.0).accepted && plain->update(lin_plain, 0.0).accepted);
-  EXPECT_EQ(test::relativeDifference(*huber, *plain), 0.0);
+  ASSERT_TRUE(robust->update(lin, 0.0).accepted && plain->update(lin_plain, 0.0).accepted);
+  EXPECT_EQ(test::relativeDifference(*robust, *plain), 0.0);
+  EXPECT_EQ(crossDifference(*robust, *plain), 0.0);
 }
 
 TEST(HuberUpdate, IsThePlainUpdateWithinKAboveThePriorRatioOrWhenGated) {
@@ -98,17 +124,22 @@ TEST(HuberUpdate, IsThePlainUpdateWithinKAboveThePriorRatioOrWhenGated) {
     expectThePlainUpdate(name, 0.05, [](const FusionStrategy& f) {
       const Linearization lin = test::imuAnchorRange(f.state(), 106, 0.0);
       return -lin.residual(0) + 1.5 * std::sqrt(innovationVariance(f, lin));
-    });
-    // The state's share of S above the bound (σ_p 0.3 m: H P Hᵀ / R ≈ 9).
-    expectThePlainUpdate(name, 0.3, [](const FusionStrategy&) { return 4.0; });
-    // Gated: nothing changes, and the NIS is still reported.
-    auto huber = makeStrategy(name, 0.05);
-    auto before = huber->clone();
-    Linearization lin = test::imuAnchorRange(huber->state(), 106, 4.0);
+    }, false);
+    // The state's share of S above the bound (σ_p 0.3 m: H P Hᵀ / R about 3).
+    expectThePlainUpdate(name, 0.3, [](const FusionStrategy&) { return 4.0; }, true);
+    // Gated on the stated NIS (about 66), not on the weighted one (NIS·k/e, about 16): a gate of
+    // 20 between them rejects the range and changes nothing.
+    auto robust = makeStrategy(name, 0.05);
+    auto before = robust->clone();
+    Linearization lin = test::imuAnchorRange(robust->state(), 106, 4.0);
+    const double S = innovationVariance(*robust, lin), nis = lin.residual(0) * lin.residual(0) / S;
+    ASSERT_GT(nis, 20.0);
+    ASSERT_LT(nis * 2.0 / std::sqrt(nis), 20.0);
     lin.huber_k = 2.0;
-    const UpdateResult r = huber->update(lin, 9.0);
+    const UpdateResult r = robust->update(lin, 20.0);
     EXPECT_FALSE(r.accepted);
-    EXPECT_GT(r.nis, 9.0);
-    EXPECT_EQ(test::relativeDifference(*huber, *before), 0.0);
+    EXPECT_NEAR(r.nis, nis, 1e-9);
+    EXPECT_EQ(test::relativeDifference(*robust, *before), 0.0);
+    EXPECT_EQ(crossDifference(*robust, *before), 0.0);
   }
 }
