@@ -3,7 +3,8 @@
 /// @brief Huber loss of a normalized residual e = r/σ, for the range fits of initialization
 /// (StaticInitializer, MotionAligner): quadratic within k, linear beyond, so NLOS outliers do not
 /// pick the minimum; and the weight of the filter's optional Huber range update
-/// (innovationInflation, Linearization::huber_k). Iteratively reweighted least squares uses weight(e) = ρ'(e) / (2e).
+/// (innovationInflation, Linearization::huber_k). Iteratively reweighted least squares uses
+/// weight(e) = ρ'(e) / (2e).
 
 #include <algorithm>
 #include <cmath>
@@ -28,7 +29,7 @@ inline double weight(double e) {
 
 /// Factor on the innovation covariance S of a Huber-weighted Kalman update with threshold k
 /// (Linearization::huber_k): max(1, √NIS / k); 1 when k ≤ 0 (off), NIS is not finite or the
-/// state's share of S, prior_ratio = tr(H P Hᵀ) / tr(R), exceeds max_prior_ratio.
+/// state's share of S, prior_ratio = H P Hᵀ / R, exceeds max_prior_ratio.
 inline double innovationInflation(double nis, double k, double prior_ratio, double max_prior_ratio) {
   if (!(k > 0.0) || !std::isfinite(nis) || nis <= k * k || !(prior_ratio <= max_prior_ratio)) return 1.0;
   return std::sqrt(nis) / k;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/types.h"
+#include "estimator/core/huber.h"
 
 namespace meshnav::estimator {
 
@@ -24,14 +25,20 @@ struct Linearization {
   /// > 0: Huber-weighted update of a scalar measurement (docs/robustness.md, "Ranges that pass the
   /// gate"; ignored for m > 1): with e = √NIS beyond k, the innovation covariance S is taken as
   /// S·e/k (R grows by S·(e/k − 1)), so the step is k/e of the plain one (the innovation clipped
-  /// to k√S) and P shrinks less. The reported
-  /// NIS and the gate stay those of the stated R. 0: the plain update. Only while the state's
-  /// share of S is small, tr(H P Hᵀ) ≤ huber_max_prior_ratio · tr(R): then a large innovation is
-  /// the measurement's; beyond, it is more likely the state's own error, which the update must
-  /// correct in full (a filter that has drifted would otherwise never catch up).
+  /// to k√S) and P shrinks less. The reported NIS and the gate stay those of the stated R.
+  /// 0: the plain update.
   double huber_k = 0.0;
+  /// The weighting only while the state's share of S is small, H P Hᵀ ≤ this · R: then a large
+  /// innovation is the measurement's; beyond, it is more likely the state's own error, which the
+  /// update must correct in full (a filter that has drifted would otherwise never catch up).
   double huber_max_prior_ratio = 1.0;
   int dim() const { return static_cast<int>(residual.size()); }
+  /// The factor on the innovation covariance s = H P Hᵀ + R of this (scalar) measurement after
+  /// the gate passed it at `nis` (huber::innovationInflation); 1 when off or not scalar.
+  double huberInflation(double nis, double s) const {
+    if (!(huber_k > 0.0) || dim() != 1) return 1.0;
+    return huber::innovationInflation(nis, huber_k, (s - R(0, 0)) / R(0, 0), huber_max_prior_ratio);
+  }
   /// The block of instance `id`, or nullptr.
   const JacobianBlock* find(SensorId id) const {
     for (const auto& b : blocks)

@@ -1,7 +1,5 @@
 #include "estimator/filter/dense_ekf_update.h"
 
-#include "estimator/core/huber.h"
-
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <stdexcept>
@@ -30,13 +28,9 @@ DenseUpdateOutput denseEkfUpdate(Eigen::MatrixXd& P, const StateLayout& layout, 
   DenseUpdateOutput out;
   out.nis = lin.residual.dot(ldlt.solve(lin.residual));
   if (!std::isfinite(out.nis) || (nis_gate > 0.0 && out.nis > nis_gate)) return out;
-  if (m == 1 && lin.huber_k > 0.0) {  // Linearization::huber_k (scalar measurements only)
-    const double prior_ratio = (S(0, 0) - lin.R(0, 0)) / lin.R(0, 0);
-    if (const double inflate = huber::innovationInflation(out.nis, lin.huber_k, prior_ratio, lin.huber_max_prior_ratio);
-        inflate > 1.0) {
-      S *= inflate;  // R_eff = R + S (inflate − 1): the Joseph form below uses S = H P Hᵀ + R_eff
-      ldlt.compute(S);
-    }
+  if (const double inflate = lin.huberInflation(out.nis, S(0, 0)); inflate > 1.0) {
+    S *= inflate;  // R_eff = R + S (inflate − 1): the Joseph form below uses S = H P Hᵀ + R_eff
+    ldlt.compute(S);
   }
   out.K = ldlt.solve(U.transpose()).transpose();  // n × m
   out.dx = out.K * lin.residual;

@@ -17,7 +17,6 @@
 #include <string>
 #include <type_traits>
 
-#include "estimator/core/huber.h"
 #include "estimator/core/imu_state.h"
 #include "estimator/filter/dense_ekf_update.h"
 #include "estimator/filter/factorized_covariance_internals.h"
@@ -232,8 +231,8 @@ class DahUpdate {
   }
 
   /// The EKF update of Σ_PP. Scalar (the arithmetic of denseEkfUpdate with m = 1): u = Σ_PP hᵀ,
-  /// s = h u + R, NIS = r² / s (gated), then s scaled by huber::innovationInflation (R_eff), K = u / s, Joseph form P ← P − K uᵀ − u Kᵀ + K s Kᵀ (or
-  /// P ← P − K uᵀ), symmetrized. Vector: denseEkfUpdate. Fills `res`; false when gated (or the NIS
+  /// s = h u + R, NIS = r² / s (gated), then s scaled by Linearization::huberInflation (R_eff),
+  /// K = u / s, Joseph form P ← P − K uᵀ − u Kᵀ + K s Kᵀ (or P ← P − K uᵀ), symmetrized. Vector: denseEkfUpdate. Fills `res`; false when gated (or the NIS
   /// is not finite).
   bool ekfUpdate(double nis_gate, bool joseph, FactorizedCovariance::Result* res) {
     if constexpr (!kFixed) {
@@ -257,9 +256,7 @@ class DahUpdate {
     const double r = lin_.residual(0);
     res->nis = r * (invertible_ ? r / s_ : 0.0);
     if (!std::isfinite(res->nis) || (nis_gate > 0.0 && res->nis > nis_gate)) return false;
-    if (lin_.huber_k > 0.0)
-      s_ *= huber::innovationInflation(res->nis, lin_.huber_k, (s_ - lin_.R(0, 0)) / lin_.R(0, 0),
-                                       lin_.huber_max_prior_ratio);  // Linearization::huber_k
+    s_ *= lin_.huberInflation(res->nis, s_);  // Huber weight (Linearization::huber_k), after the gate
     Kv_.resize(n_);
     for (int i = 0; i < n_; ++i) Kv_(i) = invertible_ ? U_(i) / s_ : 0.0;
     // Element (i, j) and (j, i) in one pass over the upper triangle, then symmetrized.
