@@ -125,8 +125,8 @@ def read_errors(path):
     return rows
 
 
-def read_recoveries(path):
-    """The `recovery` counter of status.txt (counters: block), 0 when absent."""
+def read_counter(path, name):
+    """Counter `name` of status.txt (counters: block), 0 when absent or the file is missing."""
     if not os.path.exists(path):
         return 0
     in_counters = False
@@ -137,9 +137,14 @@ def read_recoveries(path):
                 continue
             if in_counters and not line.startswith("  "):
                 in_counters = False
-            if in_counters and line.strip().startswith("recovery:"):
+            if in_counters and line.strip().startswith(name + ":"):
                 return int(float(line.split(":", 1)[1]))
     return 0
+
+
+def read_recoveries(path):
+    """The `recovery` counter of status.txt, 0 when absent."""
+    return read_counter(path, "recovery")
 
 
 def anchor_metrics(m):
@@ -170,6 +175,9 @@ def metrics_of(metrics_json, errors_csv, status_txt):
         "pos_anees": pose["position"].get("anees", float("nan")),
         "diverged": not (max_late <= DIVERGENCE_M),
         "recoveries": read_recoveries(status_txt),
+        # The estimator's start-up warning (estimator/uwb/anchor_layout.h): the known anchors lie
+        # nearly on one line, so the position across the vertical plane through it is weakly fixed.
+        "collinear": read_counter(status_txt, "known_anchors_nearly_collinear") > 0,
         "errors": late,
         **anchor_metrics(m),
     }
@@ -245,7 +253,8 @@ def fmt(v, digits):
 
 
 COLUMNS = ["name", "trajectory", "hall_m", "layout", "tags", "known", "unknown", "sigma_m", "outliers", "drop",
-           "imu", "pos_rmse_m", "max_err_10s_m", "ori_rmse_deg", "pos_anees", "diverged", "recoveries", "status"]
+           "imu", "pos_rmse_m", "max_err_10s_m", "ori_rmse_deg", "pos_anees", "diverged", "recoveries",
+           "collinear", "status"]
 # With --calibration auto, before "status": anchors calibrated of those unknown, the largest final
 # anchor error and final anchor NEES of the run.
 ANCHOR_COLUMNS = ["anchors", "anchor_err_max_m", "anchor_nees_max"]
@@ -279,6 +288,7 @@ def base_row_of(r):
             fmt(r["pos_rmse_m"], 3) if ok else "-", fmt(r["max_err_after_10s_m"], 3) if ok else "-",
             fmt(r["ori_rmse_deg"], 2) if ok else "-", fmt(r["pos_anees"], 1) if ok else "-",
             ("yes" if r["diverged"] else "no") if ok else "-", str(r["recoveries"]) if ok else "-",
+            ("yes" if r["collinear"] else "no") if ok else "-",
             "ok" if ok else ("REFUSED: " if r.get("refused") else "FAILED: ") + r["error"]]
 
 
@@ -456,6 +466,10 @@ def main(argv):
           "initialize (pose not determined by the data); wrote %s%s"
           % (len(results), n_div, SKIP_S, DIVERGENCE_M, n_failed, n_refused, os.path.join(a.out, "robustness.csv"),
              " and " + png if wrote_png else ""))
+    if n_div:
+        print("%d of the %d diverged runs have nearly collinear known anchors (column collinear; "
+              "docs/robustness.md, \"Nearly collinear known anchors\")"
+              % (sum(r["ok"] and r["diverged"] and r["collinear"] for r in results), n_div))
     n_bad_anchor = sum(is_bad_anchor_run(r) for r in results) if a.calibration == "auto" else 0
     return 1 if (n_div or n_failed or n_bad_anchor) else 0
 

@@ -17,6 +17,7 @@
 
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/node/node_internals.h"
+#include "estimator/uwb/anchor_layout.h"
 
 namespace meshnav::estimator {
 
@@ -115,6 +116,10 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
   if (setup_.flight_volume && options_.flight_volume.enabled)
     plane_mirror_ = AnchorPlaneMirror::of(setup_.abs_anchor_positions, *setup_.flight_volume);
   baro_aligns_ = baroAligns(options_, setup_);
+  if (const auto layout = AnchorLayout::of(setup_.abs_anchor_positions); layout && layout->nearlyCollinear()) {
+    spdlog::warn("estimator: {}", layout->describe());
+    diag_.count("known_anchors_nearly_collinear");
+  }
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
   skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
   rerun_enabled_ = options_.refine.rerun_on_anchor_join && (options_.strategy != "dah" || options_.refine.rerun_with_dah);

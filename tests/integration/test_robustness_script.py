@@ -80,6 +80,11 @@ class MetricsTest(unittest.TestCase):
             self.assertFalse(r["diverged"])
             self.assertAlmostEqual(r["max_err_after_10s_m"], 0.9)
             self.assertEqual(r["recoveries"], 2)
+            self.assertFalse(r["collinear"])
+            line = self.write(d, "line.txt", "counters:\n  known_anchors_nearly_collinear: 1\n  recovery: 1\n")
+            self.assertTrue(robustness.metrics_of(m, early_big, line)["collinear"])
+            self.assertEqual(robustness.read_counter(line, "recovery"), 1)
+            self.assertEqual(robustness.read_counter(line, "gated_range"), 0)
             self.assertEqual(r["pos_rmse_m"], 0.5)
             late_big = self.write(d, "e2.csv", "t,ep_norm_m\n5.0,0.1\n15.0,1.01\n")
             self.assertTrue(robustness.metrics_of(m, late_big, os.path.join(d, "missing.txt"))["diverged"])
@@ -113,7 +118,7 @@ class AnchorMetricsTest(unittest.TestCase):
     def test_a_bad_anchor_fails_the_run_and_shows_in_the_columns(self):
         sc = {"name": "r", "unknown": 3}
         good = dict(ok=True, scenario=sc, pos_rmse_m=0.1, max_err_after_10s_m=0.2, ori_rmse_deg=1.0, pos_anees=3.0,
-                    diverged=False, recoveries=0, refused=False, error="",
+                    diverged=False, recoveries=0, collinear=True, refused=False, error="",
                     **robustness.anchor_metrics(self.eval_json([0.05, 0.1])))
         bad = dict(good, **robustness.anchor_metrics(self.eval_json([0.05, 0.62])))
         self.assertFalse(robustness.is_bad_anchor_run(good))
@@ -123,6 +128,7 @@ class AnchorMetricsTest(unittest.TestCase):
         self.assertEqual(len(row), len(cols))
         self.assertEqual(row[cols.index("anchors")], "2/3")
         self.assertEqual(row[cols.index("anchor_err_max_m")], "0.620")
+        self.assertEqual(row[cols.index("collinear")], "yes")
         self.assertEqual(robustness.row_of(bad, "off"), robustness.base_row_of(bad))  # the table without anchors
         self.assertIn("1 runs with a bad anchor", robustness.anchor_summary_lines([good, bad])[0])
 
