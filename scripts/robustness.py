@@ -5,8 +5,10 @@ Every scenario is simulated with meshnav_sim (docs/scenarios.md), flown with
 `meshnav_run --no-calibration` (known anchors only; with --calibration auto, the unknown anchors
 are calibrated fly-by and fused, as `meshnav_run` does without a mission) and evaluated with
 `meshnav_eval --json`. Per run: position RMSE [m], max position error after the first 10 s [m],
-orientation RMSE [deg], position ANEES, diverged (max error after 10 s > 1 m) and recoveries (the
-`recovery` counter of the run's status.txt, 0 when absent); with --calibration auto also the
+orientation RMSE [deg], position ANEES, diverged (max error after 10 s > 1 m), recoveries (the
+`recovery` counter of the run's status.txt, 0 when absent) and collinear (the estimator warned that
+the known anchors' horizontal positions lie nearly on one line: a mirror image across the vertical
+plane through it fits the ranges alike); with --calibration auto also the
 anchors calibrated of those unknown, the largest final anchor error [m] and final anchor NEES
 (3 dof), and a bad anchor (final error > 0.5 m) fails the sweep like a divergence. meshnav_run gets --allow-lost, so a run that ends lost is
 still scored; a run that never initialized is REFUSED with the estimator's reason (the designed
@@ -414,6 +416,16 @@ def summary_lines(results):
             % (percentile(anees, 50), percentile(ori2, 50), len(ori2))]
 
 
+def collinear_lines(results):
+    """How many of the diverged runs had known anchors nearly on one line (none when nothing diverged)."""
+    diverged = [r for r in results if r["ok"] and r["diverged"]]
+    if not diverged:
+        return []
+    return ["%d of the %d diverged runs have nearly collinear known anchors (column collinear; "
+            "docs/robustness.md, \"Nearly collinear known anchors\")" % (sum(r["collinear"] for r in diverged),
+                                                                         len(diverged))]
+
+
 def main(argv):
     a = parse_args(argv)
     try:
@@ -466,10 +478,8 @@ def main(argv):
           "initialize (pose not determined by the data); wrote %s%s"
           % (len(results), n_div, SKIP_S, DIVERGENCE_M, n_failed, n_refused, os.path.join(a.out, "robustness.csv"),
              " and " + png if wrote_png else ""))
-    if n_div:
-        print("%d of the %d diverged runs have nearly collinear known anchors (column collinear; "
-              "docs/robustness.md, \"Nearly collinear known anchors\")"
-              % (sum(r["ok"] and r["diverged"] and r["collinear"] for r in results), n_div))
+    for line in collinear_lines(results):
+        print(line)
     n_bad_anchor = sum(is_bad_anchor_run(r) for r in results) if a.calibration == "auto" else 0
     return 1 if (n_div or n_failed or n_bad_anchor) else 0
 

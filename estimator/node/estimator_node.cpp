@@ -99,6 +99,11 @@ MotionAlignerOptions alignerOptionsFor(const EstimatorOptions& o, const SystemSe
 }  // namespace
 
 EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup& setup, EstimatorSinks sinks)
+    : EstimatorNode(options, setup, std::move(sinks), Quiet{}) {
+  reportSetupGeometry();
+}
+
+EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup& setup, EstimatorSinks sinks, Quiet)
     : options_(withSetup(options, setup)),
       setup_(setup),
       sinks_(std::move(sinks)),
@@ -116,10 +121,6 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
   if (setup_.flight_volume && options_.flight_volume.enabled)
     plane_mirror_ = AnchorPlaneMirror::of(setup_.abs_anchor_positions, *setup_.flight_volume);
   baro_aligns_ = baroAligns(options_, setup_);
-  if (const auto layout = AnchorLayout::of(setup_.abs_anchor_positions); layout && layout->nearlyCollinear()) {
-    spdlog::warn("estimator: {}", layout->describe());
-    diag_.count("known_anchors_nearly_collinear");
-  }
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
   skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
   rerun_enabled_ = options_.refine.rerun_on_anchor_join && (options_.strategy != "dah" || options_.refine.rerun_with_dah);
@@ -127,6 +128,14 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
   if (options_.baro.gate_probability > 0) baro_gate_ = chi2Quantile(1, options_.baro.gate_probability);
   if (options_.height.gate_probability > 0) height_gate_ = chi2Quantile(1, options_.height.gate_probability);
   resetAll();
+}
+
+void EstimatorNode::reportSetupGeometry() {
+  const auto layout = AnchorLayout::of(setup_.abs_anchor_positions);
+  if (!layout || !layout->nearlyCollinear()) return;
+  // Anchors in a wall of the flight volume: the mirror image behind the wall is told apart.
+  if (plane_mirror_ && std::abs(plane_mirror_->normal().dot(layout->acrossLine_G())) > 0.9) return;
+  diag_.report("known_anchors_nearly_collinear", "estimator: " + layout->describe());
 }
 
 void EstimatorNode::resetAll() {

@@ -91,7 +91,8 @@ struct EstimatorSinks {
 
 class EstimatorNode {
  public:
-  /// Throws std::invalid_argument for invalid options or a strategy not implemented yet.
+  /// Throws std::invalid_argument for invalid options or a strategy not implemented yet. Reports
+  /// what the setup leaves weak (reportSetupGeometry), once.
   EstimatorNode(const EstimatorOptions& options, const SystemSetup& setup, EstimatorSinks sinks = {});
   ~EstimatorNode();
   EstimatorNode(const EstimatorNode&) = delete;
@@ -151,6 +152,14 @@ class EstimatorNode {
   void injectPoseError(const Eigen::Vector3d& dp_m, double dyaw_rad);
 
  private:
+  /// The node without the start-up report: a re-run's replay node (launchRerun), whose setup the
+  /// live node has reported already.
+  struct Quiet {};
+  EstimatorNode(const EstimatorOptions& options, const SystemSetup& setup, EstimatorSinks sinks, Quiet);
+  /// Known anchors whose horizontal positions lie nearly on one line (AnchorLayout): a warning and
+  /// the counter `known_anchors_nearly_collinear`, unless they lie in a wall of the flight volume
+  /// (plane_mirror_ then tells the two sides apart).
+  void reportSetupGeometry();
   /// Everything a rewind restores.
   struct Snapshot {
     std::unique_ptr<FusionStrategy> filter;

@@ -30,7 +30,7 @@ void EstimatorNode::copyReplayContext(const EstimatorNode& live) {
 void EstimatorNode::launchRerun(RerunJob job, std::chrono::steady_clock::time_point t_job) {
   ScopedStepTimer timer(timings_, "rerun_start");  // the worker's node, on the node's thread
   // options_ already hold the setup's figures; applying them again changes nothing.
-  auto replay = std::make_unique<EstimatorNode>(options_, setup_);
+  std::unique_ptr<EstimatorNode> replay(new EstimatorNode(options_, setup_, {}, Quiet{}));
   replay->copyReplayContext(*this);
   auto run = std::make_unique<RunningRerun>();
   run->end_key = job.keys.back();

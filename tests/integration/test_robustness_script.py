@@ -132,6 +132,15 @@ class AnchorMetricsTest(unittest.TestCase):
         self.assertEqual(robustness.row_of(bad, "off"), robustness.base_row_of(bad))  # the table without anchors
         self.assertIn("1 runs with a bad anchor", robustness.anchor_summary_lines([good, bad])[0])
 
+    def test_the_diverged_runs_with_collinear_anchors_are_counted(self):
+        sc = {"name": "r"}
+        run = dict(ok=True, scenario=sc, diverged=True, collinear=True)
+        runs = [run, dict(run, collinear=False), dict(run, diverged=False), dict(run, ok=False)]
+        self.assertEqual(robustness.collinear_lines(runs),
+                         ['1 of the 2 diverged runs have nearly collinear known anchors (column collinear; '
+                          'docs/robustness.md, "Nearly collinear known anchors")'])
+        self.assertEqual(robustness.collinear_lines([dict(run, diverged=False)]), [])
+
 
 class UsageTest(unittest.TestCase):
     def test_usage_errors_and_missing_binaries(self):
