@@ -22,6 +22,13 @@ struct RefusedAnchor {
   std::string reason;  ///< human-readable
 };
 
+/// What is wrong with the values of `a` (empty: nothing): an id ≤ 0, a position or covariance not
+/// finite, cov_p_m2 not positive definite, a pair bias with β ≤ 0, σ_γ < 0 or a value not finite,
+/// joint covariance sizes that do not fit the biases, or a joint covariance of the position and
+/// the γ with σ_γ > 0 (the candidates for states) that is not positive definite. The one check
+/// of an ANCHOR_INIT and of ESTIMATOR_CMD's anchor, wherever they come from.
+std::string anchorInitValueError(const AnchorInit& a);
+
 /// Writes `inits` (PairBias a = reference device, b = the anchor) and `refused`. Throws
 /// std::runtime_error naming the file on I/O failure.
 void writeAnchorInitsYaml(const std::vector<AnchorInit>& inits, const std::string& path,

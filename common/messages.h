@@ -48,6 +48,13 @@ struct EstimatorCommand {
   Action action = Action::AddAnchor;
   SensorId id = 0;        ///< instance concerned
   AnchorInit anchor;      ///< for AddAnchor: position, covariance, bias dictionary
+  /// The anchor AddAnchor adds: `anchor` with the command's id (when set) and time.
+  AnchorInit anchorToAdd() const {
+    AnchorInit a = anchor;
+    a.id = id ? id : a.id;
+    a.t = t;
+    return a;
+  }
 };
 
 /// CALIB_CMD: what the calibrator should do.

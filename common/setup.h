@@ -72,6 +72,8 @@ struct SystemSetup {
 
   bool isTag(SensorId id) const { return rel_tag_positions.count(id) > 0; }
   bool isKnownAnchor(SensorId id) const { return abs_anchor_positions.count(id) > 0; }
+  /// The id of an instance that is no UWB device (IMU, baro, height): never an anchor's.
+  bool isSensorInstanceId(SensorId id) const { return id == imu_id || id == baro_id || id == height_id; }
   /// Pair bias for (a, b) in either order, if given.
   std::optional<PairBias> findPairBias(SensorId a, SensorId b) const;
 };

@@ -72,7 +72,7 @@ CalibratorNode::CalibratorNode(const CalibratorOptions& options, const SystemSet
 // --------------------------------------------------------------------------------------------
 
 bool CalibratorNode::isUnknownAnchor(SensorId id, UwbType type) const {
-  return id > 0 && !setup_.isTag(id) && !setup_.isKnownAnchor(id) && id != setup_.imu_id && id != setup_.baro_id &&
+  return id > 0 && !setup_.isTag(id) && !setup_.isKnownAnchor(id) && !setup_.isSensorInstanceId(id) &&
          type == UwbType::Anchor;
 }
 
@@ -109,8 +109,11 @@ void CalibratorNode::onRange(const RangeSample& r) {
   for (const auto& [id, type] : {std::make_pair(r.id_initiator, r.type_initiator),
                                  std::make_pair(r.id_responder, r.type_responder)}) {
     if (!setup_.isTag(id) && !setup_.isKnownAnchor(id) && !isUnknownAnchor(id, type)) {
-      diag_.report("unknown_device", describe(r) + ": device " + std::to_string(id) + " (type '" +
-                                         static_cast<char>(type) + "') is neither a tag of the setup nor an anchor");
+      diag_.report("unknown_device",
+                   describe(r) + ": device " + std::to_string(id) + " (type '" + static_cast<char>(type) + "') " +
+                       (setup_.isSensorInstanceId(id)
+                            ? "has the id of the IMU, baro or height instance (imu_id, baro_id, height_id in setup.yaml)"
+                            : "is neither a tag of the setup nor an anchor"));
       return;
     }
   }
@@ -229,7 +232,7 @@ void CalibratorNode::onCommand(const CalibCommand& c) {
   if (isRepeat(c)) return;
   std::vector<SensorId> ids;
   for (SensorId id : c.anchors) {
-    if (id <= 0 || setup_.isTag(id) || setup_.isKnownAnchor(id) || id == setup_.imu_id || id == setup_.baro_id) {
+    if (id <= 0 || setup_.isTag(id) || setup_.isKnownAnchor(id) || setup_.isSensorInstanceId(id)) {
       diag_.report("bad_command", "command names " + std::to_string(id) +
                                       ", which is not an anchor of unknown position; ignored for it");
       continue;

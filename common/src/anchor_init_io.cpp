@@ -2,6 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Cholesky>
+
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -9,6 +11,32 @@
 #include <stdexcept>
 
 namespace meshnav {
+
+std::string anchorInitValueError(const AnchorInit& a) {
+  if (a.id <= 0) return "anchor id " + std::to_string(a.id) + " is not > 0";
+  if (!a.p_AinG.allFinite() || !a.cov_p_m2.allFinite() ||
+      Eigen::LLT<Eigen::Matrix3d>(0.5 * (a.cov_p_m2 + a.cov_p_m2.transpose())).info() != Eigen::Success)
+    return "anchor " + std::to_string(a.id) + " with invalid position or covariance";
+  for (const auto& b : a.biases)
+    if (!std::isfinite(b.gamma_m) || !std::isfinite(b.beta) || b.beta <= 0.0 || !std::isfinite(b.sigma_m) ||
+        !std::isfinite(b.sigma_gamma_m) || b.sigma_gamma_m < 0.0)
+      return "anchor " + std::to_string(a.id) + " with invalid pair bias";
+  if (const std::string e = a.jointCovarianceError(); !e.empty()) return "anchor " + std::to_string(a.id) + ": " + e;
+  if (!a.hasJointCovariance()) return "";
+  // Positive definite where it is used: the position and the γ with σ_γ > 0 (the candidates for
+  // states; a pair with σ_γ = 0 is an exact dictionary value with a zero row).
+  std::vector<Eigen::Index> rows = {0, 1, 2};
+  for (size_t i = 0; i < a.biases.size(); ++i)
+    if (a.biases[i].sigma_gamma_m > 0.0) rows.push_back(3 + static_cast<Eigen::Index>(i));
+  const Eigen::MatrixXd J = a.jointCovariance();
+  Eigen::MatrixXd used(rows.size(), rows.size());
+  for (size_t r = 0; r < rows.size(); ++r)
+    for (size_t c = 0; c < rows.size(); ++c)
+      used(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = J(rows[r], rows[c]);
+  if (Eigen::LLT<Eigen::MatrixXd>(used).info() != Eigen::Success)
+    return "anchor " + std::to_string(a.id) + ": joint covariance of position and gamma not positive definite";
+  return "";
+}
 
 namespace {
 

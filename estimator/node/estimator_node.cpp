@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "common/anchor_init_io.h"
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/node/node_internals.h"
 #include "estimator/uwb/anchor_layout.h"
@@ -199,30 +200,11 @@ bool EstimatorNode::validate(const EstimatorInput& in) {
       bad = where("RANGE", t) + ": invalid ids " + std::to_string(s->id_initiator) + ", " +
             std::to_string(s->id_responder);
   } else if (const auto* a = std::get_if<AnchorInit>(&in)) {
-    if (a->id <= 0 || !a->p_AinG.allFinite() || !a->cov_p_m2.allFinite() ||
-        Eigen::LLT<Eigen::Matrix3d>(0.5 * (a->cov_p_m2 + a->cov_p_m2.transpose())).info() != Eigen::Success)
-      bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) + " with invalid position or covariance";
-    for (const auto& b : a->biases)
-      if (!std::isfinite(b.gamma_m) || !std::isfinite(b.beta) || b.beta <= 0.0 || !std::isfinite(b.sigma_m) ||
-          !std::isfinite(b.sigma_gamma_m) || b.sigma_gamma_m < 0.0)
-        bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) + " with invalid pair bias";
-    if (const std::string e = a->jointCovarianceError(); !e.empty())
-      bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) + ": " + e;
-    else if (a->hasJointCovariance() && bad.empty()) {
-      // Positive definite where it is used: the position and the γ with σ_γ > 0 (the candidates
-      // for states; a pair with σ_γ = 0 is an exact dictionary value with a zero row).
-      std::vector<Eigen::Index> rows = {0, 1, 2};
-      for (size_t i = 0; i < a->biases.size(); ++i)
-        if (a->biases[i].sigma_gamma_m > 0.0) rows.push_back(3 + static_cast<Eigen::Index>(i));
-      const Eigen::MatrixXd J = a->jointCovariance();
-      Eigen::MatrixXd used(rows.size(), rows.size());
-      for (size_t r = 0; r < rows.size(); ++r)
-        for (size_t c = 0; c < rows.size(); ++c)
-          used(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = J(rows[r], rows[c]);
-      if (Eigen::LLT<Eigen::MatrixXd>(used).info() != Eigen::Success)
-        bad = where("ANCHOR_INIT", t) + ": anchor " + std::to_string(a->id) +
-              ": joint covariance of position and gamma not positive definite";
-    }
+    if (const std::string e = anchorInitValueError(*a); !e.empty()) bad = where("ANCHOR_INIT", t) + ": " + e;
+  } else if (const auto* c = std::get_if<EstimatorCommand>(&in);
+             c && c->action == EstimatorCommand::Action::AddAnchor) {
+    if (const std::string e = anchorInitValueError(c->anchorToAdd()); !e.empty())
+      bad = where("ESTIMATOR_CMD", t) + ": " + e;
   }
   if (!bad.empty()) {
     diag_.report("bad_input", bad);
@@ -250,7 +232,10 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   const Timestamp t = inputTime(in);
   feedAligner(in);
   if (!initialized()) {
-    newest_ = newest_ ? std::max(*newest_, t) : t;
+    // Only measurements drive the clock: a command stamped far ahead before the first measurement
+    // would otherwise leave every later measurement too old.
+    if (!std::holds_alternative<AnchorInit>(in) && !std::holds_alternative<EstimatorCommand>(in))
+      newest_ = newest_ ? std::max(*newest_, t) : t;
     if (const auto* s = std::get_if<ImuSample>(&in); s && resume_ && tryResume(*s)) {
       publishPeriodic();
       return;
@@ -382,13 +367,9 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
 
 void EstimatorNode::applyCommand(const EstimatorCommand& c, bool first) {
   switch (c.action) {
-    case EstimatorCommand::Action::AddAnchor: {
-      AnchorInit a = c.anchor;
-      a.id = c.id ? c.id : a.id;
-      a.t = c.t;
-      applyAnchorInit(a, first);
+    case EstimatorCommand::Action::AddAnchor:
+      applyAnchorInit(c.anchorToAdd(), first);
       break;
-    }
     case EstimatorCommand::Action::RemoveInstance: {
       if (c.id == setup_.imu_id || c.id == setup_.baro_id) {
         event(first, "bad_command", "ESTIMATOR_CMD: cannot remove the IMU or baro instance " + std::to_string(c.id));

@@ -29,7 +29,7 @@ void EstimatorNode::feedInitializer(const EstimatorInput& in) {
         if constexpr (std::is_same_v<T, FlightStateSample>) initializer_->addFlightState(m);
         if constexpr (std::is_same_v<T, AnchorInit>) pending_anchor_inits_.push_back(m);
         if constexpr (std::is_same_v<T, EstimatorCommand>)
-          if (m.action == EstimatorCommand::Action::AddAnchor) pending_anchor_inits_.push_back(m.anchor);
+          if (m.action == EstimatorCommand::Action::AddAnchor) pending_anchor_inits_.push_back(m.anchorToAdd());
       },
       in);
   if (!std::holds_alternative<ImuSample>(in)) return;

@@ -138,8 +138,10 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
 
 void EstimatorNode::applyAnchorInit(const AnchorInit& a, bool first) {
   auto net = std::make_shared<UwbNetwork>(*cur_.network);
-  if (net->isTag(a.id)) {
-    event(first, "bad_command", where("ANCHOR_INIT", a.t) + ": id " + std::to_string(a.id) + " is a tag");
+  if (net->isTag(a.id) || setup_.isSensorInstanceId(a.id)) {
+    event(first, "bad_command",
+          where("ANCHOR_INIT", a.t) + ": id " + std::to_string(a.id) +
+              (net->isTag(a.id) ? " is a tag" : " is the IMU, baro or height instance's (imu_id, baro_id, height_id)"));
     return;
   }
   net->removeDevice(a.id);  // an exactly known anchor becomes an estimated one

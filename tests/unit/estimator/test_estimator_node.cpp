@@ -278,3 +278,50 @@ TEST(EstimatorNode, HeightsAddABiasInstanceThatConvergesAndBadHeightsAreCounted)
   for (const auto& is : node.status().instances) listed |= is.id == ds.setup.height_id && is.type == "height";
   EXPECT_TRUE(listed);
 }
+
+TEST(EstimatorNode, AnAnchorWithASensorInstanceIdOrBadValuesIsRefusedAlsoByCommand) {
+  // Found by an audit: ANCHOR_INIT 2 replaced the baro bias state (every later BARO sample threw),
+  // ANCHOR_INIT 1 left the IMU half replaced, and ESTIMATOR_CMD's anchor skipped every value check
+  // once the filter ran. Each is now refused and counted, and the estimate stays as without it.
+  synthetic::SyntheticOptions o;
+  o.duration_s = 8.0;
+  o.noise = true;
+  const Dataset ds = synthetic::makeSyntheticDataset(o);
+  const auto inputs = mergeInTimeOrder(ds);
+  EstimatorNode clean(test::testOptions(), ds.setup), dirty(test::testOptions(), ds.setup);
+  bool injected = false;
+  for (const auto& in : inputs) {
+    clean.onInput(in);
+    dirty.onInput(in);
+    if (injected || !dirty.initialized() || inputTime(in).sec() < 5.0) continue;
+    injected = true;
+    AnchorInit a;
+    a.t = inputTime(in);
+    a.p_AinG = {1.0, 2.0, 3.0};
+    a.cov_p_m2 = 0.01 * Eigen::Matrix3d::Identity();
+    for (SensorId id : {ds.setup.imu_id, ds.setup.baro_id, ds.setup.height_id}) {
+      a.id = id;
+      dirty.onAnchorInit(a);  // bad_command: a sensor instance's id
+    }
+    EstimatorCommand c;
+    c.t = a.t;
+    c.action = EstimatorCommand::Action::AddAnchor;
+    c.id = 130;
+    c.anchor = a;
+    c.anchor.cov_p_m2 = -0.01 * Eigen::Matrix3d::Identity();  // not positive definite
+    dirty.onCommand(c);
+    c.anchor = a;
+    c.anchor.biases.push_back(PairBias{100, 130, 0.0, -1.0, 0.1, 0.0, 0.0});  // β ≤ 0
+    dirty.onCommand(c);
+    c.anchor = a;
+    c.id = 0;
+    c.anchor.id = -4;  // no id anywhere
+    dirty.onCommand(c);
+  }
+  ASSERT_TRUE(injected);
+  EXPECT_EQ(dirty.diagnostics().get("bad_command"), 3);
+  EXPECT_EQ(dirty.diagnostics().get("bad_input"), 3);
+  EXPECT_EQ(dirty.diagnostics().get("BARO:handler_error"), 0);
+  EXPECT_EQ(dirty.filter()->layout().find(130), nullptr);
+  EXPECT_EQ(test::stateDifference(*clean.filter(), *dirty.filter()), 0.0);
+}

@@ -149,3 +149,32 @@ TEST(EstimatorTimeGuard, FarStampedCommandsApplyNow) {
   EXPECT_EQ(counter(*node, "rejected_too_old"), 0);
   EXPECT_EQ(node->status().t, inputTime(inputs.back()));
 }
+
+TEST(EstimatorTimeGuard, ACommandStampedAheadBeforeAnyMeasurementDoesNotMoveTheClock) {
+  // Found by an audit: before the first measurement the node took the command's stamp (+1 h) as
+  // its newest time, and every later measurement was "rejected_too_old" for good.
+  const Dataset ds = synthetic::makeSyntheticDataset(scenario());
+  const auto inputs = mergeInTimeOrder(ds);
+  const auto clean = run(ds, inputs, [](EstimatorNode&, double) {});
+  ASSERT_TRUE(clean->initialized());
+  bool injected = false;
+  const auto node = run(ds, inputs, [&](EstimatorNode& n, double t) {
+    if (injected) return;
+    injected = true;
+    AnchorInit a;
+    a.id = 120;
+    a.t = Timestamp::fromSec(t + 3600.0);
+    a.p_AinG = {1.0, 2.0, 3.0};
+    a.cov_p_m2 = 0.01 * Eigen::Matrix3d::Identity();
+    n.onAnchorInit(a);
+    EstimatorCommand c;
+    c.t = Timestamp::fromSec(t + 7200.0);
+    c.action = EstimatorCommand::Action::RemoveInstance;
+    c.id = 121;
+    n.onCommand(c);
+  });
+  ASSERT_TRUE(node->initialized());
+  EXPECT_EQ(counter(*node, "rejected_too_old"), 0);
+  EXPECT_EQ(node->status().t, inputTime(inputs.back()));
+  EXPECT_TRUE(node->filter()->layout().find(120) != nullptr);  // applied at initialization
+}
