@@ -17,6 +17,8 @@ constexpr double kMaxPressure_pa = 200000.0;
 /// UWB range interval [m]: biased short ranges can be slightly negative; beyond 500 m none is real.
 constexpr double kMinRange_m = -0.5;
 constexpr double kMaxRange_m = 500.0;
+/// A range's stated noise variance [m²]: a σ beyond the longest range says nothing.
+constexpr double kMaxRangeVariance_m2 = kMaxRange_m * kMaxRange_m;
 /// Laser height above the floor [m].
 constexpr double kMaxHeight_m = 100.0;
 

@@ -167,9 +167,29 @@ std::vector<RangeSample> readRangesCsv(const std::string& path, Diagnostics& dia
     s.type_initiator = *ty1;
     s.type_responder = *ty2;
     s.range_m = *z;
-    s.range_corr_m = r.has("range_corr") ? r.number("range_corr").value_or(0.0) : 0.0;
-    const double R = r.has("R") ? r.number("R").value_or(0.0) : 0.0;
-    s.R_m2 = R > 0.0 ? R : 0.0;
+    // Optional columns: absent or empty means "not given" (range_corr: the raw range; R: 0, the
+    // setup's σ); anything else must be a plausible number, or the row is bad input.
+    s.range_corr_m = *z;
+    if (r.has("range_corr") && !r.text("range_corr").empty()) {
+      const auto zc = r.number("range_corr");
+      if (!zc || *zc < limits.min_m || *zc > limits.max_m) {
+        diag.report(key + ":bad_range_corr", r.where() + ": range_corr '" + r.text("range_corr") +
+                                                 "' is not a number in [" + std::to_string(limits.min_m) + ", " +
+                                                 std::to_string(limits.max_m) + "] m; row skipped");
+        return std::nullopt;
+      }
+      s.range_corr_m = *zc;
+    }
+    s.R_m2 = 0.0;
+    if (r.has("R") && !r.text("R").empty()) {
+      const auto R = r.number("R");
+      if (!R || *R < 0.0 || *R > plausible::kMaxRangeVariance_m2) {
+        diag.report(key + ":bad_R", r.where() + ": R '" + r.text("R") + "' is not a variance in [0, " +
+                                        std::to_string(plausible::kMaxRangeVariance_m2) + "] m^2; row skipped");
+        return std::nullopt;
+      }
+      s.R_m2 = *R;
+    }
     if (r.has("LOS")) {
       const std::string l = r.text("LOS");
       s.los = !(l == "0" || l == "False" || l == "false");

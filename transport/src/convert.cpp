@@ -136,7 +136,8 @@ RangeSample fromLcm(const range_t& m) {
   requireFinite(m.range_corr, "range_corr");
   requireFinite(m.variance, "variance");
   requireWithin(m.range, plausible::kMinRange_m, plausible::kMaxRange_m, "range [m]");
-  requireWithin(m.variance, 0.0, plausible::kMaxRange_m * plausible::kMaxRange_m, "variance [m^2]");
+  requireWithin(m.range_corr, plausible::kMinRange_m, plausible::kMaxRange_m, "range_corr [m]");
+  requireWithin(m.variance, 0.0, plausible::kMaxRangeVariance_m2, "variance [m^2]");
   RangeSample s;
   s.t = Timestamp::fromUtime(m.utime);
   s.id_initiator = m.id_initiator;

@@ -112,7 +112,7 @@ SerialLineParser::Result SerialLineParser::parse(const std::string& raw, Timesta
   s.type_initiator = options_.tag_ids.count(s.id_initiator) ? UwbType::Tag : UwbType::Anchor;
   s.type_responder = options_.tag_ids.count(s.id_responder) ? UwbType::Tag : UwbType::Anchor;
   s.range_m = *z;
-  s.range_corr_m = 0.0;  // the driver applies no correction (as in the published recordings)
+  s.range_corr_m = *z;   // the driver applies no correction: the corrected range is the raw one
   s.R_m2 = 0.0;          // unknown
   s.los = true;
   ++n_ranges_;

@@ -55,6 +55,36 @@ TEST(Ranges, BadRowsAreReportedCountedAndDropped) {
   EXPECT_EQ(diag.get("ranges.csv:bad_row"), 1);
 }
 
+TEST(Ranges, OptionalColumnsAreTheRawRangeWhenEmptyAndBadInputWhenNotNumbers) {
+  const test::TempDir d("ranges");
+  auto f = test::writeFile(d / "ranges.csv",
+                           "t,range_raw,range_corr,R,UWB_ID1,UWB_ID2,type_ID1,type_ID2,LOS\n"
+                           "1.0,4.0,nan,0,100,101,T,A,1\n"      // range_corr not a number
+                           "1.1,4.0,9999,0,100,101,T,A,1\n"     // range_corr absurd
+                           "1.2,4.0,4.1,-1,100,101,T,A,1\n"     // negative variance
+                           "1.3,4.0,4.1,inf,100,101,T,A,1\n"    // infinite variance
+                           "1.4,4.0,4.1,1e6,100,101,T,A,1\n"    // beyond 500^2 m^2
+                           "1.5,4.0,,,100,101,T,A,1\n"          // both empty: not given
+                           "1.6,4.0,3.9,0.04,100,101,T,A,1\n"); // both given
+  Diagnostics diag;
+  auto r = readRangesCsv(f, diag);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_DOUBLE_EQ(r[0].range_corr_m, 4.0);  // the raw range, never 0 m
+  EXPECT_DOUBLE_EQ(r[0].R_m2, 0.0);
+  EXPECT_DOUBLE_EQ(r[1].range_corr_m, 3.9);
+  EXPECT_DOUBLE_EQ(r[1].R_m2, 0.04);
+  EXPECT_EQ(diag.get("ranges.csv:bad_range_corr"), 2);
+  EXPECT_EQ(diag.get("ranges.csv:bad_R"), 3);
+  // Without the optional columns at all.
+  auto g = test::writeFile(d / "ranges2.csv", "t,range_raw,UWB_ID1,UWB_ID2,type_ID1,type_ID2\n2.0,5.5,100,101,T,A\n");
+  Diagnostics diag2;
+  auto r2 = readRangesCsv(g, diag2);
+  ASSERT_EQ(r2.size(), 1u);
+  EXPECT_DOUBLE_EQ(r2[0].range_corr_m, 5.5);
+  EXPECT_DOUBLE_EQ(r2[0].R_m2, 0.0);
+  EXPECT_EQ(diag2.total(), 0);
+}
+
 TEST(Ranges, TimeGoingBackwardsIsReportedAndSorted) {
   const test::TempDir d("ranges");
   auto f = test::writeFile(d / "ranges.csv",
