@@ -98,6 +98,7 @@ std::vector<PairBias> readPairBiases(const YAML::Node& n, const std::string& pat
   if (!n) return out;
   if (!n.IsSequence()) fail(path, "key '" + key + "' must be a list of {ids: [a, b], gamma, beta, sigma}");
   int i = 0;
+  std::map<std::pair<SensorId, SensorId>, std::string> seen;  // pair → the key that gave it
   for (const auto& e : n) {
     const std::string k = key + "[" + std::to_string(i++) + "]";
     if (!e.IsMap()) fail(path, "key '" + k + "' must be a map {ids: [a, b], gamma, beta, sigma}");
@@ -118,6 +119,10 @@ std::vector<PairBias> readPairBiases(const YAML::Node& n, const std::string& pat
     if (b.beta <= 0.0) entry.fail("beta", "must be > 0 [-]");
     if (b.sigma_gamma_m < 0.0) entry.fail("sigma_gamma", "must be >= 0 [m]");
     if (b.sigma_beta < 0.0) entry.fail("sigma_beta", "must be >= 0 [-]");
+    // One model per pair (symmetric in a, b): a second entry would be read by some users and not others.
+    if (const auto [it, added] = seen.emplace(pairKey(b.a, b.b), k); !added)
+      fail(path, "key '" + k + ".ids' names the pair " + std::to_string(b.a) + "–" + std::to_string(b.b) +
+                     " of '" + it->second + "' again");
     out.push_back(b);
   }
   return out;

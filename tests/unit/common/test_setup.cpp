@@ -115,6 +115,9 @@ TEST(Setup, MalformedFilesNameFileAndKey) {
   expectError("abs_anchor_positions: {101: [1, 2, x]}\n", "abs_anchor_positions.101");
   expectError("pair_biases: [{ids: [1]}]\n", "pair_biases[0].ids");
   expectError("pair_biases: [{ids: [1, 1]}]\n", "same device");
+  // One model per pair, in either order (the estimator kept the last, findPairBias the first).
+  expectError("pair_biases: [{ids: [100, 101], gamma: 0.1}, {ids: [101, 100], gamma: -0.2}]\n",
+              "key 'pair_biases[1].ids' names the pair 101–100 of 'pair_biases[0]' again");
   expectError("initial_pose: {p_IinG: [0, 0, 0], sigma_p: 0.1}\n", "initial_pose.yaw_deg");
   expectError("rel_tag_positions: {5: [0,0,0]}\nabs_anchor_positions: {5: [0,0,0]}\n", "both a tag and an anchor");
   expectError("a: [1, 2\n", "YAML syntax error");
