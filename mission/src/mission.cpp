@@ -69,8 +69,9 @@ MissionStep parseStep(const YAML::Node& n, size_t i, const std::string& source) 
   } catch (const std::exception&) {
     fail(at(source, t), key + ".t", "must be a number of seconds, got '" + (t.IsScalar() ? t.Scalar() : "?") + "'");
   }
-  if (!std::isfinite(s.t_s) || s.t_s < 0.0)
-    fail(at(source, t), key + ".t", "must be a finite time >= 0 [s], got " + t.Scalar());
+  // Within kMaxTimeSeconds, so that adding the first sample's time cannot overflow later.
+  if (!std::isfinite(s.t_s) || s.t_s < 0.0 || s.t_s > kMaxTimeSeconds)
+    fail(at(source, t), key + ".t", "must be a finite time in [0, 4e12] s, got " + t.Scalar());
   // action
   const YAML::Node a = n["action"];
   if (!a) fail(where, key + ".action", "is missing (collect|calibrate|remove|abort)");

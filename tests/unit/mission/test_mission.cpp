@@ -72,7 +72,9 @@ TEST(Mission, ErrorsNameFileLineAndKey) {
       {"steps:\n  - 5", "m.yaml:2: key 'steps[0]' must be a map"},
       {"steps:\n  - {action: calibrate}", "m.yaml:2: key 'steps[0].t' is missing"},
       {"steps:\n  - {t: soon, action: calibrate}", "key 'steps[0].t' must be a number"},
-      {"steps:\n  - {t: 1, action: calibrate}\n  - {t: -3, action: collect}", "m.yaml:3: key 'steps[1].t' must be a finite time >= 0"},
+      {"steps:\n  - {t: 1, action: calibrate}\n  - {t: -3, action: collect}", "m.yaml:3: key 'steps[1].t' must be a finite time in [0, 4e12] s"},
+      // a time that loads but cannot be added to the first sample's (Duration::fromSec threw later)
+      {"steps:\n  - {t: 1e13, action: calibrate}", "m.yaml:2: key 'steps[0].t' must be a finite time in [0, 4e12] s"},
       {"steps:\n  - {t: 1}", "key 'steps[0].action' is missing"},
       {"steps:\n  - {t: 1, action: calbrate}", "key 'steps[0].action' has unknown action 'calbrate'"},
       {"steps:\n  - {t: 1, action: calibrate, anchors: 106}", "key 'steps[0].anchors' must be a list"},
