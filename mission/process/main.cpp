@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
 
     mission::DataClock clock;
     auto onDataTime = [&](Timestamp t) {
-      if (!clock.advance(t)) return;
+      if (!clock.advance(t, lcm.diagnostics())) return;
       node.onTime(t);
       if (node.finished() && !completion.finished()) {
         completion.onFinished(replay::wallUtimeNow());

@@ -16,7 +16,9 @@
 
 #include "common/cli.h"
 #include "common/messages.h"
+#include "common/diagnostics.h"
 #include "common/time.h"
+#include "common/time_guard.h"
 #include "mission/mission.h"
 
 namespace meshnav::mission {
@@ -52,18 +54,26 @@ void declareMissionProcessOptions(Cli& cli, MissionProcessConfig& config);
 /// std::runtime_error naming the option on a bad value.
 void finishMissionProcessConfig(MissionProcessConfig& config);
 
-/// Passes on only advancing data times (several channels, arriving out of order between them).
+/// Passes on only plausible, advancing data times (several channels, arriving out of order
+/// between them). A time far from the current one is refused by a TimeGuard (common/time_guard.h,
+/// its defaults: ±10 s, a jump followed after 50 agreeing inputs) and counted as
+/// DATA_TIME:time_ahead / DATA_TIME:time_behind: one message stamped far ahead would otherwise fire
+/// every remaining step at once and leave every real time "not newer" afterwards.
 class DataClock {
  public:
-  /// True when `t` is newer than every time seen so far (then it is the new data time).
-  bool advance(Timestamp t) {
-    if (now_ && t <= *now_) return false;
+  /// True when `t` is the new data time: admitted by the guard and newer than the last one (or the
+  /// first after a jump the guard followed).
+  bool advance(Timestamp t, Diagnostics& diag) {
+    const TimeGuard::Verdict v = guard_.admit("DATA_TIME", t, diag);
+    if (v == TimeGuard::Verdict::Ahead || v == TimeGuard::Verdict::Behind) return false;
+    if (now_ && t <= *now_ && v != TimeGuard::Verdict::Rebased) return false;
     now_ = t;
     return true;
   }
   std::optional<Timestamp> now() const { return now_; }
 
  private:
+  TimeGuard guard_;
   std::optional<Timestamp> now_;
 };
 

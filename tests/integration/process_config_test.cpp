@@ -275,12 +275,14 @@ TEST(MissionProcessConfig, BadValuesNameTheOption) {
 
 TEST(DataClock, PassesOnlyAdvancingTimes) {
   mission::DataClock clock;
+  Diagnostics diag;
   EXPECT_FALSE(clock.now().has_value());
-  EXPECT_TRUE(clock.advance(Timestamp::fromSec(1.0)));   // RANGE
-  EXPECT_FALSE(clock.advance(Timestamp::fromSec(0.9)));  // a lagging POSE
-  EXPECT_FALSE(clock.advance(Timestamp::fromSec(1.0)));
-  EXPECT_TRUE(clock.advance(Timestamp::fromSec(1.1)));
+  EXPECT_TRUE(clock.advance(Timestamp::fromSec(1.0), diag));   // RANGE
+  EXPECT_FALSE(clock.advance(Timestamp::fromSec(0.9), diag));  // a lagging POSE
+  EXPECT_FALSE(clock.advance(Timestamp::fromSec(1.0), diag));
+  EXPECT_TRUE(clock.advance(Timestamp::fromSec(1.1), diag));
   EXPECT_EQ(*clock.now(), Timestamp::fromSec(1.1));
+  EXPECT_EQ(diag.total(), 0);  // lagging times are normal, not bad input
 }
 
 CalibStatus calibStatus(int64_t ok, int64_t refused, std::vector<std::pair<SensorId, std::string>> states) {
@@ -363,3 +365,22 @@ TEST(MissionCompletion, CalibrateAllWaitsUntilNothingCollects) {
 }
 
 }  // namespace
+
+TEST(DataClock, PassesAdvancingTimesAndRefusesOneFarAheadWithACounter) {
+  // Found by an audit: one POSE stamped an hour ahead fired every remaining mission step at once,
+  // and every real time after it was "not newer" and dropped without a word.
+  mission::DataClock clock;
+  Diagnostics diag;
+  EXPECT_TRUE(clock.advance(Timestamp::fromSec(100.0), diag));
+  EXPECT_TRUE(clock.advance(Timestamp::fromSec(100.5), diag));
+  EXPECT_FALSE(clock.advance(Timestamp::fromSec(100.2), diag));  // older: not a new data time
+  EXPECT_FALSE(clock.advance(Timestamp::fromSec(3700.0), diag));
+  EXPECT_EQ(diag.get("DATA_TIME:time_ahead"), 1);
+  EXPECT_TRUE(clock.advance(Timestamp::fromSec(101.0), diag));
+  EXPECT_EQ(clock.now()->sec(), 101.0);
+  // A real jump of the whole stream (a replay started again later) is followed.
+  bool followed = false;
+  for (int i = 0; i < 60 && !followed; ++i) followed = clock.advance(Timestamp::fromSec(5000.0 + 0.1 * i), diag);
+  EXPECT_TRUE(followed);
+  EXPECT_EQ(diag.get("time_rebased"), 1);
+}
