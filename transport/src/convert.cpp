@@ -9,6 +9,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
+
 #include "common/plausibility.h"
 #include "transport/src/convert_internals.h"
 
@@ -58,6 +60,20 @@ void requireWithin(double v, double lo, double hi, const char* what) {
   if (!(v >= lo && v <= hi))
     throw InvalidMessage(std::string(what) + " " + std::to_string(v) + " outside the plausible [" + std::to_string(lo) +
                          ", " + std::to_string(hi) + "]");
+}
+
+/// A covariance as published: symmetric and positive semi-definite up to rounding (a negative
+/// variance behind a valid fingerprint turned into NaN in the calibrator's sqrt).
+void requireCovariance(const double (&a)[9], const char* what) {
+  requireFinite(a, what);
+  const Eigen::Matrix3d C = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(a);
+  const double scale = 1.0 + C.cwiseAbs().maxCoeff();
+  if ((C - C.transpose()).cwiseAbs().maxCoeff() > 1e-6 * scale)
+    throw InvalidMessage(std::string(what) + " is not symmetric");
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(0.5 * (C + C.transpose()), Eigen::EigenvaluesOnly);
+  if (es.eigenvalues().minCoeff() < -1e-9 * scale)
+    throw InvalidMessage(std::string(what) + " is not positive semi-definite (smallest eigenvalue " +
+                         std::to_string(es.eigenvalues().minCoeff()) + ")");
 }
 
 UwbType uwbTypeFromCode(int8_t code, const char* what) {
@@ -199,9 +215,12 @@ pose_t toLcm(const PoseEstimate& s) {
 PoseEstimate fromLcm(const pose_t& m) {
   for (const auto* f : {&m.p_IinG, &m.v_IinG, &m.bias_gyro, &m.bias_acc}) requireFinite(*f, "pose_t vector");
   requireFinite(m.q_ItoG, "q_ItoG");
-  requireFinite(m.cov_p, "cov_p");
-  requireFinite(m.cov_v, "cov_v");
-  requireFinite(m.cov_theta, "cov_theta");
+  requireWithin(std::sqrt(m.q_ItoG[0] * m.q_ItoG[0] + m.q_ItoG[1] * m.q_ItoG[1] + m.q_ItoG[2] * m.q_ItoG[2] +
+                          m.q_ItoG[3] * m.q_ItoG[3]),
+                1.0 - 1e-3, 1.0 + 1e-3, "|q_ItoG|");
+  requireCovariance(m.cov_p, "cov_p");
+  requireCovariance(m.cov_v, "cov_v");
+  requireCovariance(m.cov_theta, "cov_theta");
   PoseEstimate s;
   s.t = Timestamp::fromUtime(m.utime);
   s.p_IinG = get3(m.p_IinG);
@@ -225,7 +244,7 @@ anchor_estimate_t toLcm(const AnchorEstimate& s) {
 }
 AnchorEstimate fromLcm(const anchor_estimate_t& m) {
   requireFinite(m.p_AinG, "p_AinG");
-  requireFinite(m.cov_p, "cov_p");
+  requireCovariance(m.cov_p, "cov_p");
   AnchorEstimate s;
   s.t = Timestamp::fromUtime(m.utime);
   s.id = m.id;

@@ -29,6 +29,13 @@ Eigen::Matrix3d someMatrix(double s) {
   return m * s;
 }
 
+/// Symmetric positive definite, with distinct entries off the diagonal.
+Eigen::Matrix3d someCovariance(double s) {
+  Eigen::Matrix3d m;
+  m << 4, 1, 0.5, 1, 3, 0.2, 0.5, 0.2, 2;
+  return m * s;
+}
+
 void expectQuatEq(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
   EXPECT_EQ(a.w(), b.w());
   EXPECT_EQ(a.x(), b.x());
@@ -172,11 +179,14 @@ TEST(Convert, PoseEstimateEveryFieldAndRowMajor) {
   s.bias_gyro_rad_s = {1e-3, 2e-3, 3e-3};
   s.bias_acc_m_s2 = {0.01, 0.02, 0.03};
   s.cov_p_m2 = someMatrix(1.0);
-  s.cov_v = someMatrix(2.0);
-  s.cov_theta_rad2 = someMatrix(3.0);
+  const auto asymmetric = toLcm(s);
+  EXPECT_EQ(asymmetric.cov_p[1], 2.0);  // (0, 1): row-major
+  EXPECT_EQ(asymmetric.cov_p[3], 4.0);  // (1, 0)
+  EXPECT_THROW(fromLcm(wire(asymmetric)), InvalidMessage);  // no covariance
+  s.cov_p_m2 = someCovariance(1.0);
+  s.cov_v = someCovariance(2.0);
+  s.cov_theta_rad2 = someCovariance(3.0);
   const auto m = toLcm(s);
-  EXPECT_EQ(m.cov_p[1], 2.0);  // (0, 1): row-major
-  EXPECT_EQ(m.cov_p[3], 4.0);  // (1, 0)
   const PoseEstimate r = fromLcm(wire(m));
   EXPECT_EQ(r.t, s.t);
   EXPECT_EQ(r.p_IinG, s.p_IinG);
@@ -196,7 +206,7 @@ TEST(Convert, Anchors) {
     a.t = Timestamp{1000 + i};
     a.id = 101 + i;
     a.p_AinG = {1.0 * i, 2.0, -3.0};
-    a.cov_p_m2 = someMatrix(0.1 * (i + 1));
+    a.cov_p_m2 = someCovariance(0.1 * (i + 1));
     v.push_back(a);
   }
   const auto m = toLcm(v);
@@ -390,10 +400,25 @@ TEST(Convert, InvalidMeasurementsThrow) {
   pose = toLcm(PoseEstimate{});
   pose.v_IinG[2] = std::numeric_limits<double>::infinity();
   EXPECT_THROW(fromLcm(pose), InvalidMessage);
+  // Found by an audit: only finiteness was checked, and a negative variance became NaN in the
+  // calibrator's sqrt.
+  pose = toLcm(PoseEstimate{});
+  pose.cov_p[0] = -0.5;
+  EXPECT_THROW(fromLcm(pose), InvalidMessage);
+  pose = toLcm(PoseEstimate{});
+  pose.cov_theta[1] = 0.3;  // (0, 1) without (1, 0)
+  EXPECT_THROW(fromLcm(pose), InvalidMessage);
+  pose = toLcm(PoseEstimate{});
+  pose.q_ItoG[0] = 2.0;  // |q| = 2
+  EXPECT_THROW(fromLcm(pose), InvalidMessage);
+  EXPECT_NO_THROW(fromLcm(toLcm(PoseEstimate{})));  // zero covariances are published before initialization
   AnchorEstimate a;
   a.id = 106;
   auto est = toLcm(a);
   est.p_AinG[0] = nan;
+  EXPECT_THROW(fromLcm(est), InvalidMessage);
+  est = toLcm(a);
+  est.cov_p[8] = -1e-3;
   EXPECT_THROW(fromLcm(est), InvalidMessage);
   auto add = toLcm(EstimatorCommand{});  // AddAnchor: the anchor is decoded with its checks
   add.anchor.p_AinG[1] = nan;
