@@ -72,6 +72,12 @@ const OptionField<CalibratorOptions, Ref> kFields[] = {
     {"min_tag_position_sigma", at<&CalibratorOptions::min_tag_position_sigma_m>},
 };
 
+std::string fmtNumber(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
 /// Visits every option as (key, field, unit).
 template <typename Opts, typename F>
 void visitOptions(Opts& o, F&& f) {
@@ -112,6 +118,29 @@ void CalibratorOptions::validate() const {
     throw std::runtime_error("key 'calibrator.ransac_confidence' must be in (0, 1)");
   if (ransac_min_iterations < 1 || ransac_max_iterations < ransac_min_iterations)
     throw std::runtime_error("need 1 <= ransac_min_iterations <= ransac_max_iterations");
+  // Every other number that a value out of range would break later, without naming the key.
+  auto within = [](double v, double lo, double hi, const char* key) {
+    if (!(v >= lo && v <= hi))
+      throw std::runtime_error("key 'calibrator." + std::string(key) + "' must be in [" + fmtNumber(lo) + ", " +
+                               fmtNumber(hi) + "], got " + fmtNumber(v));
+  };
+  within(max_pose_gap_s, 1e-3, 3600.0, "max_pose_gap");
+  within(lm_max_iterations, 1, 100000, "lm_max_iterations");
+  within(linear_passes, 0, 100, "linear_passes");
+  within(ransac_rows_margin, 0, 100, "ransac_rows_margin");
+  within(min_measurements, 1, 1e9, "min_measurements");
+  within(min_measurements_per_reference, 1, 1e9, "min_measurements_per_reference");
+  within(min_distinct_positions, 1, 1e9, "min_distinct_positions");
+  within(min_plane_spread_m, 0.0, 1e3, "min_plane_spread");
+  within(min_line_spread_m, 0.0, 1e3, "min_line_spread");
+  within(max_position_sigma_m, 1e-6, 1e6, "max_position_sigma");
+  within(correlated_reference_fraction, 0.0, 1.0, "correlated_reference_fraction");
+  within(min_tag_position_sigma_m, 0.0, 1e3, "min_tag_position_sigma");
+  within(moving_min_spread_m, 0.0, 1e3, "moving_min_spread");
+  within(beta_min_range_spread_m, 0.0, 1e3, "beta_min_range_spread");
+  within(mirror_max_plane_spread_m, 0.0, 1e3, "mirror_max_plane_spread");
+  within(mirror_max_normal_sigma_m, 0.0, 1e3, "mirror_max_normal_sigma");
+  within(mirror_merge_max_m, 0.0, 1e3, "mirror_merge_max");
 }
 
 std::string CalibratorOptions::toString() const {

@@ -734,3 +734,26 @@ TEST(CalibratorNode, AutoModeOnAWalkCalibratesOnTheRightSideOfTheTagPlaneOrSaysW
   EXPECT_NE(anchorStatus(old_node, walk.dataset.truth->anchor_positions.rbegin()->first).reason.find("coplanar"),
             std::string::npos);
 }
+
+TEST(CalibratorOptions, NumbersOutOfRangeAreRefusedNamingFileAndKey) {
+  // Found by an audit: max_pose_gap 1e13 loaded and threw std::out_of_range at the first
+  // calibration without naming the key; a negative max_pose_gap gave no tag range a pose.
+  EXPECT_NO_THROW(CalibratorOptions::fromYaml(YAML::Load("{max_pose_gap: 0.2, min_measurements: 12}"), "c.yaml"));
+  const std::pair<const char*, const char*> cases[] = {
+      {"{max_pose_gap: 1e13}", "calibrator.max_pose_gap"},
+      {"{max_pose_gap: -0.5}", "calibrator.max_pose_gap"},
+      {"{lm_max_iterations: 0}", "calibrator.lm_max_iterations"},
+      {"{min_measurements: -1}", "calibrator.min_measurements"},
+      {"{correlated_reference_fraction: 1.5}", "calibrator.correlated_reference_fraction"},
+      {"{min_tag_position_sigma: -0.1}", "calibrator.min_tag_position_sigma"},
+  };
+  for (const auto& [text, key] : cases) {
+    try {
+      CalibratorOptions::fromYaml(YAML::Load(text), "c.yaml");
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("c.yaml"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+}
