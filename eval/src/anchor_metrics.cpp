@@ -66,7 +66,10 @@ std::vector<double> readNumbers(const YAML::Node& node, size_t n, const std::str
   if (!node || !node.IsSequence() || node.size() != n)
     throw std::runtime_error(where + ": expected a list of " + std::to_string(n) + " numbers");
   std::vector<double> v;
-  for (const auto& x : node) v.push_back(x.as<double>());
+  for (const auto& x : node) {
+    v.push_back(x.as<double>());
+    if (!std::isfinite(v.back())) throw std::runtime_error(where + ": '" + x.Scalar() + "' is not a finite number");
+  }
   return v;
 }
 
@@ -99,7 +102,7 @@ std::map<SensorId, AnchorEstimate> readCalibrationYaml(const std::string& path) 
           for (int k = 0; k < 3; ++k) a.cov_p_m2(r, k) = c[3 * r + k];
       }
       if (entry["t"]) a.t = Timestamp::fromSec(entry["t"].as<double>());
-      out[a.id] = a;
+      if (!out.emplace(a.id, a).second) throw std::runtime_error(where + ": anchor " + std::to_string(a.id) + " again");
     } catch (const YAML::Exception& ex) {
       throw std::runtime_error(where + ": " + ex.what());
     } catch (const std::out_of_range& ex) {

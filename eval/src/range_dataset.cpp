@@ -35,8 +35,11 @@ std::map<SensorId, Eigen::Vector3d> readAbsAnchorPositions(const std::string& pa
     for (const auto& kv : a) {
       if (!kv.second.IsSequence() || kv.second.size() != 3)
         throw std::runtime_error(path + ": abs_anchor_positions[" + kv.first.Scalar() + "] is not [x, y, z]");
-      out[kv.first.as<SensorId>()] =
-          Eigen::Vector3d(kv.second[0].as<double>(), kv.second[1].as<double>(), kv.second[2].as<double>());
+      const Eigen::Vector3d p(kv.second[0].as<double>(), kv.second[1].as<double>(), kv.second[2].as<double>());
+      if (!p.allFinite())
+        throw std::runtime_error(path + ": abs_anchor_positions[" + kv.first.Scalar() + "] is not finite");
+      if (!out.emplace(kv.first.as<SensorId>(), p).second)
+        throw std::runtime_error(path + ": abs_anchor_positions[" + kv.first.Scalar() + "] is given twice");
     }
   } catch (const YAML::Exception& ex) {
     throw std::runtime_error(path + ": abs_anchor_positions: " + ex.what());

@@ -97,3 +97,26 @@ TEST(CalibrationYaml, ReadsEntriesAndNamesMissingKeys) {
     EXPECT_NE(std::string(ex.what()).find("bad.yaml"), std::string::npos) << ex.what();
   }
 }
+
+TEST(CalibrationYaml, NonFiniteNumbersAndRepeatedAnchorsAreRefused) {
+  // Found by an audit: '.nan' and '.inf' loaded, and the report then showed NaN anchor errors
+  // with exit 0; a repeated id silently replaced the first entry.
+  const meshnav::test::TempDir dir("eval_calib_nan");
+  const std::pair<const char*, const char*> cases[] = {
+      {"- id: 106\n  p_AinG: [1, .nan, 3]\n", "'.nan' is not a finite number"},
+      {"- id: 106\n  p_AinG: [1, 2, 3]\n  p_AinG_cov: [.inf, 0, 0, 0, 1, 0, 0, 0, 1]\n", "p_AinG_cov"},
+      {"- id: 106\n  p_AinG: [1, 2, 3]\n- id: 106\n  p_AinG: [4, 5, 6]\n", "anchor 106 again"},
+  };
+  int i = 0;
+  for (const auto& [text, needle] : cases) {
+    const auto path = (dir / ("c" + std::to_string(i++) + ".yaml")).string();
+    std::ofstream(path) << text;
+    try {
+      readCalibrationYaml(path);
+      ADD_FAILURE() << "accepted:\n" << text;
+    } catch (const std::runtime_error& ex) {
+      EXPECT_NE(std::string(ex.what()).find(needle), std::string::npos) << ex.what();
+      EXPECT_NE(std::string(ex.what()).find(path), std::string::npos) << ex.what();
+    }
+  }
+}
