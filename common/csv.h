@@ -84,7 +84,13 @@ std::vector<T> readTimedRows(const std::string& path, const std::vector<std::str
       [&](const CsvRow& r) {
         const std::optional<Timestamp> t = parseRowTime(r, key, diag);
         if (!t) return;
-        if (std::optional<T> s = sample(r, *t, key)) out.push_back(std::move(*s));
+        std::optional<T> s = sample(r, *t, key);
+        if (!s) return;
+        if (!out.empty() && *t < out.back().t)
+          diag.report(key + ":time_backwards", r.where() + ": t=" + formatSeconds(*t) +
+                                                   " s is earlier than the previous row's (" +
+                                                   formatSeconds(out.back().t) + " s); file will be time-sorted");
+        out.push_back(std::move(*s));
       },
       diag);
   return out;

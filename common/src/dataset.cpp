@@ -18,20 +18,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// Reports samples whose time goes backwards and sorts them (stable).
+/// Sorts samples by time (stable); readTimedRows has reported each row whose time went backwards.
 template <typename T>
-void checkOrder(std::vector<T>& v, const std::string& path, Diagnostics& d) {
-  const std::string key = baseName(path);
-  bool sorted = true;
-  for (size_t i = 1; i < v.size(); ++i) {
-    if (v[i].t < v[i - 1].t) {
-      sorted = false;
-      d.report(key + ":time_backwards", path + ": sample " + std::to_string(i + 1) + " at t=" +
-                                            formatSeconds(v[i].t) + " s is earlier than the previous one (" +
-                                            formatSeconds(v[i - 1].t) + " s); file will be time-sorted");
-    }
-  }
-  if (!sorted) std::stable_sort(v.begin(), v.end(), [](const T& a, const T& b) { return a.t < b.t; });
+void checkOrder(std::vector<T>& v) {
+  if (!std::is_sorted(v.begin(), v.end(), [](const T& a, const T& b) { return a.t < b.t; }))
+    std::stable_sort(v.begin(), v.end(), [](const T& a, const T& b) { return a.t < b.t; });
 }
 
 std::optional<UwbType> parseType(const std::string& s) {
@@ -87,7 +78,7 @@ std::vector<T> readTimeValueCsv(const std::string& path, const char* column, dou
     return T{t, *v};
   };
   std::vector<T> out = readTimedRows<T>(path, {"t", column}, diag, sample);
-  checkOrder(out, path, diag);
+  checkOrder(out);
   return out;
 }
 
@@ -114,7 +105,7 @@ std::vector<ImuSample> readImuCsv(const std::string& path, Diagnostics& diag) {
     return s;
   };
   std::vector<ImuSample> out = readTimedRows<ImuSample>(path, cols, diag, sample);
-  checkOrder(out, path, diag);
+  checkOrder(out);
   return out;
 }
 
@@ -198,7 +189,7 @@ std::vector<RangeSample> readRangesCsv(const std::string& path, Diagnostics& dia
   };
   std::vector<RangeSample> out = readTimedRows<RangeSample>(
       path, {"t", "range_raw", "UWB_ID1", "UWB_ID2", "type_ID1", "type_ID2"}, diag, sample);
-  checkOrder(out, path, diag);
+  checkOrder(out);
   return out;
 }
 
@@ -215,7 +206,7 @@ std::vector<FlightStateSample> readFlightStateCsv(const std::string& path, Diagn
     return FlightStateSample{t, landed};
   };
   std::vector<FlightStateSample> out = readTimedRows<FlightStateSample>(path, {"t", "landed"}, diag, sample);
-  checkOrder(out, path, diag);
+  checkOrder(out);
   return out;
 }
 
@@ -245,7 +236,7 @@ std::vector<PoseSample> readTumCsv(const std::string& path, Diagnostics& diag) {
     return PoseSample{t, {v[0], v[1], v[2]}, q};
   };
   std::vector<PoseSample> out = readTimedRows<PoseSample>(path, cols, diag, sample);
-  checkOrder(out, path, diag);
+  checkOrder(out);
   return out;
 }
 
