@@ -303,6 +303,8 @@ TEST(EstimatorNode, AnAnchorWithASensorInstanceIdOrBadValuesIsRefusedAlsoByComma
       a.id = id;
       dirty.onAnchorInit(a);  // bad_command: a sensor instance's id
     }
+    a.id = ds.setup.rel_tag_positions.begin()->first;
+    dirty.onAnchorInit(a);  // bad_command: a tag's id
     EstimatorCommand c;
     c.t = a.t;
     c.action = EstimatorCommand::Action::AddAnchor;
@@ -319,7 +321,7 @@ TEST(EstimatorNode, AnAnchorWithASensorInstanceIdOrBadValuesIsRefusedAlsoByComma
     dirty.onCommand(c);
   }
   ASSERT_TRUE(injected);
-  EXPECT_EQ(dirty.diagnostics().get("bad_command"), 3);
+  EXPECT_EQ(dirty.diagnostics().get("bad_command"), 4);
   EXPECT_EQ(dirty.diagnostics().get("bad_input"), 3);
   EXPECT_EQ(dirty.diagnostics().get("BARO:handler_error"), 0);
   EXPECT_EQ(dirty.filter()->layout().find(130), nullptr);
