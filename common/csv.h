@@ -89,7 +89,7 @@ std::vector<T> readTimedRows(const std::string& path, const std::vector<std::str
         if (!out.empty() && *t < out.back().t)
           diag.report(key + ":time_backwards", r.where() + ": t=" + formatSeconds(*t) +
                                                    " s is earlier than the previous row's (" +
-                                                   formatSeconds(out.back().t) + " s); file will be time-sorted");
+                                                   formatSeconds(out.back().t) + " s)");
         out.push_back(std::move(*s));
       },
       diag);

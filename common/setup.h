@@ -72,8 +72,9 @@ struct SystemSetup {
 
   bool isTag(SensorId id) const { return rel_tag_positions.count(id) > 0; }
   bool isKnownAnchor(SensorId id) const { return abs_anchor_positions.count(id) > 0; }
-  /// The id of an instance that is no UWB device (IMU, baro, height): never an anchor's.
-  bool isSensorInstanceId(SensorId id) const { return id == imu_id || id == baro_id || id == height_id; }
+  /// The id of the IMU or the baro, instances every run has: never an anchor's. (height_id is
+  /// an instance only once heights come; the estimator refuses an anchor on it while it is one.)
+  bool isSensorInstanceId(SensorId id) const { return id == imu_id || id == baro_id; }
   /// Pair bias for (a, b) in either order, if given.
   std::optional<PairBias> findPairBias(SensorId a, SensorId b) const;
 };

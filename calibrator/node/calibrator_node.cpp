@@ -112,7 +112,7 @@ void CalibratorNode::onRange(const RangeSample& r) {
       diag_.report("unknown_device",
                    describe(r) + ": device " + std::to_string(id) + " (type '" + static_cast<char>(type) + "') " +
                        (setup_.isSensorInstanceId(id)
-                            ? "has the id of the IMU, baro or height instance (imu_id, baro_id, height_id in setup.yaml)"
+                            ? "has the id of the IMU or the baro (imu_id, baro_id in setup.yaml)"
                             : "is neither a tag of the setup nor an anchor"));
       return;
     }
@@ -233,8 +233,11 @@ void CalibratorNode::onCommand(const CalibCommand& c) {
   std::vector<SensorId> ids;
   for (SensorId id : c.anchors) {
     if (id <= 0 || setup_.isTag(id) || setup_.isKnownAnchor(id) || setup_.isSensorInstanceId(id)) {
-      diag_.report("bad_command", "command names " + std::to_string(id) +
-                                      ", which is not an anchor of unknown position; ignored for it");
+      diag_.report("bad_command", "command names " + std::to_string(id) + ", which is not an anchor of unknown position (" +
+                                      (setup_.isSensorInstanceId(id) ? "the IMU's or the baro's id"
+                                       : id <= 0                     ? "not a device id"
+                                                                     : "a tag or a known anchor") +
+                                      "); ignored for it");
       continue;
     }
     ids.push_back(id);

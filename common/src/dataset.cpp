@@ -18,11 +18,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// Sorts samples by time (stable); readTimedRows has reported each row whose time went backwards.
+/// Sorts samples by time (stable; logged once per file); readTimedRows has reported each row whose
+/// time went backwards.
 template <typename T>
-void checkOrder(std::vector<T>& v) {
-  if (!std::is_sorted(v.begin(), v.end(), [](const T& a, const T& b) { return a.t < b.t; }))
-    std::stable_sort(v.begin(), v.end(), [](const T& a, const T& b) { return a.t < b.t; });
+void checkOrder(std::vector<T>& v, const std::string& path) {
+  if (std::is_sorted(v.begin(), v.end(), [](const T& a, const T& b) { return a.t < b.t; })) return;
+  std::stable_sort(v.begin(), v.end(), [](const T& a, const T& b) { return a.t < b.t; });
+  spdlog::warn("{}: rows out of time order; the {} rows were sorted by time", path, v.size());
 }
 
 std::optional<UwbType> parseType(const std::string& s) {
@@ -78,7 +80,7 @@ std::vector<T> readTimeValueCsv(const std::string& path, const char* column, dou
     return T{t, *v};
   };
   std::vector<T> out = readTimedRows<T>(path, {"t", column}, diag, sample);
-  checkOrder(out);
+  checkOrder(out, path);
   return out;
 }
 
@@ -105,7 +107,7 @@ std::vector<ImuSample> readImuCsv(const std::string& path, Diagnostics& diag) {
     return s;
   };
   std::vector<ImuSample> out = readTimedRows<ImuSample>(path, cols, diag, sample);
-  checkOrder(out);
+  checkOrder(out, path);
   return out;
 }
 
@@ -189,7 +191,7 @@ std::vector<RangeSample> readRangesCsv(const std::string& path, Diagnostics& dia
   };
   std::vector<RangeSample> out = readTimedRows<RangeSample>(
       path, {"t", "range_raw", "UWB_ID1", "UWB_ID2", "type_ID1", "type_ID2"}, diag, sample);
-  checkOrder(out);
+  checkOrder(out, path);
   return out;
 }
 
@@ -206,7 +208,7 @@ std::vector<FlightStateSample> readFlightStateCsv(const std::string& path, Diagn
     return FlightStateSample{t, landed};
   };
   std::vector<FlightStateSample> out = readTimedRows<FlightStateSample>(path, {"t", "landed"}, diag, sample);
-  checkOrder(out);
+  checkOrder(out, path);
   return out;
 }
 
@@ -236,7 +238,7 @@ std::vector<PoseSample> readTumCsv(const std::string& path, Diagnostics& diag) {
     return PoseSample{t, {v[0], v[1], v[2]}, q};
   };
   std::vector<PoseSample> out = readTimedRows<PoseSample>(path, cols, diag, sample);
-  checkOrder(out);
+  checkOrder(out, path);
   return out;
 }
 

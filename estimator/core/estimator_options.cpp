@@ -89,7 +89,7 @@ const Field kFields[] = {
     {"uwb.gate_probability", field<&EstimatorOptions::uwb, &UwbOptions::gate_probability>, "chi^2 gate, 0 = off [-]"},
     {"uwb.huber_k", field<&EstimatorOptions::uwb, &UwbOptions::huber_k>, "Huber threshold of the range update in innovation sigmas, 0 = off [-]"},
     {"uwb.huber_max_prior_ratio", field<&EstimatorOptions::uwb, &UwbOptions::huber_max_prior_ratio>, "Huber weighting only while H P H^T / R of the range is at most this [-]"},
-    {"uwb.use_corrected_range", field<&EstimatorOptions::uwb, &UwbOptions::use_corrected_range>, "fuse range_corr instead of range_raw"},
+    {"uwb.use_corrected_range", field<&EstimatorOptions::uwb, &UwbOptions::use_corrected_range>, "fuse range_corr instead of range_raw (one more than 1 m from it is bad input)"},
     {"uwb.max_range_m", field<&EstimatorOptions::uwb, &UwbOptions::max_range_m>, "longer ranges are bad input [m]"},
     {"uwb.estimate_tag_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_tag_biases>, "estimate tag-anchor gamma (setup anchors, sigma_gamma > 0) as states"},
     {"uwb.estimate_anchor_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_anchor_biases>, "estimate a calibrated anchor's gamma (ANCHOR_INIT, sigma_gamma > 0) as states of its instance"},

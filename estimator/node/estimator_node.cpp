@@ -177,6 +177,10 @@ void EstimatorNode::event(bool first, const std::string& kind, const std::string
     diag_.report(kind, message);
 }
 
+/// With uwb.use_corrected_range, a correction larger than this is no correction (a source that
+/// leaves range_corr at 0, like old serial-bridge logs and real-t1-a3-loiter) [m].
+constexpr double kMaxRangeCorrection_m = 1.0;
+
 bool EstimatorNode::validate(const EstimatorInput& in) {
   std::string bad;
   Timestamp t = inputTime(in);
@@ -196,6 +200,10 @@ bool EstimatorNode::validate(const EstimatorInput& in) {
     if (!std::isfinite(z) || z < -0.5 || z > options_.uwb.max_range_m || !std::isfinite(s->R_m2) || s->R_m2 < 0)
       bad = where("RANGE", t) + ": bad range " + std::to_string(z) + " m between " + std::to_string(s->id_initiator) +
             " and " + std::to_string(s->id_responder);
+    else if (options_.uwb.use_corrected_range && std::abs(s->range_corr_m - s->range_m) > kMaxRangeCorrection_m)
+      bad = where("RANGE", t) + ": corrected range " + std::to_string(s->range_corr_m) + " m is more than " +
+            std::to_string(kMaxRangeCorrection_m) + " m from the raw " + std::to_string(s->range_m) +
+            " m (not given? old logs carry 0)";
     else if (s->id_initiator == s->id_responder || s->id_initiator <= 0 || s->id_responder <= 0)
       bad = where("RANGE", t) + ": invalid ids " + std::to_string(s->id_initiator) + ", " +
             std::to_string(s->id_responder);

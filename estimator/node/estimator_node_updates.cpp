@@ -56,6 +56,12 @@ void EstimatorNode::processHeight(const HeightSample& s, bool first) {
     event(first, "height_tilted");
     return;
   }
+  if (cur_.filter->state().values<AnchorKind>().count(setup_.height_id)) {
+    event(first, "height_id_is_an_anchor",
+          where("HEIGHT", s.t) + ": height_id " + std::to_string(setup_.height_id) +
+              " is an estimated anchor's id; heights not used (set height_id in setup.yaml)");
+    return;
+  }
   if (!cur_.filter->state().values<HeightBiasKind>().count(setup_.height_id)) {
     // The floor is at z = 0 of G: the bias is near zero unless the sensor sits far from the IMU.
     const double b = pending_height_bias_ ? pending_height_bias_->first : 0.0;
@@ -138,10 +144,14 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
 
 void EstimatorNode::applyAnchorInit(const AnchorInit& a, bool first) {
   auto net = std::make_shared<UwbNetwork>(*cur_.network);
-  if (net->isTag(a.id) || setup_.isSensorInstanceId(a.id)) {
+  // An id holds one instance: a tag's, the IMU's, the baro's, or a height bias already added.
+  const bool height = cur_.filter->state().values<HeightBiasKind>().count(a.id) > 0;
+  if (net->isTag(a.id) || setup_.isSensorInstanceId(a.id) || height) {
     event(first, "bad_command",
           where("ANCHOR_INIT", a.t) + ": id " + std::to_string(a.id) +
-              (net->isTag(a.id) ? " is a tag" : " is the IMU, baro or height instance's (imu_id, baro_id, height_id)"));
+              (net->isTag(a.id) ? " is a tag"
+                                : " is the IMU's, the baro's or the height sensor's (imu_id, baro_id, height_id in "
+                                  "setup.yaml)"));
     return;
   }
   net->removeDevice(a.id);  // an exactly known anchor becomes an estimated one

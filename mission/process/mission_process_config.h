@@ -55,18 +55,25 @@ void declareMissionProcessOptions(Cli& cli, MissionProcessConfig& config);
 void finishMissionProcessConfig(MissionProcessConfig& config);
 
 /// Passes on only plausible, advancing data times (several channels, arriving out of order
-/// between them). A time far from the current one is refused by a TimeGuard (common/time_guard.h,
-/// its defaults: ±10 s, a jump followed after 50 agreeing inputs) and counted as
-/// DATA_TIME:time_ahead / DATA_TIME:time_behind: one message stamped far ahead would otherwise fire
-/// every remaining step at once and leave every real time "not newer" afterwards.
+/// between them). A time more than 10 s ahead of the current one is refused by a TimeGuard
+/// (common/time_guard.h; a whole-stream jump is followed after 50 agreeing inputs) and counted as
+/// DATA_TIME:time_ahead: one message stamped far ahead would otherwise fire every remaining step at
+/// once and leave every real time "not newer" afterwards. Older times are harmless (a POSE lagging
+/// the ranges): only beyond 600 s are they counted (DATA_TIME:time_behind). A followed jump back
+/// (a replay started again) is reported as DATA_TIME:jumped_back; the mission does not start over.
 class DataClock {
  public:
+  DataClock() : guard_(TimeGuardOptions{10.0, 50, 600.0}) {}
   /// True when `t` is the new data time: admitted by the guard and newer than the last one (or the
   /// first after a jump the guard followed).
   bool advance(Timestamp t, Diagnostics& diag) {
     const TimeGuard::Verdict v = guard_.admit("DATA_TIME", t, diag);
     if (v == TimeGuard::Verdict::Ahead || v == TimeGuard::Verdict::Behind) return false;
     if (now_ && t <= *now_ && v != TimeGuard::Verdict::Rebased) return false;
+    if (v == TimeGuard::Verdict::Rebased && now_ && t < *now_)
+      diag.report("DATA_TIME:jumped_back", "mission: data time jumped back from t=" + formatSeconds(*now_) +
+                                               " s to t=" + formatSeconds(t) +
+                                               " s; steps already run are not run again");
     now_ = t;
     return true;
   }

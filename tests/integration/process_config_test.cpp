@@ -383,4 +383,11 @@ TEST(DataClock, PassesAdvancingTimesAndRefusesOneFarAheadWithACounter) {
   for (int i = 0; i < 60 && !followed; ++i) followed = clock.advance(Timestamp::fromSec(5000.0 + 0.1 * i), diag);
   EXPECT_TRUE(followed);
   EXPECT_EQ(diag.get("time_rebased"), 1);
+  // Lagging times are no bad input unless absurdly old; a replay started again is followed and said.
+  EXPECT_FALSE(clock.advance(Timestamp::fromSec(4800.0), diag));
+  EXPECT_EQ(diag.get("DATA_TIME:time_behind"), 0);
+  followed = false;
+  for (int i = 0; i < 60 && !followed; ++i) followed = clock.advance(Timestamp::fromSec(10.0 + 0.1 * i), diag);
+  EXPECT_TRUE(followed);
+  EXPECT_EQ(diag.get("DATA_TIME:jumped_back"), 1);
 }

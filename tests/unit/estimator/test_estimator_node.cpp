@@ -282,7 +282,7 @@ TEST(EstimatorNode, HeightsAddABiasInstanceThatConvergesAndBadHeightsAreCounted)
 TEST(EstimatorNode, AnAnchorWithASensorInstanceIdOrBadValuesIsRefusedAlsoByCommand) {
   // Found by an audit: ANCHOR_INIT 2 replaced the baro bias state (every later BARO sample threw),
   // ANCHOR_INIT 1 left the IMU half replaced, and ESTIMATOR_CMD's anchor skipped every value check
-  // once the filter ran. Each is now refused and counted, and the estimate stays as without it.
+  // once the filter ran. (An anchor on height_id is one while no height came: next test.) Each is now refused and counted, and the estimate stays as without it.
   synthetic::SyntheticOptions o;
   o.duration_s = 8.0;
   o.noise = true;
@@ -299,7 +299,7 @@ TEST(EstimatorNode, AnAnchorWithASensorInstanceIdOrBadValuesIsRefusedAlsoByComma
     a.t = inputTime(in);
     a.p_AinG = {1.0, 2.0, 3.0};
     a.cov_p_m2 = 0.01 * Eigen::Matrix3d::Identity();
-    for (SensorId id : {ds.setup.imu_id, ds.setup.baro_id, ds.setup.height_id}) {
+    for (SensorId id : {ds.setup.imu_id, ds.setup.baro_id}) {
       a.id = id;
       dirty.onAnchorInit(a);  // bad_command: a sensor instance's id
     }
@@ -321,9 +321,81 @@ TEST(EstimatorNode, AnAnchorWithASensorInstanceIdOrBadValuesIsRefusedAlsoByComma
     dirty.onCommand(c);
   }
   ASSERT_TRUE(injected);
-  EXPECT_EQ(dirty.diagnostics().get("bad_command"), 4);
+  EXPECT_EQ(dirty.diagnostics().get("bad_command"), 3);
   EXPECT_EQ(dirty.diagnostics().get("bad_input"), 3);
   EXPECT_EQ(dirty.diagnostics().get("BARO:handler_error"), 0);
   EXPECT_EQ(dirty.filter()->layout().find(130), nullptr);
   EXPECT_EQ(test::stateDifference(*clean.filter(), *dirty.filter()), 0.0);
+}
+
+TEST(EstimatorNode, AnAnchorOnTheHeightIdIsOneUntilHeightsComeAndThenTheyAreRefused) {
+  // height_id is an instance only once heights come: without a height sensor an unknown anchor
+  // numbered like the default height_id (3) is calibrated and fused as any other. Whichever comes
+  // first keeps the id; the other is refused and counted, never swapped.
+  synthetic::SyntheticOptions o;
+  o.duration_s = 8.0;
+  const Dataset ds = synthetic::makeSyntheticDataset(o);
+  const auto inputs = mergeInTimeOrder(ds);
+  AnchorInit a;
+  a.id = ds.setup.height_id;
+  a.p_AinG = {1.0, 2.0, 3.0};
+  a.cov_p_m2 = 0.01 * Eigen::Matrix3d::Identity();
+  {
+    EstimatorNode node(test::testOptions(), ds.setup);
+    bool added = false;
+    for (const auto& in : inputs) {
+      node.onInput(in);
+      if (added || !node.initialized() || inputTime(in).sec() < 5.0) continue;
+      added = true;
+      a.t = inputTime(in);
+      node.onAnchorInit(a);
+      node.onHeight({inputTime(in), 1.0});
+    }
+    ASSERT_TRUE(added);
+    EXPECT_NE(node.filter()->layout().find(ds.setup.height_id), nullptr);
+    EXPECT_EQ(node.filter()->state().values<AnchorKind>().count(ds.setup.height_id), 1u);
+    EXPECT_EQ(node.diagnostics().get("height_id_is_an_anchor"), 1);
+    EXPECT_EQ(node.diagnostics().get("bad_command"), 0);
+  }
+  EstimatorNode node(test::testOptions(), ds.setup);
+  bool height = false, added = false;
+  for (const auto& in : inputs) {
+    node.onInput(in);
+    if (!node.initialized() || inputTime(in).sec() < 5.0) continue;
+    if (!height) {
+      height = true;
+      node.onHeight({inputTime(in), 1.0});
+    } else if (!added && inputTime(in).sec() >= 6.0) {
+      added = true;
+      a.t = inputTime(in);
+      node.onAnchorInit(a);
+    }
+  }
+  ASSERT_TRUE(added);
+  EXPECT_EQ(node.filter()->state().values<HeightBiasKind>().count(ds.setup.height_id), 1u);
+  EXPECT_EQ(node.filter()->state().values<AnchorKind>().count(ds.setup.height_id), 0u);
+  EXPECT_EQ(node.diagnostics().get("bad_command"), 1);
+}
+
+TEST(EstimatorNode, ACorrectedRangeFarFromTheRawOneIsBadInputWhenUsed) {
+  // real-t1-a3-loiter and old serial-bridge logs carry range_corr = 0: with
+  // uwb.use_corrected_range those were fused as 0 m ranges.
+  synthetic::SyntheticOptions o;
+  o.duration_s = 30.0;
+  const Dataset ds = synthetic::makeSyntheticDataset(o);
+  EstimatorOptions opt = test::testOptions();
+  RangeSample r{Timestamp::fromSec(1.0), 100, 101, UwbType::Tag, UwbType::Anchor, 4.0, 0.0, 0.0, true};
+  {
+    EstimatorNode raw(opt, ds.setup);  // the corrected range is not used: nothing to refuse
+    raw.onRange(r);
+    EXPECT_EQ(raw.diagnostics().get("bad_input"), 0);
+  }
+  opt.uwb.use_corrected_range = true;
+  EstimatorNode node(opt, ds.setup);
+  node.onRange(r);
+  EXPECT_EQ(node.diagnostics().get("bad_input"), 1);
+  r.t = Timestamp::fromSec(1.1);
+  r.range_corr_m = 3.85;  // a correction of 0.15 m
+  node.onRange(r);
+  EXPECT_EQ(node.diagnostics().get("bad_input"), 1);
 }

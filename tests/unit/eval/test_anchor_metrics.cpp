@@ -98,14 +98,16 @@ TEST(CalibrationYaml, ReadsEntriesAndNamesMissingKeys) {
   }
 }
 
-TEST(CalibrationYaml, NonFiniteNumbersAndRepeatedAnchorsAreRefused) {
+TEST(CalibrationYaml, NonFiniteNumbersAreRefusedAndARecalibrationWins) {
   // Found by an audit: '.nan' and '.inf' loaded, and the report then showed NaN anchor errors
-  // with exit 0; a repeated id silently replaced the first entry.
+  // with exit 0. A repeated id is a re-calibration (the logger appends every ANCHOR_INIT).
   const meshnav::test::TempDir dir("eval_calib_nan");
+  const auto twice = (dir / "twice.yaml").string();
+  std::ofstream(twice) << "- id: 106\n  p_AinG: [1, 2, 3]\n- id: 106\n  p_AinG: [4, 5, 6]\n";
+  EXPECT_TRUE(readCalibrationYaml(twice).at(106).p_AinG.isApprox(Eigen::Vector3d(4, 5, 6)));
   const std::pair<const char*, const char*> cases[] = {
       {"- id: 106\n  p_AinG: [1, .nan, 3]\n", "'.nan' is not a finite number"},
       {"- id: 106\n  p_AinG: [1, 2, 3]\n  p_AinG_cov: [.inf, 0, 0, 0, 1, 0, 0, 0, 1]\n", "p_AinG_cov"},
-      {"- id: 106\n  p_AinG: [1, 2, 3]\n- id: 106\n  p_AinG: [4, 5, 6]\n", "anchor 106 again"},
   };
   int i = 0;
   for (const auto& [text, needle] : cases) {
