@@ -23,7 +23,11 @@
 ///  - Micro/<s>/<N>: reference scenario (a 6-state p, v body at 100 Hz, N stationary 3-state
 ///    anchors, body–anchor ranges at 10 Hz each, ring i → i+1 ranges, σ 0.1 m): one range update;
 ///  - Sequence/<s>: a whole simulated paper sequence (seed 1) through EstimatorNode (needs the
-///    simulator library), counter realtime_factor.
+///    simulator library), counter realtime_factor;
+///  - AlignerSolve/<window_s>: one in-motion alignment (MotionAligner::solve: the multi-start
+///    Levenberg–Marquardt fit of IMU and tag–anchor ranges) over the last <window_s> seconds of
+///    that sequence before t = 52 s, in flight; the node runs it while uninitialized, lost or
+///    degraded, and on real recordings it is most of a run's time (needs the simulator library).
 /// Covariances are restored from the warm-up snapshot every 1000 iterations (outside the timing).
 
 #include <benchmark/benchmark.h>
@@ -37,6 +41,7 @@
 #include "estimator/filter/joint_set_bound.h"
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/node/estimator_node.h"
+#include "estimator/node/motion_aligner.h"
 #include "estimator/testing/synthetic_scenario.h"
 #include "estimator/uwb/range_model.h"
 #ifdef MESHNAV_BENCH_WITH_SIM
@@ -377,6 +382,33 @@ void Sequence(benchmark::State& state, std::string strategy) {
   state.counters["realtime_factor"] =
       benchmark::Counter(dur * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
+
+void AlignerSolve(benchmark::State& state, double window_s) {
+  const Dataset& ds = paperSequence();
+  constexpr double kEnd_s = 52.0;
+  MotionAlignerOptions o;
+  o.window_s = window_s;
+  MotionAligner aligner(o, ds.setup.rel_tag_positions);
+  for (const ImuSample& s : ds.imu)
+    if (s.t.sec() >= kEnd_s - window_s - 0.1 && s.t.sec() <= kEnd_s) aligner.addImu(s);
+  int n_ranges = 0;
+  for (const RangeSample& r : ds.ranges) {
+    if (r.t.sec() < kEnd_s - window_s || r.t.sec() > kEnd_s) continue;
+    const bool tag_first = ds.setup.rel_tag_positions.count(r.id_initiator) > 0;
+    const SensorId tag = tag_first ? r.id_initiator : r.id_responder, anchor = tag_first ? r.id_responder : r.id_initiator;
+    if (!ds.setup.rel_tag_positions.count(tag) || !ds.setup.abs_anchor_positions.count(anchor)) continue;
+    aligner.addRange({r.t, tag, anchor, ds.setup.abs_anchor_positions.at(anchor), r.range_m, 0.1});
+    ++n_ranges;
+  }
+  bool aligned = false;
+  for (auto _ : state) {
+    const auto res = aligner.solve(Eigen::Vector3d::Zero());
+    aligned = res.has_value();
+    benchmark::DoNotOptimize(res);
+  }
+  state.counters["ranges"] = n_ranges;
+  state.counters["aligned"] = aligned ? 1 : 0;
+}
 #endif
 
 void registerAll() {
@@ -411,6 +443,9 @@ void registerAll() {
 #ifdef MESHNAV_BENCH_WITH_SIM
   for (const char* s : listedStrategies())
     benchmark::RegisterBenchmark(("Sequence/" + std::string(s)).c_str(), Sequence, s)->Unit(benchmark::kMillisecond);
+  for (double w : {6.0, 12.0})
+    benchmark::RegisterBenchmark(("AlignerSolve/" + std::to_string(static_cast<int>(w))).c_str(), AlignerSolve, w)
+        ->Unit(benchmark::kMillisecond);
 #endif
 }
 

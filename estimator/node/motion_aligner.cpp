@@ -58,8 +58,12 @@ MotionAligner::Unknowns MotionAligner::Unknowns::plus(const VecU& d) const {
   return x;
 }
 
-Eigen::Vector3d MotionAligner::bodyTerm(const Increments& inc, const Unknowns& x, const Eigen::Vector3d& p_TinI) const {
-  const Eigen::Matrix3d C = inc.C * so3::expMap(inc.JC * x.dbg);
+Eigen::Matrix3d MotionAligner::attitude(const Increments& inc, const Unknowns& x) {
+  return inc.C * so3::expMap(inc.JC * x.dbg);
+}
+
+Eigen::Vector3d MotionAligner::bodyTerm(const Increments& inc, const Unknowns& x, const Eigen::Vector3d& p_TinI,
+                                        const Eigen::Matrix3d& C) {
   return inc.S + inc.JS * x.dbg - inc.M * x.ba + C * p_TinI;
 }
 
@@ -152,72 +156,62 @@ std::vector<MotionAligner::Obs> MotionAligner::buildObservations(const Eigen::Ve
   return obs;
 }
 
-double MotionAligner::residual(const Obs& o, const Unknowns& x) const {
-  const Eigen::Vector3d g = gravityG();
-  const double tau = o.inc.tau_s;
-  const Eigen::Vector3d p_TinG =
-      x.p0 + x.v0 * tau + 0.5 * g * tau * tau + x.R0 * bodyTerm(o.inc, x, tags_p_TinI_.at(o.r.tag));
-  return o.r.d_m - (o.r.p_AinG - p_TinG).norm();
-}
-
-Eigen::Matrix<double, 1, 16> MotionAligner::jacobian(const Obs& o, const Unknowns& x) const {
+double MotionAligner::residual(const Obs& o, const Unknowns& x, Eigen::Matrix<double, 1, 16>* J) const {
   // r = d − ‖p_A − p_T‖: ∂r/∂p_T = uᵀ with u the unit vector from the tag to the anchor;
   // ∂p_T/∂[p₀, v₀, δθ, b_a, δb_ω] = [I, τ I, −R₀[w]×, −R₀ M, R₀ (J_S − C[p_TinI]× J_C)],
   // w = S − M b_a + C p_TinI (the J_C term to first order around the current δb_ω).
   const Eigen::Vector3d g = gravityG();
   const double tau = o.inc.tau_s;
   const Eigen::Vector3d& lever = tags_p_TinI_.at(o.r.tag);
-  const Eigen::Vector3d w = bodyTerm(o.inc, x, lever);
+  const Eigen::Matrix3d C = attitude(o.inc, x);
+  const Eigen::Vector3d w = bodyTerm(o.inc, x, lever, C);
   const Eigen::Vector3d p_TinG = x.p0 + x.v0 * tau + 0.5 * g * tau * tau + x.R0 * w;
-  const Eigen::Vector3d u = (o.r.p_AinG - p_TinG).normalized();
-  const Eigen::Matrix3d C = o.inc.C * so3::expMap(o.inc.JC * x.dbg);
-  Eigen::Matrix<double, 1, 16> J;
-  J(kBh) = 0.0;
-  J.segment<3>(0) = u.transpose();
-  J.segment<3>(3) = tau * u.transpose();
-  J.segment<3>(6) = -u.transpose() * x.R0 * so3::skew(w);
-  J.segment<3>(9) = -u.transpose() * x.R0 * o.inc.M;
-  J.segment<3>(12) = u.transpose() * x.R0 * (o.inc.JS - C * so3::skew(lever) * o.inc.JC);
-  return J;
+  if (J) {
+    const Eigen::Vector3d u = (o.r.p_AinG - p_TinG).normalized();
+    (*J)(kBh) = 0.0;
+    J->segment<3>(0) = u.transpose();
+    J->segment<3>(3) = tau * u.transpose();
+    J->segment<3>(6) = -u.transpose() * x.R0 * so3::skew(w);
+    J->segment<3>(9) = -u.transpose() * x.R0 * o.inc.M;
+    J->segment<3>(12) = u.transpose() * x.R0 * (o.inc.JS - C * so3::skew(lever) * o.inc.JC);
+  }
+  return o.r.d_m - (o.r.p_AinG - p_TinG).norm();
 }
 
-double MotionAligner::residual(const HeightObs& o, const Unknowns& x) const {
-  const Eigen::Vector3d g = gravityG();
-  const double tau = o.inc.tau_s;
-  const Eigen::Vector3d s = x.p0 + x.v0 * tau + 0.5 * g * tau * tau + x.R0 * bodyTerm(o.inc, x, options_.p_IH);
-  const double c = options_.height_tilt_correction ? (x.R0 * o.inc.C * so3::expMap(o.inc.JC * x.dbg))(2, 2) : 1.0;
-  return o.h.range_m - (s.z() / c + x.bh);
-}
-
-Eigen::Matrix<double, 1, 16> MotionAligner::jacobian(const HeightObs& o, const Unknowns& x) const {
+double MotionAligner::residual(const HeightObs& o, const Unknowns& x, Eigen::Matrix<double, 1, 16>* J) const {
   // ĥ = s_z / c + b_H with s = p₀ + v₀τ + ½gτ² + R₀ w (w as for a tag, lever p_IH), c = e_zᵀ R₀ C e_z:
   // ∂s_z = e_zᵀ [I, τ I, −R₀[w]×, −R₀ M, R₀ (J_S − C[p_IH]× J_C)],
   // ∂c/∂δθ = −e_zᵀ R₀ [C e_z]×, ∂c/∂δb_ω = −e_zᵀ R₀ C [e_z]× J_C; r = h − ĥ, so J = −∂ĥ.
   const Eigen::Vector3d g = gravityG();
   const double tau = o.inc.tau_s;
   const Eigen::Vector3d& lever = options_.p_IH;
-  const Eigen::Vector3d w = bodyTerm(o.inc, x, lever);
+  const Eigen::Matrix3d E = so3::expMap(o.inc.JC * x.dbg);
+  const Eigen::Matrix3d C = o.inc.C * E;  // attitude(o.inc, x)
+  const Eigen::Vector3d w = bodyTerm(o.inc, x, lever, C);
   const Eigen::Vector3d s = x.p0 + x.v0 * tau + 0.5 * g * tau * tau + x.R0 * w;
-  const Eigen::Matrix3d C = o.inc.C * so3::expMap(o.inc.JC * x.dbg);
-  const Eigen::RowVector3d ez = Eigen::RowVector3d::UnitZ();
-  Eigen::Matrix<double, 1, 15> ds;
-  ds.segment<3>(0) = ez;
-  ds.segment<3>(3) = tau * ez;
-  ds.segment<3>(6) = -ez * x.R0 * so3::skew(w);
-  ds.segment<3>(9) = -ez * x.R0 * o.inc.M;
-  ds.segment<3>(12) = ez * x.R0 * (o.inc.JS - C * so3::skew(lever) * o.inc.JC);
-  Eigen::Matrix<double, 1, 15> dh = ds;
-  if (options_.height_tilt_correction) {
-    const double c = (x.R0 * C)(2, 2);
-    Eigen::Matrix<double, 1, 15> dc = Eigen::Matrix<double, 1, 15>::Zero();
-    dc.segment<3>(6) = -ez * x.R0 * so3::skew(C * Eigen::Vector3d::UnitZ());
-    dc.segment<3>(12) = -ez * x.R0 * C * so3::skew(Eigen::Vector3d::UnitZ()) * o.inc.JC;
-    dh = ds / c - s.z() / (c * c) * dc;
+  // c in the residual as (R₀ C_inc) E and in the Jacobian as R₀ (C_inc E): the same number up to
+  // rounding, each kept as it was computed before the two functions were merged (same results).
+  const double c = options_.height_tilt_correction ? (x.R0 * o.inc.C * E)(2, 2) : 1.0;
+  if (J) {
+    const Eigen::RowVector3d ez = Eigen::RowVector3d::UnitZ();
+    Eigen::Matrix<double, 1, 15> ds;
+    ds.segment<3>(0) = ez;
+    ds.segment<3>(3) = tau * ez;
+    ds.segment<3>(6) = -ez * x.R0 * so3::skew(w);
+    ds.segment<3>(9) = -ez * x.R0 * o.inc.M;
+    ds.segment<3>(12) = ez * x.R0 * (o.inc.JS - C * so3::skew(lever) * o.inc.JC);
+    Eigen::Matrix<double, 1, 15> dh = ds;
+    if (options_.height_tilt_correction) {
+      const double cj = (x.R0 * C)(2, 2);
+      Eigen::Matrix<double, 1, 15> dc = Eigen::Matrix<double, 1, 15>::Zero();
+      dc.segment<3>(6) = -ez * x.R0 * so3::skew(C * Eigen::Vector3d::UnitZ());
+      dc.segment<3>(12) = -ez * x.R0 * C * so3::skew(Eigen::Vector3d::UnitZ()) * o.inc.JC;
+      dh = ds / cj - s.z() / (cj * cj) * dc;
+    }
+    J->head<15>() = -dh;
+    (*J)(kBh) = -1.0;
   }
-  Eigen::Matrix<double, 1, 16> J;
-  J.head<15>() = -dh;
-  J(kBh) = -1.0;
-  return J;
+  return o.h.range_m - (s.z() / c + x.bh);
 }
 
 }  // namespace meshnav::estimator

@@ -209,15 +209,19 @@ class MotionAligner {
              Unknowns& x, Info* info) const;
   /// huber::varianceFactor of the inlier ranges: how much noisier than their σ they fit.
   double robustVarianceFactor(const std::vector<Obs>& obs, const Unknowns& x) const;
-  double residual(const Obs& o, const Unknowns& x) const;
-  /// ∂residual/∂[δp₀, δv₀, δθ, δb_a, δb_ω, δb_H] (analytic; the noise-free unit test converges with it).
-  Eigen::Matrix<double, 1, 16> jacobian(const Obs& o, const Unknowns& x) const;
-  /// Height residual h − ĥ and its Jacobian (same unknowns).
-  double residual(const HeightObs& o, const Unknowns& x) const;
-  Eigen::Matrix<double, 1, 16> jacobian(const HeightObs& o, const Unknowns& x) const;
-  /// Tag position (τ of `inc`) and the body-frame vector w it is R₀ w away from the
-  /// gravity/velocity terms.
-  Eigen::Vector3d bodyTerm(const Increments& inc, const Unknowns& x, const Eigen::Vector3d& p_TinI) const;
+  /// Range residual d − ‖p_A − p_T‖ and, when `J` is given, its Jacobian ∂r/∂[δp₀, δv₀, δθ, δb_a, δb_ω,
+  /// δb_H] (analytic; the noise-free unit test converges with it), from one evaluation of the model:
+  /// the Levenberg–Marquardt loop needs both at every observation, and the attitude C(τ) Exp(J_C δb_ω)
+  /// (an SO(3) exponential per observation) is the fit's largest cost.
+  double residual(const Obs& o, const Unknowns& x, Eigen::Matrix<double, 1, 16>* J = nullptr) const;
+  /// Height residual h − ĥ and, when `J` is given, its Jacobian (same unknowns).
+  double residual(const HeightObs& o, const Unknowns& x, Eigen::Matrix<double, 1, 16>* J = nullptr) const;
+  /// C(τ) Exp(J_C δb_ω): the body attitude at τ relative to R₀, corrected to first order in δb_ω.
+  static Eigen::Matrix3d attitude(const Increments& inc, const Unknowns& x);
+  /// The body-frame vector w = S − M b_a + C p_TinI (δb_ω-corrected) with which the point p_TinI
+  /// of the body (τ of `inc`) is R₀ w away from the gravity/velocity terms; `C` = attitude(inc, x).
+  static Eigen::Vector3d bodyTerm(const Increments& inc, const Unknowns& x, const Eigen::Vector3d& p_TinI,
+                                  const Eigen::Matrix3d& C);
   ImuState endState(const Unknowns& x, const Increments& end, const Eigen::Vector3d& bias_gyro) const;
   std::vector<Unknowns> starts(const std::vector<Obs>& obs) const;
   /// Covariance, end state and the acceptance checks of the best fit.

@@ -70,26 +70,30 @@ double MotionAligner::fit(const std::vector<Obs>& obs, const std::vector<HeightO
   };
   double c = cost(x), lambda = 1e-3;
   MatU H;
+  Eigen::Matrix<double, 1, 16> J;
+  // H = Σ w Jᵀ J in its lower triangle only (what LDLT reads; symmetric at the end).
+  auto accumulate = [&](double w, double r, VecU& g) {
+    for (int i = 0; i < kDim; ++i) {
+      const double wj = w * J(i);
+      for (int k = 0; k <= i; ++k) H(i, k) += wj * J(k);
+      g(i) += wj * r;
+    }
+  };
   for (int it = 0; it < 25; ++it) {
     H.setZero();
     VecU g = VecU::Zero();
     for (const Obs& o : obs) {
       if (!o.use) continue;
-      const double r = residual(o, x);
+      const double r = residual(o, x, &J);
       const double e = std::abs(r) / o.r.sigma_m;
-      const double w = huber::weight(e) / (o.r.sigma_m * o.r.sigma_m);
-      const Eigen::Matrix<double, 1, 16> J = jacobian(o, x);
-      H += w * J.transpose() * J;
-      g += w * J.transpose() * r;
+      accumulate(huber::weight(e) / (o.r.sigma_m * o.r.sigma_m), r, g);
     }
     for (const HeightObs& o : heights) {
       if (!o.use) continue;
-      const double r = residual(o, x);
-      const double w = huber::weight(std::abs(r) / o.h.sigma_m) / (o.h.sigma_m * o.h.sigma_m);
-      const Eigen::Matrix<double, 1, 16> J = jacobian(o, x);
-      H += w * J.transpose() * J;
-      g += w * J.transpose() * r;
+      const double r = residual(o, x, &J);
+      accumulate(huber::weight(std::abs(r) / o.h.sigma_m) / (o.h.sigma_m * o.h.sigma_m), r, g);
     }
+    H.triangularView<Eigen::StrictlyUpper>() = H.transpose();
     H(kBh, kBh) += prior_bh;
     g(kBh) += prior_bh * x.bh;
     H.block<3, 3>(9, 9).diagonal().array() += prior_ba;
