@@ -232,6 +232,9 @@ class EstimatorNode {
   void propagateFilter(const ImuReading& u, Timestamp t);
   /// Feeds the aligner (and stillness) with an input in arrival order.
   void feedAligner(const EstimatorInput& in);
+  /// aligner_.solve timed as the step "align": it runs inside the input that triggered it and is a
+  /// real recording's longest step (tens of ms per solve on ISAS-Walk1).
+  std::optional<AlignmentResult> solveAlignment(const Eigen::Vector3d& bias_gyro_rad_s);
   void tryMotionInitialization(Timestamp t);
   /// A full alignment window after the first initialization (not earlier: a window that still
   /// held the rest before a hand-held start chose the wrong side on ISAS-Walk1), and again a

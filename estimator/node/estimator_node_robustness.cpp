@@ -210,11 +210,16 @@ bool EstimatorNode::landedAt(Timestamp t) const {
   return it != still_at_.end() && it->second;
 }
 
+std::optional<AlignmentResult> EstimatorNode::solveAlignment(const Eigen::Vector3d& bias_gyro_rad_s) {
+  ScopedStepTimer timer(timings_, "align");
+  return aligner_.solve(bias_gyro_rad_s);
+}
+
 void EstimatorNode::tryMotionInitialization(Timestamp t) {
   if (last_align_try_ && (t - *last_align_try_).sec() < 0.5) return;
   last_align_try_ = t;
   const int relinearized_before = aligner_.relinearizations();
-  const auto r = aligner_.solve(Eigen::Vector3d::Zero());
+  const auto r = solveAlignment(Eigen::Vector3d::Zero());
   if (aligner_.relinearizations() > relinearized_before) diag_.count("init_motion_relinearized");
   if (!r) {
     diag_.count("init_motion_refused");
@@ -226,8 +231,11 @@ void EstimatorNode::tryMotionInitialization(Timestamp t) {
 void EstimatorNode::checkGravityDirection(Timestamp t) {
   gravity_check_at_.reset();
   ++gravity_checks_;
-  const auto c = cur_.filter ? aligner_.checkGravityDirection(cur_.filter->state().imu.bias_gyro_rad_s)
-                             : aligner_.checkGravityDirection(Eigen::Vector3d::Zero());
+  const auto c = [&] {
+    ScopedStepTimer timer(timings_, "align");  // the check alone: adoptGravityAlongPlusZ times its own solve
+    return cur_.filter ? aligner_.checkGravityDirection(cur_.filter->state().imu.bias_gyro_rad_s)
+                       : aligner_.checkGravityDirection(Eigen::Vector3d::Zero());
+  }();
   if (!c) {
     spdlog::info("estimator: gravity direction not checked at t={}: {}", formatSeconds(t), aligner_.reason());
     if (gravity_checks_ < kMaxGravityChecks) gravity_check_at_ = t + Duration::fromSec(options_.init.motion_window_s);
@@ -266,7 +274,7 @@ void EstimatorNode::checkGravityDirection(Timestamp t) {
 
 void EstimatorNode::adoptGravityAlongPlusZ(Timestamp t) {
   last_flip_try_ = t;
-  const auto r = aligner_.solve(cur_.filter->state().imu.bias_gyro_rad_s);
+  const auto r = solveAlignment(cur_.filter->state().imu.bias_gyro_rad_s);
   if (!r) {
     diag_.count("gravity_flip_refused");
     return;
@@ -374,7 +382,7 @@ void EstimatorNode::tryRecover(Timestamp t) {
   if (last_recovery_try_ && (t - *last_recovery_try_).sec() < options_.recovery.retry_s) return;
   last_recovery_try_ = t;
   const bool lost = health_.health() == Health::Lost;
-  const auto r = aligner_.solve(cur_.filter->state().imu.bias_gyro_rad_s);
+  const auto r = solveAlignment(cur_.filter->state().imu.bias_gyro_rad_s);
   if (!r) {
     if (!lost) return;  // degraded: nothing to compare with
     diag_.count("recovery_refused");

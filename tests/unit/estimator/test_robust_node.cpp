@@ -136,6 +136,12 @@ TEST(RobustNode, HandheldWalkInitializesWithoutALandedPhase) {
   ASSERT_TRUE(node.initialized()) << node.waitingFor();
   EXPECT_LT(res.max_error_after_m, 0.6);
   EXPECT_NE(res.final_health, Health::Lost);
+  // Every in-motion alignment (the refused tries and the one that initialized, plus any recovery
+  // or gravity check) ran inside an input's handling and is timed as the step "align".
+  const auto steps = node.timings().stats();
+  ASSERT_TRUE(steps.count("align"));
+  EXPECT_GE(steps.at("align").count, 1 + node.diagnostics().get("init_motion_refused"));
+  EXPECT_GT(steps.at("align").median_us, 0.0);
 }
 
 TEST(RobustNode, CarriedHeightHoldsAWalkUnderThreeNearlyCoplanarAnchors) {
