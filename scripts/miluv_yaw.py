@@ -11,6 +11,10 @@ Vicon) and a meshnav_run output folder:
   * the IMU-to-body rotation fitted to the truth's accelerations on each half of the flight
     (Wahba's problem): if yaw were well excited, both halves would give the same mounting yaw.
 
+σ_yaw is √qyy of estimate.csv, the variance about the IMU's z axis: the yaw variance up to the
+tilt (a few degrees on MILUV). "In flight" is the truth's span less 9 s at the start and 4 s at
+the end (MILUV's take-off and landing). The CSVs are read comma-separated, as meshnav writes them.
+
 Usage: /usr/bin/python3 scripts/miluv_yaw.py DATASET_DIR RUN_DIR [--step S]
 """
 

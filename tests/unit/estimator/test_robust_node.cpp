@@ -141,7 +141,6 @@ TEST(RobustNode, HandheldWalkInitializesWithoutALandedPhase) {
   const auto steps = node.timings().stats();
   ASSERT_TRUE(steps.count("align"));
   EXPECT_GE(steps.at("align").count, 1 + node.diagnostics().get("init_motion_refused"));
-  EXPECT_GT(steps.at("align").median_us, 0.0);
 }
 
 TEST(RobustNode, CarriedHeightHoldsAWalkUnderThreeNearlyCoplanarAnchors) {
