@@ -15,6 +15,11 @@
 ///   by one jump all run, in order). Commands carry the data time at which they are issued.
 ///   collect/calibrate/abort → one CALIB_CMD; remove → one ESTIMATOR_CMD RemoveInstance per id.
 ///   Data time going backwards never re-runs a step (counted as "time_backwards").
+/// - **Clock rebased** (`onClockRebased`: the data clock followed a jump of the whole stream that
+///   its TimeGuard agreed on). Before any step ran and with t0 taken from the data, the first time
+///   was the bad one (a sender's wrong first stamp): the mission starts again at the new time, t0
+///   with it ("t0_retaken"). Otherwise t0 stays (a --t0 of the user's, or steps already run are
+///   not run again) and the node follows the new time line ("clock_rebased").
 /// - **Resends** (a lossy link, docs/deployment.md): a CALIB_CMD counts as answered once a
 ///   CALIB_STATUS shows its effect — Collect: its anchors (all: every listed one) no longer `idle`;
 ///   Calibrate: its anchors `calibrated` or `refused` (all: none `collecting`); Abort: none of its
@@ -66,6 +71,9 @@ class MissionNode {
   void onPose(const PoseEstimate& p) { onTime(p.t); }
   /// Advances data time; runs the start, the due steps and the heartbeat.
   void onTime(Timestamp data_time);
+  /// The data clock jumped to `data_time` by agreement of its inputs (see the file comment), then
+  /// as onTime.
+  void onClockRebased(Timestamp data_time);
   void onCalibStatus(const CalibStatus& s);
   void onEstimatorStatus(const EstimatorStatus& s);
 
@@ -93,6 +101,7 @@ class MissionNode {
   MissionNodeOptions options_;
   Diagnostics diag_;
   std::optional<Timestamp> t0_;
+  bool t0_from_data_ = false;  ///< t0 was the first data time (no setT0)
   Timestamp now_;
   bool started_ = false;
   size_t next_step_ = 0;

@@ -57,7 +57,10 @@ int main(int argc, char** argv) {
     mission::DataClock clock;
     auto onDataTime = [&](Timestamp t) {
       if (!clock.advance(t, lcm.diagnostics())) return;
-      node.onTime(t);
+      if (clock.rebased())
+        node.onClockRebased(t);
+      else
+        node.onTime(t);
       if (node.finished() && !completion.finished()) {
         completion.onFinished(replay::wallUtimeNow());
         spdlog::info("mission finished at data t = {} s{}", formatSeconds(t),

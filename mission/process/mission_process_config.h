@@ -60,7 +60,11 @@ void finishMissionProcessConfig(MissionProcessConfig& config);
 /// DATA_TIME:time_ahead: one message stamped far ahead would otherwise fire every remaining step at
 /// once and leave every real time "not newer" afterwards. Older times are harmless (a POSE lagging
 /// the ranges): only beyond 600 s are they counted (DATA_TIME:time_behind). A followed jump back
-/// (a replay started again) is reported as DATA_TIME:jumped_back; the mission does not start over.
+/// (a replay started again) is reported as DATA_TIME:jumped_back; `rebased()` tells the caller,
+/// which hands the jump to MissionNode::onClockRebased: steps already run are not run again, and a
+/// mission whose t0 came from a wrong first stamp starts again at the new time. A wrong first stamp
+/// less than 600 s ahead is not told apart from POSE lagging the ranges: it delays the mission by
+/// its error (the process's --t0 avoids it).
 class DataClock {
  public:
   DataClock() : guard_(TimeGuardOptions{10.0, 50, 600.0}) {}
@@ -75,13 +79,17 @@ class DataClock {
                                                " s to t=" + formatSeconds(t) +
                                                " s; steps already run are not run again");
     now_ = t;
+    rebased_ = v == TimeGuard::Verdict::Rebased;
     return true;
   }
   std::optional<Timestamp> now() const { return now_; }
+  /// The last advance() that returned true followed a jump of the whole stream (TimeGuard rebase).
+  bool rebased() const { return rebased_; }
 
  private:
   TimeGuard guard_;
   std::optional<Timestamp> now_;
+  bool rebased_ = false;
 };
 
 /// Decides when the process of a finished mission may exit. When the mission's last step is a

@@ -24,7 +24,10 @@ void MissionNode::setT0(Timestamp t0) {
 
 void MissionNode::onTime(Timestamp t) {
   if (!started_) {
-    if (!t0_) t0_ = t;
+    if (!t0_) {
+      t0_ = t;
+      t0_from_data_ = true;
+    }
     started_ = true;
     now_ = t;
     spdlog::info("mission: started at t={} s (t0={} s), {} steps from {}", formatSeconds(t), formatSeconds(*t0_),
@@ -58,6 +61,34 @@ void MissionNode::onTime(Timestamp t) {
     }
     publishStatus();
   }
+}
+
+void MissionNode::onClockRebased(Timestamp t) {
+  if (!started_) {
+    onTime(t);
+    return;
+  }
+  if (next_step_ == 0 && t0_from_data_) {
+    diag_.count("t0_retaken");
+    spdlog::warn("mission: data time jumped from t={} s to t={} s before any step ran; the first data time was "
+                 "wrong, so the mission starts again with t0 = {} s",
+                 formatSeconds(now_), formatSeconds(t), formatSeconds(t));
+    // Nothing ran but the start: start again, with the start's Collect at the new time (the
+    // calibrator refuses the old one as out of time, so resending it could never be answered).
+    started_ = false;
+    t0_.reset();
+    t0_from_data_ = false;
+    next_status_.reset();
+    unanswered_.clear();
+  } else {
+    diag_.count("clock_rebased");
+    spdlog::warn("mission: data time jumped from t={} s to t={} s; t0 stays {} s ({}), {} of {} steps ran",
+                 formatSeconds(now_), formatSeconds(t), formatSeconds(*t0_),
+                 t0_from_data_ ? "steps already ran" : "set by the user", next_step_, mission_.steps.size());
+    now_ = t;
+    next_status_.reset();
+  }
+  onTime(t);
 }
 
 void MissionNode::runStep(const MissionStep& step) {

@@ -13,6 +13,7 @@
 #include "calibrator/calibration_io.h"
 #include "common/anchor_init_io.h"
 #include "calibrator/process/calibrator_process_config.h"
+#include "mission/mission_node.h"
 #include "mission/process/mission_process_config.h"
 #include "tests/support/test_util.h"
 
@@ -365,6 +366,37 @@ TEST(MissionCompletion, CalibrateAllWaitsUntilNothingCollects) {
 }
 
 }  // namespace
+
+TEST(DataClock, AWrongFirstStampIsFollowedBackAndTheMissionStartsAgain) {
+  // The mission process's wiring (mission/process/main.cpp): the clock's rebase goes to the node.
+  std::vector<CalibCommand> calib;
+  mission::MissionSinks sinks;
+  sinks.calib_cmd = [&](const CalibCommand& c) { calib.push_back(c); };
+  mission::MissionNode node(mission::parseMission("steps:\n  - {t: 5.0, action: calibrate, anchors: [106]}\n", "t"),
+                            sinks);
+  mission::DataClock clock;
+  Diagnostics diag;
+  int rebases = 0;
+  auto tick = [&](double t_s) {
+    const Timestamp t = Timestamp::fromSec(t_s);
+    if (!clock.advance(t, diag)) return;
+    rebases += clock.rebased();
+    if (clock.rebased())
+      node.onClockRebased(t);
+    else
+      node.onTime(t);
+  };
+  tick(3700.0);  // wrong: an hour ahead of the data
+  for (int i = 0; i <= 1000; ++i) tick(20.0 + 0.01 * i);
+  EXPECT_EQ(rebases, 1);
+  EXPECT_EQ(diag.get("DATA_TIME:jumped_back"), 1);
+  EXPECT_EQ(node.diagnostics().get("t0_retaken"), 1);
+  ASSERT_TRUE(node.t0().has_value());
+  EXPECT_NEAR(node.t0()->sec(), 20.49, 0.02);  // the rebase after 50 agreeing inputs
+  ASSERT_TRUE(node.finished());
+  ASSERT_EQ(calib.size(), 3u);  // Collect (wrong time), Collect again, Calibrate
+  EXPECT_NEAR(calib[2].t.sec(), node.t0()->sec() + 5.0, 0.011);
+}
 
 TEST(DataClock, PassesAdvancingTimesAndRefusesOneFarAheadWithACounter) {
   // Found by an audit: one POSE stamped an hour ahead fired every remaining mission step at once,

@@ -109,6 +109,59 @@ TEST(MissionNode, SetT0OverridesTheFirstSample) {
   EXPECT_EQ(node.t0()->sec(), 10.0);
 }
 
+TEST(MissionNode, AWrongFirstStampIsRetakenWhenTheClockRebasesBeforeAnyStep) {
+  // Left by an audit: the mission's t0 came from the very first data time; when that one was wrong
+  // (an hour ahead) the data clock later followed the real stream back, but t0 stayed an hour
+  // ahead and no step ever ran (every real time was also counted as going backwards).
+  Recorder rec;
+  MissionNode node(paperLike(), rec.sinks());
+  node.onTime(Timestamp::fromSec(3700.0));  // the wrong first stamp
+  ASSERT_EQ(rec.calib.size(), 1u);          // the start's Collect, at the wrong time
+  node.onClockRebased(Timestamp::fromSec(100.0));
+  EXPECT_EQ(node.diagnostics().get("t0_retaken"), 1);
+  EXPECT_EQ(node.t0()->sec(), 100.0);
+  ASSERT_EQ(rec.calib.size(), 2u);  // the start's Collect again, at the real time
+  EXPECT_EQ(rec.calib[1].action, CalibCommand::Action::Collect);
+  EXPECT_DOUBLE_EQ(rec.calib[1].t.sec(), 100.0);
+  fly(node, 100.02, 149.0);
+  ASSERT_TRUE(node.finished());
+  ASSERT_EQ(rec.calib.size(), 5u);
+  EXPECT_NEAR(rec.calib[2].t.sec(), 180.0, 1e-6);  // 100 + 80 s
+  EXPECT_NEAR(rec.calib[4].t.sec(), 230.0, 1e-6);  // 100 + 130 s
+  EXPECT_EQ(node.diagnostics().get("time_backwards"), 0);
+}
+
+TEST(MissionNode, ARebasedClockKeepsAUserT0AndNeverRerunsAStep) {
+  {  // t0 given by the user: it stays, and the node follows the new time line
+    Recorder rec;
+    MissionNode node(paperLike(), rec.sinks());
+    node.setT0(Timestamp::fromSec(0.0));
+    node.onTime(Timestamp::fromSec(3700.0));  // wrong; with t0 = 0 every step is due
+    ASSERT_EQ(rec.calib.size(), 4u);
+    node.onClockRebased(Timestamp::fromSec(50.0));
+    EXPECT_EQ(node.diagnostics().get("clock_rebased"), 1);
+    EXPECT_EQ(node.diagnostics().get("t0_retaken"), 0);
+    EXPECT_EQ(node.t0()->sec(), 0.0);
+    fly(node, 50.02, 100.0);
+    EXPECT_EQ(rec.calib.size(), 4u);  // nothing ran twice
+    EXPECT_EQ(node.diagnostics().get("time_backwards"), 0);
+    EXPECT_NEAR(node.status().t.sec(), 150.02, 1e-6);  // it follows the new time line
+  }
+  {  // t0 from the data, but a step already ran: t0 stays, the remaining steps run on time
+    Recorder rec;
+    MissionNode node(paperLike(), rec.sinks());
+    fly(node, 0.0, 90.0);  // the first calibrate at 80 s ran
+    ASSERT_EQ(node.nextStep(), 1u);
+    node.onClockRebased(Timestamp::fromSec(95.0));  // a jump forward of the whole stream
+    EXPECT_EQ(node.diagnostics().get("clock_rebased"), 1);
+    EXPECT_EQ(node.t0()->sec(), 0.0);
+    EXPECT_EQ(node.nextStep(), 1u);
+    fly(node, 95.02, 10.0);
+    EXPECT_EQ(node.nextStep(), 2u);  // the second calibrate at t0 + 100 s
+    EXPECT_NEAR(rec.calib.back().t.sec(), 100.0, 0.03);
+  }
+}
+
 TEST(MissionNode, WithoutCollectAtStartAndWithoutSinksNothingBreaks) {
   Mission m = paperLike();
   m.collect_at_start = false;
