@@ -42,6 +42,8 @@ const Field kFields[] = {
     {"imu.extrapolate_max_period_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::extrapolate_max_period_s>, "readings between samples extrapolated when the last two are at most this far apart, else held; 0 = always held [s]"},
     {"imu.gap_sigma_acc_m_s2", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_sigma_acc_m_s2>, "held-reading error during a gap [m/s^2/sqrt(s)]"},
     {"imu.gap_sigma_gyro_rad_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_sigma_gyro_rad_s>, "held-reading error during a gap [rad/s/sqrt(s)]"},
+    {"imu.gap_readings", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_readings>, "mean | still | held: in a gap propagate on the low-passed readings, as if the vehicle kept its velocity and attitude, or on the last reading repeated"},
+    {"imu.gap_mean_time_constant_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_mean_time_constant_s>, "low-pass of the readings for gap_readings mean [s]"},
     {"init.duration_s", field<&EstimatorOptions::init, &InitOptions::duration_s>, "landed data before initializing [s]"},
     {"init.min_ranges", field<&EstimatorOptions::init, &InitOptions::min_ranges>, "tag-anchor ranges needed without initial_pose [-]"},
     {"init.assume_landed_without_flight_state", field<&EstimatorOptions::init, &InitOptions::assume_landed_without_flight_state>, "no FLIGHT_STATE received yet: treat as landed (else IMU stillness decides)"},
@@ -55,6 +57,7 @@ const Field kFields[] = {
     {"init.static_max_sigma_yaw_deg", field<&EstimatorOptions::init, &InitOptions::static_max_sigma_yaw_deg>, "static range fit refused above [deg]"},
     {"init.ambiguity_chi2", field<&EstimatorOptions::init, &InitOptions::ambiguity_chi2>, "second fit minimum within this cost: ambiguous, refused [-]"},
     {"init.motion_window_s", field<&EstimatorOptions::init, &InitOptions::motion_window_s>, "in-motion alignment window [s]"},
+    {"init.gravity_early_check_nis_ratio", field<&EstimatorOptions::init, &InitOptions::gravity_early_check_nis_ratio>, "median range NIS over its expected value that runs the gravity-direction check before its time, once, 0 = never [-]"},
     {"init.motion_max_window_s", field<&EstimatorOptions::init, &InitOptions::motion_max_window_s>, "in-motion alignment: longest window when ranges are sparse (count-based) [s]"},
     {"init.motion_min_span_s", field<&EstimatorOptions::init, &InitOptions::motion_min_span_s>, "in-motion alignment shortest window [s]"},
     {"init.motion_min_ranges", field<&EstimatorOptions::init, &InitOptions::motion_min_ranges>, "in-motion alignment ranges needed [-]"},
@@ -139,6 +142,7 @@ const Field kFields[] = {
     {"recovery.enabled", field<&EstimatorOptions::recovery, &RecoveryOptions::enabled>, "re-initialize from ranges and IMU when lost"},
     {"recovery.retry_s", field<&EstimatorOptions::recovery, &RecoveryOptions::retry_s>, "between two attempts while lost or degraded [s]"},
     {"recovery.degraded_disagreement_chi2", field<&EstimatorOptions::recovery, &RecoveryOptions::degraded_disagreement_chi2>, "degraded: re-initialize when the aligned pose disagrees beyond this chi^2 (4 dof), 0 = off [-]"},
+    {"recovery.after_gap_check_min_s", field<&EstimatorOptions::recovery, &RecoveryOptions::after_gap_check_min_s>, "after an IMU gap this long, compare the aligned pose with the filter as while degraded, for init.motion_window_s, 0 = off [s]"},
     {"flight_volume.enabled", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::enabled>, "use setup flight_volume: against the mirror image of coplanar known anchors on its walls or ceiling, and to drop initial fits outside it"},
     {"flight_volume.mirror_margin_m", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::mirror_margin_m>, "an estimate this far outside whose mirror image is inside is reflected [m]"},
     {"flight_volume.side_constraint_rate_hz", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::side_constraint_rate_hz>, "truncate the position to the volume's side of the anchors' plane at most this often, 0 = off [Hz]"},
@@ -210,19 +214,23 @@ void EstimatorOptions::validate() const {
   need(imu.max_dt_s > 0.0, "imu.max_dt_s > 0");
   need(imu.extrapolate_max_period_s >= 0.0, "imu.extrapolate_max_period_s >= 0");
   need(imu.gap_sigma_acc_m_s2 >= 0.0 && imu.gap_sigma_gyro_rad_s >= 0.0, "imu.gap_sigma_* >= 0");
+  need(imu.gap_readings == "mean" || imu.gap_readings == "still" || imu.gap_readings == "held",
+       "imu.gap_readings must be mean, still or held");
+  need(imu.gap_mean_time_constant_s > 0.0, "imu.gap_mean_time_constant_s > 0");
   need(init.static_max_sigma_yaw_deg > 0 && init.ambiguity_chi2 > 0 && init.motion_window_s >= init.motion_min_span_s &&
            init.motion_min_span_s > 0 && init.motion_min_ranges >= 8 && init.motion_max_sigma_yaw_deg > 0 &&
            init.motion_max_sigma_p_m > 0 && init.resume_max_age_s >= 0 && init.resume_max_acc_m_s2 >= 0 &&
            init.resume_max_rate_deg_s >= 0 && init.resume_max_outage_s >= 0,
        "init.motion_* (window >= min span > 0, min_ranges >= 8, sigmas > 0)");
   need(init.motion_relinearize_rad >= 0 && init.motion_relinearize_rad < M_PI, "init.motion_relinearize_rad in [0, pi)");
+  need(init.gravity_early_check_nis_ratio >= 0, "init.gravity_early_check_nis_ratio >= 0");
   need(health.window_s > 0 && health.min_ranges >= 1 && health.min_anchors >= 1 &&
            health.degraded_gated_fraction > 0 && health.degraded_gated_fraction <= health.lost_gated_fraction &&
            health.lost_gated_fraction <= 1 && health.degraded_mean_nis > 0 && health.degraded_no_aiding_s > 0 &&
            health.lost_no_aiding_s >= health.degraded_no_aiding_s && health.lost_sigma_p_m > 0 && health.hold_s >= 0,
        "health.* (0 < degraded <= lost fractions <= 1, positive times)");
-  need(recovery.retry_s > 0 && recovery.degraded_disagreement_chi2 >= 0,
-       "recovery.retry_s > 0, recovery.degraded_disagreement_chi2 >= 0");
+  need(recovery.retry_s > 0 && recovery.degraded_disagreement_chi2 >= 0 && recovery.after_gap_check_min_s >= 0,
+       "recovery.retry_s > 0, recovery.degraded_disagreement_chi2 >= 0, recovery.after_gap_check_min_s >= 0");
   need(flight_volume.mirror_margin_m >= 0 && flight_volume.side_constraint_rate_hz >= 0 &&
            flight_volume.candidate_margin_m >= 0,
        "flight_volume: mirror_margin_m >= 0, side_constraint_rate_hz >= 0, candidate_margin_m >= 0");

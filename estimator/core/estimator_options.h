@@ -33,6 +33,14 @@ struct ImuNoiseOptions {
   /// lets range updates explain position innovations by tilt, which leaks gravity afterwards
   /// (measured on a 3 s dropout: 15 m with 0.1 rad/s/√s, 7 m with 0; the recovery then fixes it).
   double gap_sigma_gyro_rad_s = 0.0;  ///< [rad/s/√s]
+  /// What the filter propagates on in a gap: "mean" (the acceleration in G and the angular rate
+  /// low-passed with `gap_mean_time_constant_s`: a steady turn continues, an oscillation such as a
+  /// gait is averaged out),
+  /// "still" (no acceleration in G, no rotation: the vehicle keeps its velocity and attitude) or
+  /// "held" (the last reading repeated, which integrates a momentary rotation rate over the whole
+  /// gap; before 2026-12-04 the only way).
+  std::string gap_readings = "mean";
+  double gap_mean_time_constant_s = 0.5;  ///< low-pass of the readings for gap_readings "mean" [s]
 };
 
 /// Static initialization while landed.
@@ -55,6 +63,10 @@ struct InitOptions {
   /// the best makes the pose ambiguous (refused) [-]
   double ambiguity_chi2 = 16.0;
   double motion_window_s = 12.0;            ///< in-motion alignment: data window [s]
+  /// Before the scheduled gravity check (a `motion_window_s` after the first initialization): a
+  /// median range NIS at least this many times its expected value runs the check at once (once;
+  /// it acts only on a decisive +z); 0 = never [-]
+  double gravity_early_check_nis_ratio = 5.0;
   /// In-motion alignment: with fewer than `motion_min_ranges` ranges in `motion_window_s` (sparse
   /// ranging), the window reaches back until it holds them, at most this far [s]
   double motion_max_window_s = 40.0;
@@ -217,6 +229,9 @@ struct RecoveryOptions {
   /// While `degraded`, also align every `retry_s` and re-initialize when the aligned pose and the
   /// filter's disagree beyond this χ² (4 dof: position and yaw, both covariances) [-]; 0: off.
   double degraded_disagreement_chi2 = 23.5;
+  /// After an IMU gap at least this long, for `init.motion_window_s`, the same comparison as while
+  /// degraded (the gap's dead reckoning may be metres off before the gate notices) [s]; 0: off.
+  double after_gap_check_min_s = 1.0;
 };
 
 /// The setup's `flight_volume` (docs/robustness.md "The flight volume"): initialization drops fits

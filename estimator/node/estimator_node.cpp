@@ -46,6 +46,7 @@ EstimatorNode::Snapshot EstimatorNode::Snapshot::copy() const {
   s.rest_rate = rest_rate;
   s.last_carried_height = last_carried_height;
   s.noise_adapter = noise_adapter;
+  s.mean_reading = mean_reading;
   return s;
 }
 
@@ -148,6 +149,8 @@ void EstimatorNode::resetAll() {
   gravity_checks_ = 0;
   gravity_z_sign_ = -1.0;
   gravity_flip_pending_ = false;
+  gravity_early_check_due_ = gravity_early_checked_ = false;
+  check_after_gap_until_.reset();
   last_flip_try_.reset();
   aligner_.setGravityAlongPlusZ(false);
   zupt_model_ = ZuptModel(Eigen::Vector3d(0.0, 0.0, -options_.gravity_m_s2));
@@ -253,6 +256,7 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     return;
   }
   if (std::holds_alternative<ImuSample>(in)) {
+    if (gravity_early_check_due_) earlyGravityCheck(t);
     if (gravity_check_at_ && t >= *gravity_check_at_) checkGravityDirection(t);
     if (gravity_flip_pending_ && (!last_flip_try_ || (t - *last_flip_try_).sec() >= 0.5)) adoptGravityAlongPlusZ(t);
   }
@@ -337,10 +341,13 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
   FusionStrategy& f = *cur_.filter;
   const Timestamp t0 = f.state().t;
   // Gaps on the IMU's own time line (range and baro updates move the filter's time meanwhile).
-  if (cur_.last_imu && (s.t - cur_.last_imu->t).sec() > options_.imu.max_dt_s)
+  if (const double gap_s = cur_.last_imu ? (s.t - cur_.last_imu->t).sec() : 0.0; gap_s > options_.imu.max_dt_s) {
     event(first, "imu_gap",
-          where("IMU", s.t) + ": no IMU sample for " + std::to_string((s.t - cur_.last_imu->t).sec()) +
-              " s; propagated on held readings with inflated noise");
+          where("IMU", s.t) + ": no IMU sample for " + std::to_string(gap_s) + " s; propagated on " +
+              options_.imu.gap_readings + " readings with inflated noise");
+    const double check_s = options_.recovery.after_gap_check_min_s;
+    if (check_s > 0.0 && gap_s >= check_s) check_after_gap_until_ = s.t + Duration::fromSec(options_.init.motion_window_s);
+  }
   if (s.t > t0) {
     // Readings interpolated to the middle of [t0, s.t] (held when no earlier reading).
     const ImuReading u =
@@ -351,6 +358,7 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
   const std::optional<ImuSample> previous = cur_.last_imu;
   cur_.prev_imu = previous;
   cur_.last_imu = s;
+  updateMeanReading(s, previous);
   if (!have_flight_state_) cur_.landed = landedAt(s.t);
   if (cur_.landed && previous && s.t > previous->t)
     cur_.rest_rate.add(s.gyro_rad_s, (s.t - previous->t).sec(), options_.imu.max_dt_s);

@@ -171,6 +171,10 @@ class EstimatorNode {
     RestRateMean rest_rate;  ///< gyro readings since last_zupt while landed (the ZUPT's ω row)
     Timestamp last_carried_height;  ///< last carried-height pseudo-reading (IMU time)
     ProcessNoiseAdapter noise_adapter;  ///< IMU noise scale from the range innovations
+    /// Low-passed (time constant imu.gap_mean_time_constant_s) acceleration and angular rate in
+    /// G (`acc_m_s2` = R̂(a_m − b̂_a) + g, `gyro_rad_s` = R̂(ω_m − b̂_ω)): what an IMU gap is
+    /// propagated on with imu.gap_readings "mean" (the rate's vertical part only).
+    std::optional<ImuReading> mean_reading;
     Snapshot copy() const;
   };
   struct Entry {
@@ -230,6 +234,12 @@ class EstimatorNode {
   /// Propagation on the readings `u` held over [filter time, t], with λ's and `u`'s extra white
   /// noise; the part beyond `imu.max_dt_s` after the last IMU sample gets the gap noise.
   void propagateFilter(const ImuReading& u, Timestamp t);
+  /// One propagation on `u` with the innovation-driven extra IMU noise (no gap handling).
+  void propagateFilterStep(const ImuReading& u, Timestamp t);
+  /// Low-passes the readings into cur_.mean_reading (restarted after a gap).
+  void updateMeanReading(const ImuSample& s, const std::optional<ImuSample>& previous);
+  /// Gravity in G: (0, 0, ∓|g|) by the gravity check's sign.
+  Eigen::Vector3d gravityG() const;
   /// Feeds the aligner (and stillness) with an input in arrival order.
   void feedAligner(const EstimatorInput& in);
   /// aligner_.solve timed as the step "align": it runs inside the input that triggered it and is a
@@ -244,6 +254,20 @@ class EstimatorNode {
   /// heights (which measure along −z), the filter is re-initialized by the aligner with gravity
   /// along +z of G and propagates with it from then on (`adoptGravityAlongPlusZ`).
   void checkGravityDirection(Timestamp t);
+  /// The median range NIS over its expected value, as the process-noise adapter took it: at or
+  /// above `init.gravity_early_check_nis_ratio` before the first check, the check runs at the next
+  /// IMU sample (`earlyGravityCheck`), once. A wrong gravity sign shows there first (ISAS-Walk1
+  /// started mid-walk: 12× within 2 s of an in-motion initialization, 3.3 m off by the scheduled check).
+  void noteRangeNisRatio(double ratio);
+  /// The early check: acts only when +z fits decisively better (as checkGravityDirection), else
+  /// leaves the scheduled check as it was; not with baro or heights.
+  void earlyGravityCheck(Timestamp t);
+  std::optional<MotionAligner::GravityCheck> runGravityCheck();
+  /// Baro readings or heights seen (both measure along −z of G).
+  bool hasVerticalSensor() const;
+  /// The frame fits decisively better upside down: gravity along +z from now on, unless baro or
+  /// heights measure along −z (then a warning only).
+  void takeGravityAlongPlusZ(Timestamp t, const MotionAligner::GravityCheck& c);
   /// Re-initializes the pose with gravity along +z (anchors and biases kept, as a recovery);
   /// retried every 0.5 s while the aligner refuses.
   void adoptGravityAlongPlusZ(Timestamp t);
@@ -368,6 +392,10 @@ class EstimatorNode {
   static constexpr int kMaxGravityChecks = 3;
   double gravity_z_sign_ = -1.0;  ///< gravity along −z of G (−1, the convention) or +z (+1)
   bool gravity_flip_pending_ = false;
+  bool gravity_early_check_due_ = false, gravity_early_checked_ = false;
+  /// After an IMU gap of recovery.after_gap_check_min_s: until then the aligned pose is compared
+  /// with the filter every recovery.retry_s, as while degraded.
+  std::optional<Timestamp> check_after_gap_until_;
   std::optional<Timestamp> last_flip_try_;
 
   Snapshot cur_;

@@ -228,65 +228,6 @@ void EstimatorNode::tryMotionInitialization(Timestamp t) {
   initialize(beliefFromAlignment(*r));
 }
 
-void EstimatorNode::checkGravityDirection(Timestamp t) {
-  gravity_check_at_.reset();
-  ++gravity_checks_;
-  const auto c = [&] {
-    ScopedStepTimer timer(timings_, "align");  // the check alone: adoptGravityAlongPlusZ times its own solve
-    return cur_.filter ? aligner_.checkGravityDirection(cur_.filter->state().imu.bias_gyro_rad_s)
-                       : aligner_.checkGravityDirection(Eigen::Vector3d::Zero());
-  }();
-  if (!c) {
-    spdlog::info("estimator: gravity direction not checked at t={}: {}", formatSeconds(t), aligner_.reason());
-    if (gravity_checks_ < kMaxGravityChecks) gravity_check_at_ = t + Duration::fromSec(options_.init.motion_window_s);
-    return;
-  }
-  const std::string costs = fmt::format("cost {:.1f} with gravity along -z, {:.1f} along +z, margin {:.1f}, {} ranges",
-                                        c->cost_z_up, c->cost_z_down, c->margin, c->n_ranges);
-  if (c->zDown()) {
-    diag_.count("anchor_frame_z_down");
-    const bool vertical_sensor = last_pressure_pa_ || last_align_height_ ||
-                                 (cur_.filter && (!cur_.filter->state().values<BaroBiasKind>().empty() ||
-                                                  !cur_.filter->state().values<HeightBiasKind>().empty()));
-    if (vertical_sensor) {
-      spdlog::warn(
-          "estimator: at t={} the anchors' frame G fits the IMU upside down ({}), but baro or heights measure along "
-          "-z: kept gravity along -z of G; expect poor estimates (docs/real_data.md)",
-          formatSeconds(t), costs);
-      return;
-    }
-    spdlog::warn("estimator: at t={} the anchors' frame G fits the IMU upside down ({}): its z axis points down; "
-                 "gravity is taken along +z of G from now on (docs/real_data.md)",
-                 formatSeconds(t), costs);
-    gravity_z_sign_ = 1.0;
-    aligner_.setGravityAlongPlusZ(true);
-    zupt_model_ = ZuptModel(Eigen::Vector3d(0.0, 0.0, options_.gravity_m_s2));
-    gravity_flip_pending_ = true;
-    adoptGravityAlongPlusZ(t);
-  } else {
-    spdlog::info("estimator: gravity direction at t={}: {} ({})", formatSeconds(t),
-                 c->zUp() ? "along -z of G as assumed" : "undecided", costs);
-    // Undecided (little motion in the window): again a window later, at most kMaxGravityChecks times.
-    if (!c->zUp() && gravity_checks_ < kMaxGravityChecks)
-      gravity_check_at_ = t + Duration::fromSec(options_.init.motion_window_s);
-  }
-}
-
-void EstimatorNode::adoptGravityAlongPlusZ(Timestamp t) {
-  last_flip_try_ = t;
-  const auto r = solveAlignment(cur_.filter->state().imu.bias_gyro_rad_s);
-  if (!r) {
-    diag_.count("gravity_flip_refused");
-    return;
-  }
-  gravity_flip_pending_ = false;
-  replaceImu(r->imu, r->cov, r->t, r->last_imu);
-  diag_.count("gravity_flip");
-  spdlog::warn("estimator: re-initialized at t={} with gravity along +z of G from {} ranges (σ_p {:.2f} m, σ_yaw "
-               "{:.1f} deg); anchors and bias states kept",
-               formatSeconds(r->t), r->n_ranges, r->sigma_p_m, r->sigma_yaw_deg);
-}
-
 InitialBelief EstimatorNode::beliefFromAlignment(const AlignmentResult& r) const {
   InitialBelief b;
   b.t = r.t;
@@ -321,6 +262,58 @@ InitialBelief EstimatorNode::beliefFromAlignment(const AlignmentResult& r) const
 void EstimatorNode::propagateFilter(const ImuReading& u, Timestamp t) {
   FusionStrategy& f = *cur_.filter;
   const Timestamp t0 = f.state().t;
+  // Held readings beyond max_dt after the last sample: the part of the step in the gap.
+  const Timestamp stale_from =
+      cur_.last_imu ? std::max(t0, cur_.last_imu->t + Duration::fromSec(options_.imu.max_dt_s)) : t;
+  const std::string& mode = options_.imu.gap_readings;
+  if (mode != "held" && stale_from < t) {
+    // In the gap no reading. "held" repeats the last one for the whole gap, which turns a drone's
+    // momentary rotation rate into tens of degrees (docs/robustness.md, "IMU gaps"); "mean"
+    // repeats the low-passed readings (a steady turn as held, an oscillation averaged out);
+    // "still" takes the vehicle as keeping its velocity and attitude (a = 0 in G, ω = 0).
+    if (stale_from > t0) propagateFilterStep(u, stale_from);
+    const ImuState& x = f.state().imu;
+    const bool mean = mode == "mean" && cur_.mean_reading;
+    // Acceleration in G (0 for "still") and angular rate, as the readings they would give.
+    const Eigen::Vector3d a_G = mean ? cur_.mean_reading->acc_m_s2 : Eigen::Vector3d::Zero();
+    ImuReading gap;
+    gap.acc_m_s2 = x.bias_acc_m_s2 + x.q_ItoG.conjugate() * (a_G - gravityG());
+    // Turning about the vertical at the low-passed rate; no tilting (a vehicle's tilt swings
+    // about level: integrating a low-passed tilt rate for seconds leaves the attitude tilted
+    // after the gap, and gravity leaks into the position).
+    const double yaw_rate = mean ? cur_.mean_reading->gyro_rad_s.z() : 0.0;
+    gap.gyro_rad_s = x.bias_gyro_rad_s + x.q_ItoG.conjugate() * Eigen::Vector3d(0.0, 0.0, yaw_rate);
+    propagateFilterStep(gap, t);
+  } else {
+    propagateFilterStep(u, t);
+  }
+  const double dt = (t - stale_from).sec();
+  if (dt <= 0.0) return;
+  // Their error as white noise (velocity and attitude random walk; position the integrated
+  // velocity noise).
+  f.addImuNoise(whiteImuNoise(std::pow(options_.imu.gap_sigma_acc_m_s2, 2),
+                              std::pow(options_.imu.gap_sigma_gyro_rad_s, 2), dt));
+}
+
+Eigen::Vector3d EstimatorNode::gravityG() const { return {0.0, 0.0, gravity_z_sign_ * options_.gravity_m_s2}; }
+
+void EstimatorNode::updateMeanReading(const ImuSample& s, const std::optional<ImuSample>& previous) {
+  const ImuState& x = cur_.filter->state().imu;
+  const Eigen::Vector3d a_G = x.q_ItoG * (s.acc_m_s2 - x.bias_acc_m_s2) + gravityG();
+  const Eigen::Vector3d w_G = x.q_ItoG * (s.gyro_rad_s - x.bias_gyro_rad_s);
+  const double dt = previous ? (s.t - previous->t).sec() : 0.0;
+  if (!cur_.mean_reading || dt <= 0.0 || dt > options_.imu.max_dt_s) {  // (re)start after a gap
+    cur_.mean_reading = ImuReading{a_G, w_G};
+    return;
+  }
+  const double a = 1.0 - std::exp(-dt / options_.imu.gap_mean_time_constant_s);
+  cur_.mean_reading->acc_m_s2 += a * (a_G - cur_.mean_reading->acc_m_s2);
+  cur_.mean_reading->gyro_rad_s += a * (w_G - cur_.mean_reading->gyro_rad_s);
+}
+
+void EstimatorNode::propagateFilterStep(const ImuReading& u, Timestamp t) {
+  FusionStrategy& f = *cur_.filter;
+  const Timestamp t0 = f.state().t;
   f.propagate(u.acc_m_s2, u.gyro_rad_s, t);
   // The IMU noise beyond its stated densities that the range innovations show (λ − 1 of it), and
   // an extrapolated reading's own excess (λ times its extra_noise_scale), in one addition.
@@ -329,14 +322,6 @@ void EstimatorNode::propagateFilter(const ImuReading& u, Timestamp t) {
   if (extra > 0.0 && t > t0)
     f.addImuNoise(whiteImuNoise(extra * std::pow(options_.imu.acc_noise_density, 2),
                                 extra * std::pow(options_.imu.gyro_noise_density, 2), (t - t0).sec()));
-  if (!cur_.last_imu) return;
-  // Held readings beyond max_dt after the last sample: their error as white noise (velocity and
-  // attitude random walk; position gets the integrated velocity noise).
-  const Timestamp stale_from = std::max(t0, cur_.last_imu->t + Duration::fromSec(options_.imu.max_dt_s));
-  const double dt = (t - stale_from).sec();
-  if (dt <= 0.0) return;
-  f.addImuNoise(whiteImuNoise(std::pow(options_.imu.gap_sigma_acc_m_s2, 2),
-                              std::pow(options_.imu.gap_sigma_gyro_rad_s, 2), dt));
 }
 
 void EstimatorNode::updateHealth(Timestamp t) {
@@ -358,9 +343,10 @@ void EstimatorNode::updateHealth(Timestamp t) {
   }
   // Degraded by gating alone, with the accepted ranges fitting, is what NLOS outliers look like:
   // a re-alignment from those ranges is then more likely wrong than the filter (docs/robustness.md).
+  const bool compare = options_.recovery.degraded_disagreement_chi2 > 0.0;
   if (health_.health() == Health::Lost ||
-      (health_.health() == Health::Degraded && options_.recovery.degraded_disagreement_chi2 > 0.0 &&
-       !health_.acceptedRangesFit(t)))
+      (health_.health() == Health::Degraded && compare && !health_.acceptedRangesFit(t)) ||
+      (compare && check_after_gap_until_ && t <= *check_after_gap_until_))
     tryRecover(t);
 }
 
@@ -393,9 +379,11 @@ void EstimatorNode::tryRecover(Timestamp t) {
   if (!lost) {
     const double chi2 = disagreement(*r);
     if (chi2 <= options_.recovery.degraded_disagreement_chi2) return;
-    diag_.count("recovery_degraded");
-    spdlog::warn("estimator: degraded at t={} and the aligned pose disagrees (chi2 {:.1f} > {:.1f})",
-                 formatSeconds(t), chi2, options_.recovery.degraded_disagreement_chi2);
+    const bool degraded = health_.health() == Health::Degraded;
+    diag_.count(degraded ? "recovery_degraded" : "recovery_after_imu_gap");
+    spdlog::warn("estimator: {} at t={} and the aligned pose disagrees (chi2 {:.1f} > {:.1f})",
+                 degraded ? "degraded" : "after an IMU gap", formatSeconds(t), chi2,
+                 options_.recovery.degraded_disagreement_chi2);
   }
   const ImuState before = cur_.filter->state().imu;
   replaceImu(r->imu, r->cov, r->t, r->last_imu);

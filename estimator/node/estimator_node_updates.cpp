@@ -127,6 +127,7 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
     diag_.count("process_noise_scale_change");
     spdlog::info("estimator: IMU noise scale {:.3g} at t={} (median range NIS {:.2f} of its expected value)",
                  cur_.noise_adapter.scale(), formatSeconds(s.t), cur_.noise_adapter.lastRatio());
+    noteRangeNisRatio(cur_.noise_adapter.lastRatio());
   }
   if (!count) return;
   if (!r.accepted) diag_.count("gated_range");
