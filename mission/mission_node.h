@@ -16,10 +16,11 @@
 ///   collect/calibrate/abort → one CALIB_CMD; remove → one ESTIMATOR_CMD RemoveInstance per id.
 ///   Data time going backwards never re-runs a step (counted as "time_backwards").
 /// - **Clock rebased** (`onClockRebased`: the data clock followed a jump of the whole stream that
-///   its TimeGuard agreed on). Before any step ran and with t0 taken from the data, the first time
-///   was the bad one (a sender's wrong first stamp): the mission starts again at the new time, t0
-///   with it ("t0_retaken"). Otherwise t0 stays (a --t0 of the user's, or steps already run are
-///   not run again) and the node follows the new time line ("clock_rebased").
+///   its TimeGuard agreed on). When the first data time was the only one accepted and t0 was taken
+///   from it, that time was the bad one (a sender's wrong first stamp): the mission starts again
+///   at the new time, t0 with it, and what it issued at the wrong time is issued again
+///   ("t0_retaken"). Otherwise (a --t0 of the user's, or a real stream that paused after many
+///   times) t0 stays, no step runs twice and the node follows the new time line ("clock_rebased").
 /// - **Resends** (a lossy link, docs/deployment.md): a CALIB_CMD counts as answered once a
 ///   CALIB_STATUS shows its effect — Collect: its anchors (all: every listed one) no longer `idle`;
 ///   Calibrate: its anchors `calibrated` or `refused` (all: none `collecting`); Abort: none of its
@@ -102,6 +103,7 @@ class MissionNode {
   Diagnostics diag_;
   std::optional<Timestamp> t0_;
   bool t0_from_data_ = false;  ///< t0 was the first data time (no setT0)
+  int64_t times_accepted_ = 0;  ///< data times accepted since the start (the start's included)
   Timestamp now_;
   bool started_ = false;
   size_t next_step_ = 0;

@@ -69,6 +69,9 @@ def first_time(dataset):
     return min(times)
 
 
+ANCHOR_TYPES = ("A", "a", "65")  # docs/formats.md: the letter, either case, or its ASCII code
+
+
 def busiest_anchor(dataset):
     """The anchor id with the most ranges in ranges.csv."""
     header, rows = read_rows(os.path.join(dataset, "ranges.csv"))
@@ -76,8 +79,10 @@ def busiest_anchor(dataset):
     counts = {}
     for r in rows:
         for id_col, type_col in (("UWB_ID1", "type_ID1"), ("UWB_ID2", "type_ID2")):
-            if r[col[type_col]] == "A":
+            if r[col[type_col]].strip() in ANCHOR_TYPES:
                 counts[r[col[id_col]]] = counts.get(r[col[id_col]], 0) + 1
+    if not counts:
+        raise SystemExit("realdata_stress: %s/ranges.csv has no range to an anchor (give --anchor)" % dataset)
     return max(counts, key=counts.get)
 
 
@@ -116,8 +121,8 @@ def perturb(case, src, dst, t0, seed, anchor):
             for r in rows:
                 if rng.random() < 0.10:
                     extra = rng.uniform(0.5, 3.0)
-                    for k in ("range_raw", "range_corr"):
-                        if r[c[k]] != "":
+                    for k in ("range_raw", "range_corr"):  # range_corr is optional (docs/formats.md)
+                        if k in c and r[c[k]] != "":
                             r[c[k]] = repr(float(r[c[k]]) + extra)
             return rows
         edit("ranges.csv", longer)
@@ -126,7 +131,7 @@ def perturb(case, src, dst, t0, seed, anchor):
 
 
 def run_case(case, dataset, out, bin_dir, t0, seed, anchor):
-    """Perturb, run, evaluate one case; returns a result dict (never raises)."""
+    """Perturb, run, evaluate one case; returns a result dict (a failed run is a result, not an exception)."""
     base = os.path.join(out, case)
     if os.path.exists(base):
         shutil.rmtree(base)
@@ -172,6 +177,16 @@ def holds(res, clean_ate):
     return res["ate_m"] <= max(HOLD_FACTOR * clean_ate, clean_ate + HOLD_SLACK_M)
 
 
+def write_csv(path, results, clean):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["case", "run_rc", "initialized", "ate_m", "max_late_m", "gated", "recoveries", "health", "holds",
+                    "error"])
+        for r in results:
+            w.writerow([r["case"], r["run_rc"], r["initialized"], r["ate_m"], r["max_late_m"], r["gated"],
+                        r["recoveries"], r["health"], holds(r, clean["ate_m"]), r["error"]])
+
+
 def main():
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     ap = argparse.ArgumentParser(prog="realdata_stress.py", description=__doc__,
@@ -193,8 +208,7 @@ def main():
     for b in ("meshnav_run", "meshnav_eval"):
         if not os.access(os.path.join(a.bin, b), os.X_OK):
             sys.exit("realdata_stress: %s not found in %s (build first, or give --bin)" % (b, a.bin))
-    if "clean" not in cases:
-        cases.insert(0, "clean")
+    cases = ["clean"] + [c for c in cases if c != "clean"]  # the reference comes first
     expect_fail = set(c for c in a.expect_fail.split(",") if c)
     t0 = first_time(a.dataset)
     anchor = a.anchor or busiest_anchor(a.dataset)
@@ -204,6 +218,7 @@ def main():
         print("[realdata_stress] %s ..." % case, file=sys.stderr, flush=True)
         results.append(run_case(case, a.dataset, a.out, a.bin, t0, a.seed, anchor))
     clean = results[0]
+    write_csv(os.path.join(a.out, "stress.csv"), results, clean)
     if not holds(clean, clean["ate_m"]):
         print("realdata_stress: the clean run failed: %s (exit %s)" % (clean["error"] or "?", clean["run_rc"]))
         return 1
@@ -221,13 +236,6 @@ def main():
         print("| %s | %s | %s | %s | %d | %d | %s | %s |" % (
             r["case"], r["run_rc"], robustness.fmt(r["ate_m"], 3), robustness.fmt(r["max_late_m"], 3), r["gated"],
             r["recoveries"], r["health"] or "-", verdict + (" " + r["error"] if r["error"] else "")))
-    with open(os.path.join(a.out, "stress.csv"), "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["case", "run_rc", "initialized", "ate_m", "max_late_m", "gated", "recoveries", "health", "holds",
-                    "error"])
-        for r in results:
-            w.writerow([r["case"], r["run_rc"], r["initialized"], r["ate_m"], r["max_late_m"], r["gated"],
-                        r["recoveries"], r["health"], holds(r, clean["ate_m"]), r["error"]])
     if failed:
         print("realdata_stress: %d case(s) do not hold: %s" % (len(failed), ", ".join(failed)))
         return 1

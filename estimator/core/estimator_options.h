@@ -26,8 +26,8 @@ struct ImuNoiseOptions {
   /// samples when these are at most this far apart, else on the last one held (imu_readings.h):
   /// a slope over a longer span says nothing about the next few ms. 0: always held [s]
   double extrapolate_max_period_s = 0.02;
-  /// Beyond `max_dt_s` after the last IMU sample the filter runs on held readings; their error is
-  /// modelled as white noise of these densities (docs/robustness.md, "IMU gaps").
+  /// Beyond `max_dt_s` after the last IMU sample the filter runs on the readings `gap_readings`
+  /// says; their error is modelled as white noise of these densities (docs/robustness.md, "IMU gaps").
   double gap_sigma_acc_m_s2 = 1.0;    ///< [m/s²/√s]
   /// Attitude is not inflated by default: with no accelerometer data in the gap, an inflated tilt
   /// lets range updates explain position innovations by tilt, which leaks gravity afterwards
@@ -64,8 +64,9 @@ struct InitOptions {
   double ambiguity_chi2 = 16.0;
   double motion_window_s = 12.0;            ///< in-motion alignment: data window [s]
   /// Before the scheduled gravity check (a `motion_window_s` after the first initialization): a
-  /// median range NIS at least this many times its expected value runs the check at once (once;
-  /// it acts only on a decisive +z); 0 = never [-]
+  /// batch median range NIS (process_noise: every `batch` ranges, so only with it enabled) at
+  /// least this many times its expected value runs the check at once (once; it acts only on a
+  /// decisive +z); 0 = never [-]
   double gravity_early_check_nis_ratio = 5.0;
   /// In-motion alignment: with fewer than `motion_min_ranges` ranges in `motion_window_s` (sparse
   /// ranging), the window reaches back until it holds them, at most this far [s]

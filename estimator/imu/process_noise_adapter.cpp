@@ -35,6 +35,7 @@ bool ProcessNoiseAdapter::onRangeNis(double nis, double prior_ratio, bool accept
   accepted_.clear();
   prior_ratios_.clear();
   last_ratio_ = r;
+  ++decisions_;
   const bool above = r > options_.upper_ratio && prior <= options_.max_prior_ratio;  // else Q is not the cause
   if (!above) recent_above_.clear();
   if (!above && r >= options_.lower_ratio) return false;

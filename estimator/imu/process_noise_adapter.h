@@ -72,11 +72,14 @@ class ProcessNoiseAdapter {
   double scale() const { return scale_; }
   /// Median NIS ratio of the last decision (1 if consistent); 0 before the first.
   double lastRatio() const { return last_ratio_; }
+  /// Decisions (batches of `batch` ranges) taken so far, whether λ changed or not.
+  long decisions() const { return decisions_; }
 
  private:
   ProcessNoiseAdaptOptions options_;
   double scale_ = 1.0;
   double last_ratio_ = 0.0;
+  long decisions_ = 0;
   std::vector<double> recent_above_;  ///< ratios of the consecutive decisions above upper_ratio (the last confirm_batches)
   std::vector<double> batch_;
   std::vector<bool> accepted_;

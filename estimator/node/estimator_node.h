@@ -232,7 +232,8 @@ class EstimatorNode {
   /// extrapolated along the last two samples to the step's middle (readingPast, imu_readings.h).
   void propagateTo(Timestamp t);
   /// Propagation on the readings `u` held over [filter time, t], with λ's and `u`'s extra white
-  /// noise; the part beyond `imu.max_dt_s` after the last IMU sample gets the gap noise.
+  /// noise; the part beyond `imu.max_dt_s` after the last IMU sample is a gap: propagated on what
+  /// `imu.gap_readings` says, with the gap noise.
   void propagateFilter(const ImuReading& u, Timestamp t);
   /// One propagation on `u` with the innovation-driven extra IMU noise (no gap handling).
   void propagateFilterStep(const ImuReading& u, Timestamp t);

@@ -21,6 +21,7 @@ void EstimatorNode::copyReplayContext(const EstimatorNode& live) {
   pending_height_bias_ = live.pending_height_bias_;
   rerun_anchors_ = live.rerun_anchors_;
   gravity_z_sign_ = live.gravity_z_sign_;
+  check_after_gap_until_ = live.check_after_gap_until_;
   zupt_model_ = live.zupt_model_;
   // Ranges after a gap: rejected ones stay out of the re-run, held ones wait for the live node's release.
   reentry_.decided = live.reentry_.decided;

@@ -124,6 +124,7 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   if (resume_kept_) restoreKeptInstances(*filter, *resume_kept_, b.t);  // replace the priors
   resume_kept_.reset();
   cur_.filter = std::move(filter);
+  cur_.mean_reading.reset();
   cur_.last_imu = b.last_imu;
   cur_.prev_imu.reset();
   cur_.landed = b.landed;
@@ -379,10 +380,10 @@ void EstimatorNode::tryRecover(Timestamp t) {
   if (!lost) {
     const double chi2 = disagreement(*r);
     if (chi2 <= options_.recovery.degraded_disagreement_chi2) return;
-    const bool degraded = health_.health() == Health::Degraded;
-    diag_.count(degraded ? "recovery_degraded" : "recovery_after_imu_gap");
+    const bool after_gap = check_after_gap_until_ && t <= *check_after_gap_until_;
+    diag_.count(after_gap ? "recovery_after_imu_gap" : "recovery_degraded");
     spdlog::warn("estimator: {} at t={} and the aligned pose disagrees (chi2 {:.1f} > {:.1f})",
-                 degraded ? "degraded" : "after an IMU gap", formatSeconds(t), chi2,
+                 after_gap ? "after an IMU gap" : "degraded", formatSeconds(t), chi2,
                  options_.recovery.degraded_disagreement_chi2);
   }
   const ImuState before = cur_.filter->state().imu;
@@ -439,6 +440,7 @@ void EstimatorNode::constrainToVolumeSide(Timestamp t) {
 }
 
 void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu) {
+  cur_.mean_reading.reset();  // low-passed in the attitude and gravity being replaced
   const FusionStrategy& old = *cur_.filter;
   const NominalState& s = old.state();
   auto f = makeStrategy(options_, gravity_z_sign_);

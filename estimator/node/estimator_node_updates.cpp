@@ -123,12 +123,14 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
   // H P Hᵀ / R from NIS = ν²/S, S = H P Hᵀ + R (scalar range).
   const double nu2 = lin.residual(0) * lin.residual(0), R = lin.R(0, 0);
   const double prior_ratio = r.nis > 0.0 && R > 0.0 ? std::max(0.0, nu2 / r.nis - R) / R : 0.0;
+  const long decisions = cur_.noise_adapter.decisions();
   if (tag_range && cur_.noise_adapter.onRangeNis(r.nis, prior_ratio, r.accepted) && first) {
     diag_.count("process_noise_scale_change");
     spdlog::info("estimator: IMU noise scale {:.3g} at t={} (median range NIS {:.2f} of its expected value)",
                  cur_.noise_adapter.scale(), formatSeconds(s.t), cur_.noise_adapter.lastRatio());
-    noteRangeNisRatio(cur_.noise_adapter.lastRatio());
   }
+  // Every batch's median NIS, whether λ changed or not (it holds at its bound, or while H P Hᵀ ≫ R).
+  if (first && cur_.noise_adapter.decisions() != decisions) noteRangeNisRatio(cur_.noise_adapter.lastRatio());
   if (!count) return;
   if (!r.accepted) diag_.count("gated_range");
   if (tag_range && r.accepted) last_tag_range_accepted_ = s.t;

@@ -44,6 +44,7 @@ void MissionNode::onTime(Timestamp t) {
   } else {
     now_ = t;
   }
+  ++times_accepted_;
   resendUnanswered();
   bool ran = false;
   while (next_step_ < mission_.steps.size() &&
@@ -68,16 +69,20 @@ void MissionNode::onClockRebased(Timestamp t) {
     onTime(t);
     return;
   }
-  if (next_step_ == 0 && t0_from_data_) {
+  if (times_accepted_ <= 1 && t0_from_data_) {
+    // The first data time was the only one ever accepted and the stream then agreed on another
+    // time line: that first time was wrong (a pause of a real stream comes after many accepted
+    // times). Start again, the start's Collect and any step issued at the wrong time included
+    // (the calibrator refuses commands stamped off its data time, so they were never answered).
     diag_.count("t0_retaken");
-    spdlog::warn("mission: data time jumped from t={} s to t={} s before any step ran; the first data time was "
-                 "wrong, so the mission starts again with t0 = {} s",
-                 formatSeconds(now_), formatSeconds(t), formatSeconds(t));
-    // Nothing ran but the start: start again, with the start's Collect at the new time (the
-    // calibrator refuses the old one as out of time, so resending it could never be answered).
+    spdlog::warn("mission: data time jumped from t={} s to t={} s right after the first data time, which was "
+                 "wrong; the mission starts again with t0 = {} s ({} step(s) issued at the wrong time again)",
+                 formatSeconds(now_), formatSeconds(t), formatSeconds(t), next_step_);
     started_ = false;
     t0_.reset();
     t0_from_data_ = false;
+    next_step_ = 0;
+    times_accepted_ = 0;
     next_status_.reset();
     unanswered_.clear();
   } else {

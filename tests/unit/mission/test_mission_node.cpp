@@ -131,6 +131,34 @@ TEST(MissionNode, AWrongFirstStampIsRetakenWhenTheClockRebasesBeforeAnyStep) {
   EXPECT_EQ(node.diagnostics().get("time_backwards"), 0);
 }
 
+TEST(MissionNode, APauseOfTheRealStreamBeforeTheFirstStepKeepsT0) {
+  // Found by a review of the first version, which re-took t0 whenever no step had run yet: a real
+  // stream that pauses 30 s before the first step would have shifted every step by its runtime.
+  Recorder rec;
+  MissionNode node(paperLike(), rec.sinks());
+  fly(node, 0.0, 40.0);
+  node.onClockRebased(Timestamp::fromSec(70.0));
+  EXPECT_EQ(node.diagnostics().get("t0_retaken"), 0);
+  EXPECT_EQ(node.diagnostics().get("clock_rebased"), 1);
+  EXPECT_EQ(node.t0()->sec(), 0.0);
+  fly(node, 70.02, 15.0);
+  ASSERT_EQ(rec.calib.size(), 2u);
+  EXPECT_NEAR(rec.calib[1].t.sec(), 80.0, 0.03);  // t0 + 80 s, as without the pause
+}
+
+TEST(MissionNode, AStepIssuedAtAWrongFirstStampIsIssuedAgain) {
+  Recorder rec;
+  MissionNode node(parseMission("steps:\n  - {t: 0.0, action: calibrate, anchors: [106]}\n", "t"), rec.sinks());
+  node.onTime(Timestamp::fromSec(3700.0));  // wrong; the step at t0 + 0 runs at once
+  ASSERT_EQ(node.nextStep(), 1u);
+  node.onClockRebased(Timestamp::fromSec(100.0));
+  EXPECT_EQ(node.diagnostics().get("t0_retaken"), 1);
+  EXPECT_TRUE(node.finished());
+  ASSERT_EQ(rec.calib.size(), 4u);  // Collect, Calibrate at the wrong time; both again at 100 s
+  EXPECT_EQ(rec.calib[3].action, CalibCommand::Action::Calibrate);
+  EXPECT_DOUBLE_EQ(rec.calib[3].t.sec(), 100.0);
+}
+
 TEST(MissionNode, ARebasedClockKeepsAUserT0AndNeverRerunsAStep) {
   {  // t0 given by the user: it stays, and the node follows the new time line
     Recorder rec;
