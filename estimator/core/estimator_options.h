@@ -67,7 +67,7 @@ struct InitOptions {
   /// batch median range NIS (process_noise: every `batch` ranges, so only with it enabled) at
   /// least this many times its expected value runs the check at once (once; it acts only on a
   /// decisive +z); 0 = never [-]
-  double gravity_early_check_nis_ratio = 5.0;
+  double gravity_early_check_nis_ratio = 6.0;
   /// In-motion alignment: with fewer than `motion_min_ranges` ranges in `motion_window_s` (sparse
   /// ranging), the window reaches back until it holds them, at most this far [s]
   double motion_max_window_s = 40.0;

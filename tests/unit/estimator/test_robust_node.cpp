@@ -443,9 +443,12 @@ TEST(RobustNode, MalformedCheckpointIsRefusedNamingFileAndKey) {
 // that frame, re-initializes with it and then tracks the walk as in the true frame. In the true
 // frame nothing is flipped. Without baro (a baro measures along −z and keeps the convention).
 // The same upside-down walk, started 20 s late: the node initializes in motion (23 s), and the
-// range innovations show the wrong gravity long before the scheduled check a window later (35 s):
-// the early check (init.gravity_early_check_nis_ratio) flips at 27.6 s. ISAS-Walk1 started late
-// is the real case (realdata.test_realdata_stress: 1.61 m before, 0.22 m after).
+// range innovations show the wrong gravity before the scheduled check a window later (35 s): the
+// early check (init.gravity_early_check_nis_ratio, default 6) flips at 32.1 s and the largest
+// error goes 0.69 -> 0.64 m (a ratio of 5: 27.6 s, 0.53 m; 6 because on ISAS-Walk1 with NLOS
+// outliers one batch reached 5.1 and an early re-alignment over the rest before the walk cost
+// 0.15 m, docs/robustness.md). ISAS-Walk1 started late is the real case
+// (realdata.test_realdata_stress: 1.61 m before, 0.22 m after).
 TEST(RobustNode, AWrongGravityIsFoundEarlyWhenTheRangesSaySo) {
   auto r = handheldWalk();
   r.dataset.baro.clear();
@@ -462,7 +465,8 @@ TEST(RobustNode, AWrongGravityIsFoundEarlyWhenTheRangesSaySo) {
   late(ds.ranges);
   late(ds.ground_truth);
   std::map<double, double> max_error_m;
-  for (const double ratio : {0.0, 5.0}) {
+  const double on = EstimatorOptions{}.init.gravity_early_check_nis_ratio;  // the default
+  for (const double ratio : {0.0, on}) {
     EstimatorOptions o;
     o.init.gravity_early_check_nis_ratio = ratio;
     EstimatorNode node(o, ds.setup);
@@ -473,14 +477,13 @@ TEST(RobustNode, AWrongGravityIsFoundEarlyWhenTheRangesSaySo) {
     ASSERT_TRUE(flip_s.has_value()) << "ratio " << ratio;
     EXPECT_EQ(node.diagnostics().get("gravity_early_check"), ratio > 0.0 ? 1 : 0);
     if (ratio > 0.0) {
-      EXPECT_LT(*flip_s, 30.0);
+      EXPECT_LT(*flip_s, 33.0);
     } else {
       EXPECT_GE(*flip_s, 35.0);
     }
     max_error_m[ratio] = res.max_error_after_m;
   }
-  EXPECT_LT(max_error_m[5.0], max_error_m[0.0]);
-  EXPECT_LT(max_error_m[5.0], 0.6);
+  EXPECT_LT(max_error_m[on], max_error_m[0.0]);
 }
 
 TEST(RobustNode, UpsideDownAnchorFrameIsDetectedAndTakenAsItIs) {
