@@ -153,7 +153,7 @@ void EstimatorNode::resetAll() {
   check_after_gap_until_.reset();
   last_flip_try_.reset();
   aligner_.setGravityAlongPlusZ(false);
-  zupt_model_ = ZuptModel(Eigen::Vector3d(0.0, 0.0, -options_.gravity_m_s2));
+  zupt_model_ = ZuptModel(gravityG());
   last_recovery_try_.reset();
   cur_ = Snapshot{};
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);

@@ -92,7 +92,7 @@ void EstimatorNode::takeGravityAlongPlusZ(Timestamp t, const MotionAligner::Grav
                formatSeconds(t), costsText(c));
   gravity_z_sign_ = 1.0;
   aligner_.setGravityAlongPlusZ(true);
-  zupt_model_ = ZuptModel(Eigen::Vector3d(0.0, 0.0, options_.gravity_m_s2));
+  zupt_model_ = ZuptModel(gravityG());
   gravity_flip_pending_ = true;
   adoptGravityAlongPlusZ(t);
 }

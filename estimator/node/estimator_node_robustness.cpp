@@ -267,7 +267,7 @@ void EstimatorNode::propagateFilter(const ImuReading& u, Timestamp t) {
   const Timestamp stale_from =
       cur_.last_imu ? std::max(t0, cur_.last_imu->t + Duration::fromSec(options_.imu.max_dt_s)) : t;
   const std::string& mode = options_.imu.gap_readings;
-  if (mode != "held" && stale_from < t) {
+  if (stale_from < t && mode != "held") {  // the string only in a gap
     // In the gap no reading. "held" repeats the last one for the whole gap, which turns a drone's
     // momentary rotation rate into tens of degrees (docs/robustness.md, "IMU gaps"); "mean"
     // repeats the low-passed readings (a steady turn as held, an oscillation averaged out);
