@@ -1,6 +1,7 @@
 /// @file fuzz_anchor_init_yaml.cpp
-/// @brief Fuzz target: a calibration results file (DESIGN §6, written by the calibrator and the
-/// logger, read back for the estimator and the evaluation) through readAnchorInitsYaml.
+/// @brief Fuzz target: a calibration results file (docs/formats.md, "Calibration results (YAML)":
+/// written by the calibrator and the logger, read back for the estimator and the evaluation)
+/// through readAnchorInitsYaml.
 /// Refusals are std::runtime_error; every accepted bias names its anchor.
 #include "common/anchor_init_io.h"
 #include "fuzz/support/fuzz_target.h"

@@ -15,7 +15,7 @@ Vicon) and a meshnav_run output folder:
 tilt (a few degrees on MILUV). "In flight" is the truth's span less 9 s at the start and 4 s at
 the end (MILUV's take-off and landing). The CSVs are read comma-separated, as meshnav writes them.
 
-Usage: /usr/bin/python3 scripts/miluv_yaw.py DATASET_DIR RUN_DIR [--step S]
+Usage: /usr/bin/python3 tools/analysis/miluv_yaw.py DATASET_DIR RUN_DIR [--step S]
 """
 
 import argparse

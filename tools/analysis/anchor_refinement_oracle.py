@@ -24,7 +24,8 @@ sample).
       writes DST: SRC with the run's calibrated anchors as known-but-uncertain setup anchors
       (p_AinG = calibration, sigma per axis --sigma), tag-anchor gamma unknown (N(0, 0.25^2)) and
       the ranges between such an anchor and another anchor dropped; `meshnav_run --no-calibration`
-      on DST estimates the anchors jointly with the pose from t = 0 (docs/results.md, issue 10).
+      on DST estimates the anchors jointly with the pose from t = 0
+      (docs/decisions/003-rerun-on-anchor-join.md).
   anchor_refinement_oracle.py --self-test                    noise-free ranges: exact recovery
 """
 

@@ -13,7 +13,7 @@ groundtruth.csv, setup.yaml) and prints, per window of the flight:
     Where this fit moves away from the truth, the window's ranges prefer a wrong trajectory: no
     estimator that sees only this window's data (a filter sees less) can be expected to do better.
 
-Usage: /usr/bin/python3 scripts/miluv_reachable.py out/ifo001 [--window 20] [--step 10]
+Usage: /usr/bin/python3 tools/analysis/miluv_reachable.py out/ifo001 [--window 20] [--step 10]
 Units: metres, seconds, degrees. Takes about a minute per robot.
 """
 import argparse

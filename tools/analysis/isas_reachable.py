@@ -11,7 +11,7 @@ imu.csv, setup.yaml) and prints, all SE(3)-aligned to the Vive truth like `meshn
     Vive scale fitted jointly with the alignment; tracker-to-IMU rotation and time offset from the
     gyro against the tracker's angular rate.
 
-Usage: /usr/bin/python3 scripts/isas_reachable.py out/isas
+Usage: /usr/bin/python3 tools/analysis/isas_reachable.py out/isas
 """
 import csv
 import sys
