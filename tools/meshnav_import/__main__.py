@@ -1,10 +1,10 @@
-"""./meshnav import rosbag|miluv ... (run as `python3 -m meshnav_import` with tools/ on the path)."""
+"""./meshnav import rosbag|miluv|csv ... (run as `python3 -m meshnav_import` with tools/ on the path)."""
 
 import argparse
 import sys
 
 from . import dataset_writer as dw
-from . import miluv_importer, rosbag_importer
+from . import csv_importer, miluv_importer, rosbag_importer
 
 
 def main(argv=None):
@@ -18,8 +18,11 @@ def main(argv=None):
     miluv_importer.add_arguments(sub.add_parser(
         "miluv", help="one robot of a MILUV experiment folder",
         description=miluv_importer.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter))
+    csv_importer.add_arguments(sub.add_parser(
+        "csv", help="your own CSV files, described by a mapping file (--map FILE)",
+        description=csv_importer.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter))
     args = p.parse_args(argv)
-    module = rosbag_importer if args.kind == "rosbag" else miluv_importer
+    module = {"rosbag": rosbag_importer, "miluv": miluv_importer, "csv": csv_importer}[args.kind]
     try:
         return module.run(args)
     except (ValueError, OSError) as ex:
