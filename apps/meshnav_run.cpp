@@ -2,7 +2,8 @@
 /// @brief The whole pipeline in one process, deterministic and as fast as possible (README.md):
 /// reads a dataset, merges every sample into time order, feeds the estimator node, writes
 /// estimate.csv, anchors.csv, timings.csv and status.txt into --out. The estimator, calibrator and
-/// mission nodes run in one `pipeline::Pipeline`, wired as the processes are over LCM.
+/// mission nodes run in one `pipeline::Pipeline`, wired as the processes are over LCM. With
+/// `--fleet FILE` several vehicles' datasets run in one pipeline that shares the anchor map.
 
 #include <spdlog/spdlog.h>
 
@@ -10,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 
 #include "common/cli_main.h"
 #include "common/dataset.h"
@@ -19,6 +21,7 @@
 #include "estimator/node/estimator_node.h"
 #include "calibrator/calibration_io.h"
 #include "calibrator/node/calibrator_config.h"
+#include "pipeline/fleet.h"
 #include "pipeline/pipeline.h"
 
 using namespace meshnav;
@@ -32,13 +35,20 @@ constexpr char kDescription[] =
 
 /// The command line of meshnav_run.
 struct RunOptions {
-  std::string dataset, out, strategy, config, mission, calib_config;
+  std::string dataset, fleet, out, strategy, config, mission, calib_config;
   bool no_calibration = false, allow_lost = false, print_config = false;
 };
 
 void declareOptions(Cli& cli, RunOptions& o) {
-  cli.optional("dataset", o.dataset, "dataset folder (imu.csv, baro.csv, ranges.csv, flight_state.csv, setup.yaml)")
-      ->type_name("DIR");
+  auto* dataset =
+      cli.optional("dataset", o.dataset, "dataset folder (imu.csv, baro.csv, ranges.csv, flight_state.csv, setup.yaml)")
+          ->type_name("DIR");
+  cli.optional("fleet", o.fleet,
+               "fleet file (YAML 'vehicles: [{name, dataset}]', docs/fleet.md): several vehicles sharing one anchor "
+               "map, each with its own estimator, one calibrator for all; outputs in --out/NAME, calibration.yaml in "
+               "--out")
+      ->type_name("FILE")
+      ->excludes(dataset);
   cli.optional("out", o.out, "output folder (created): estimate.csv, anchors.csv, timings.csv, status.txt")
       ->type_name("DIR");
   cli.optional("strategy", o.strategy,
@@ -84,14 +94,14 @@ void writeStatus(const EstimatorStatus& st, double wall_s, double data_s, const 
         << ", n_rejected: " << i.n_rejected << "}\n";
 }
 
-/// Feeds every input of `inputs` (time order) to the pipeline, with a progress line every 25 %.
+/// Feeds every input of `inputs` (time order, each to its vehicle) to the pipeline, with a progress line every 25 %.
 /// Returns the wall time it took [s].
-double feed(pipeline::Pipeline& pipe, const std::vector<EstimatorInput>& inputs, double data_s) {
-  const Timestamp t_first = inputTime(inputs.front());
+double feed(pipeline::Pipeline& pipe, const std::vector<pipeline::FleetInput>& inputs, double data_s) {
+  const Timestamp t_first = inputTime(inputs.front().input);
   const auto wall0 = std::chrono::steady_clock::now();
   int next_progress = 1;
-  for (const auto& input : inputs) {
-    pipe.onInput(input);
+  for (const auto& [vehicle, input] : inputs) {
+    pipe.onInput(vehicle, input);
     if (data_s > 0 && (inputTime(input) - t_first).sec() >= next_progress * 0.25 * data_s) {
       spdlog::info("progress {:3d}% (t = {} s)", next_progress * 25, formatSeconds(inputTime(input)));
       ++next_progress;
@@ -100,36 +110,94 @@ double feed(pipeline::Pipeline& pipe, const std::vector<EstimatorInput>& inputs,
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 }
 
-/// The end-of-run log lines; returns the exit code (3 when the estimate ends lost or never initialized).
-int report(const EstimatorNode& node, double data_s, double wall_s, const std::string& out_dir, bool allow_lost) {
+/// The end-of-run log lines of one vehicle (`who`: "" or "vehicle NAME: "); returns its exit code
+/// (3 when the estimate ends lost or never initialized).
+int report(const EstimatorNode& node, double data_s, double wall_s, const std::string& out_dir, bool allow_lost,
+           const std::string& who) {
   const EstimatorStatus st = node.status();
-  if (!node.initialized()) spdlog::error("the estimator never initialized: {}", node.waitingFor());
+  if (!node.initialized()) spdlog::error("{}the estimator never initialized: {}", who, node.waitingFor());
   if (auto pose = node.pose())
-    spdlog::info("final: p_IinG [{:.3f}, {:.3f}, {:.3f}] m, b_gyro [{:.5f}, {:.5f}, {:.5f}] rad/s, "
+    spdlog::info("{}final: p_IinG [{:.3f}, {:.3f}, {:.3f}] m, b_gyro [{:.5f}, {:.5f}, {:.5f}] rad/s, "
                  "b_acc [{:.4f}, {:.4f}, {:.4f}] m/s^2, IMU noise scale {:.3g}",
-                 pose->p_IinG.x(), pose->p_IinG.y(), pose->p_IinG.z(), pose->bias_gyro_rad_s.x(),
+                 who, pose->p_IinG.x(), pose->p_IinG.y(), pose->p_IinG.z(), pose->bias_gyro_rad_s.x(),
                  pose->bias_gyro_rad_s.y(), pose->bias_gyro_rad_s.z(), pose->bias_acc_m_s2.x(),
                  pose->bias_acc_m_s2.y(), pose->bias_acc_m_s2.z(), node.processNoiseScale());
   std::string counters;
   for (const auto& [k, v] : st.counters) counters += fmt::format("{}={} ", k, v);
-  spdlog::info("counters: {}", counters);
+  spdlog::info("{}counters: {}", who, counters);
   for (const auto& [type, s] : node.timings().stats())
-    spdlog::info("step {:<13} n={:<7} mean {:8.2f} us  median {:8.2f} us  max {:8.1f} us", type, s.count, s.mean_us,
-                 s.median_us, s.max_us);
-  spdlog::info("processed {:.1f} s of data in {:.3f} s wall (real-time factor {:.0f}x); results in {}", data_s,
+    spdlog::info("{}step {:<13} n={:<7} mean {:8.2f} us  median {:8.2f} us  max {:8.1f} us", who, type, s.count,
+                 s.mean_us, s.median_us, s.max_us);
+  spdlog::info("{}processed {:.1f} s of data in {:.3f} s wall (real-time factor {:.0f}x); results in {}", who, data_s,
                wall_s, wall_s > 0 ? data_s / wall_s : 0.0, out_dir);
   // A run that ends lost (no usable aiding, or runaway the recovery could not fix) is not healthy.
   const int64_t lost_events = st.counters.count("health_lost") ? st.counters.at("health_lost") : 0;
   if (node.initialized() && node.health() == Health::Lost)
-    spdlog::error("the estimate ends LOST ({}); {} lost events, {} recoveries", st.health_reason, lost_events,
+    spdlog::error("{}the estimate ends LOST ({}); {} lost events, {} recoveries", who, st.health_reason, lost_events,
                   st.counters.count("recovery") ? st.counters.at("recovery") : 0);
   else if (lost_events > 0)
-    spdlog::warn("the estimate was lost {} times during the run and recovered", lost_events);
+    spdlog::warn("{}the estimate was lost {} times during the run and recovered", who, lost_events);
   const bool healthy = node.initialized() && node.health() != Health::Lost;
   return healthy || allow_lost ? 0 : 3;
 }
 
-/// The whole run: dataset in, pipeline, files out. Returns the exit code.
+/// One vehicle of the run: its dataset, its output folder and its writers.
+struct VehicleRun {
+  std::string name;  ///< "" for a single dataset
+  std::string dataset;
+  std::filesystem::path out;
+  Dataset ds;
+  std::unique_ptr<EstimateCsvWriter> estimates;
+  std::unique_ptr<AnchorsCsvWriter> anchors;
+  std::string who() const { return name.empty() ? "" : "vehicle " + name + ": "; }
+};
+
+/// The vehicles of the run: --dataset (one, writing into --out) or the --fleet file's (each into
+/// --out/NAME). Reads every dataset.
+std::vector<VehicleRun> readVehicles(const RunOptions& o) {
+  std::vector<VehicleRun> runs;
+  if (!o.fleet.empty()) {
+    for (const auto& e : pipeline::loadFleetFile(o.fleet)) {
+      VehicleRun r;
+      r.name = e.name;
+      r.dataset = e.dataset;
+      r.out = std::filesystem::path(o.out) / e.name;
+      runs.push_back(std::move(r));
+    }
+  } else {
+    VehicleRun r;
+    r.dataset = o.dataset;
+    r.out = o.out;
+    runs.push_back(std::move(r));
+  }
+  for (auto& r : runs) {
+    Diagnostics diag;
+    spdlog::info("{}reading dataset {}", r.who(), r.dataset);
+    r.ds = readDataset(r.dataset, diag, false);
+    spdlog::info("{}dataset: {} imu, {} baro, {} ranges, {} flight states, {} heights{}", r.who(), r.ds.imu.size(),
+                 r.ds.baro.size(), r.ds.ranges.size(), r.ds.flight_states.size(), r.ds.heights.size(),
+                 diag.total() ? "; dropped/flagged: " + diag.summary() : "");
+  }
+  return runs;
+}
+
+/// A fleet's datasets must be stamped by one clock: their time spans must overlap.
+void checkSharedClock(const std::vector<VehicleRun>& runs, const std::vector<std::vector<EstimatorInput>>& inputs,
+                      const std::string& fleet_file) {
+  Timestamp latest_start = inputTime(inputs[0].front()), earliest_end = inputTime(inputs[0].back());
+  std::string spans;
+  for (size_t v = 0; v < runs.size(); ++v) {
+    const Timestamp a = inputTime(inputs[v].front()), b = inputTime(inputs[v].back());
+    latest_start = std::max(latest_start, a);
+    earliest_end = std::min(earliest_end, b);
+    spans += fmt::format("{}{} {}-{} s", v ? ", " : "", runs[v].name, formatSeconds(a), formatSeconds(b));
+  }
+  if (latest_start > earliest_end)
+    throw std::runtime_error(fleet_file + ": the vehicles' datasets share no time span (" + spans +
+                             "); a fleet's recordings must be stamped by one clock");
+}
+
+/// The whole run: datasets in, pipeline, files out. Returns the exit code.
 int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
   pipeline::PipelineOptions popts;
   popts.estimator = options;
@@ -137,57 +205,73 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
   calib::CalibratorConfig calib_config = calib::CalibratorConfig::load(o.calib_config);
   if (!o.mission.empty()) popts.mission = mission::loadMission(o.mission);
 
-  Diagnostics diag;
-  spdlog::info("reading dataset {}", o.dataset);
-  const Dataset ds = readDataset(o.dataset, diag, false);
-  spdlog::info("dataset: {} imu, {} baro, {} ranges, {} flight states, {} heights{}", ds.imu.size(), ds.baro.size(),
-               ds.ranges.size(), ds.flight_states.size(), ds.heights.size(), diag.total() ? "; dropped/flagged: " + diag.summary() : "");
+  std::vector<VehicleRun> runs = readVehicles(o);
+  std::vector<pipeline::Vehicle> vehicles;
+  for (const auto& r : runs) vehicles.push_back({r.name, r.ds.setup});
+  const SystemSetup fleet_setup = o.fleet.empty() ? runs[0].ds.setup : pipeline::mergeFleetSetups(vehicles, o.fleet);
 
-  const std::filesystem::path out_dir = o.out;
-  std::filesystem::create_directories(out_dir);
-  EstimateCsvWriter est_writer((out_dir / "estimate.csv").string());
-  AnchorsCsvWriter anchor_writer((out_dir / "anchors.csv").string());
-  // The calibrator's range σ_d comes from setup.yaml unless the calibrator config sets it, as in
-  // the calibrator process.
-  calib_config.applySetup(ds.setup);
+  std::vector<std::vector<EstimatorInput>> per_vehicle;
+  for (size_t v = 0; v < runs.size(); ++v) {
+    per_vehicle.push_back(mergeInTimeOrder(runs[v].ds));
+    if (per_vehicle.back().empty()) throw std::runtime_error(runs[v].dataset + ": no samples");
+  }
+  if (runs.size() > 1) checkSharedClock(runs, per_vehicle, o.fleet);
+  const std::vector<pipeline::FleetInput> inputs = pipeline::mergeFleetInputs(per_vehicle);
+
+  for (auto& r : runs) {
+    std::filesystem::create_directories(r.out);
+    r.estimates = std::make_unique<EstimateCsvWriter>((r.out / "estimate.csv").string());
+    r.anchors = std::make_unique<AnchorsCsvWriter>((r.out / "anchors.csv").string());
+  }
+  // The calibrator's range σ_d comes from setup.yaml (the first vehicle's in a fleet) unless the
+  // calibrator config sets it, as in the calibrator process.
+  calib_config.applySetup(fleet_setup);
   popts.calibrator = calib_config.calibrator;
   popts.calibrator_node = calib_config.node;
   pipeline::PipelineSinks psinks;
-  psinks.pose = [&](const PoseEstimate& e) { est_writer.write(e); };
-  psinks.anchors = [&](const std::vector<AnchorEstimate>& v) {
-    for (const auto& a : v) anchor_writer.write(a);
+  psinks.pose = [&](size_t v, const PoseEstimate& e) { runs[v].estimates->write(e); };
+  psinks.anchors = [&](size_t v, const std::vector<AnchorEstimate>& list) {
+    for (const auto& a : list) runs[v].anchors->write(a);
   };
-  pipeline::Pipeline pipe(popts, ds.setup, psinks);
-  EstimatorNode& node = pipe.estimator();
-  spdlog::info("estimator options:\n{}", node.options().toString());
-  spdlog::info("calibration: {}", !popts.calibration_enabled ? "off (known anchors only)"
-                                  : popts.mission            ? "by mission " + o.mission
-                                                             : std::string("automatic"));
+  pipeline::Pipeline pipe(popts, vehicles, fleet_setup, psinks);
+  spdlog::info("estimator options:\n{}", pipe.estimator().options().toString());
+  spdlog::info("calibration: {}{}", !popts.calibration_enabled ? "off (known anchors only)"
+                                    : popts.mission            ? "by mission " + o.mission
+                                                               : std::string("automatic"),
+               runs.size() > 1 ? fmt::format(", one anchor map for {} vehicles", runs.size()) : std::string());
 
-  const std::vector<EstimatorInput> inputs = mergeInTimeOrder(ds);
-  if (inputs.empty()) throw std::runtime_error(o.dataset + ": no samples");
-  const double data_s = (inputTime(inputs.back()) - inputTime(inputs.front())).sec();
+  const double data_s = (inputTime(inputs.back().input) - inputTime(inputs.front().input)).sec();
   const double wall_s = feed(pipe, inputs, data_s);
-  node.finishRerun();  // refine.rerun_mode async: a re-run still on its worker comes in before the final anchors
-  if (node.initialized())
-    for (const auto& a : node.anchors()) anchor_writer.write(a);
-  est_writer.flush();
-  anchor_writer.flush();
-  writeTimings(node.timings(), (out_dir / "timings.csv").string());
+  int code = 0;
+  for (size_t v = 0; v < runs.size(); ++v) {
+    EstimatorNode& node = pipe.estimator(v);
+    node.finishRerun();  // refine.rerun_mode async: a re-run still on its worker comes in before the final anchors
+    if (node.initialized())
+      for (const auto& a : node.anchors()) runs[v].anchors->write(a);
+    runs[v].estimates->flush();
+    runs[v].anchors->flush();
+    writeTimings(node.timings(), (runs[v].out / "timings.csv").string());
+  }
+  if (pipe.diagnostics().total() > 0) spdlog::info("fleet: {}", pipe.diagnostics().summary());
   if (const auto* cal = pipe.calibrator()) {
-    calib::writeCalibrationYaml(cal->results(), (out_dir / "calibration.yaml").string());
+    const std::filesystem::path calib_file = std::filesystem::path(o.out) / "calibration.yaml";
+    calib::writeCalibrationYaml(cal->results(), calib_file.string());
     std::string ids;
     for (const auto& a : pipe.anchorInits()) ids += (ids.empty() ? "" : ",") + std::to_string(a.id);
-    spdlog::info("calibration: {} anchors initialized ({}), results in calibration.yaml", pipe.anchorInits().size(),
-                 ids.empty() ? std::string("none") : ids);
+    spdlog::info("calibration: {} anchors initialized ({}), results in {}", pipe.anchorInits().size(),
+                 ids.empty() ? std::string("none") : ids, calib_file.string());
     // The anchors left out, each with why (a refusal, or what automatic calibration waits for).
     for (const auto& a : cal->status().anchors)
       if (a.state != "calibrated")
         spdlog::warn("calibration: anchor {} not calibrated ({}, {} ranges from {} references){}", a.id, a.state,
                      a.n_ranges, a.n_refs, a.reason.empty() ? std::string() : ": " + a.reason);
   }
-  writeStatus(node.status(), wall_s, data_s, (out_dir / "status.txt").string());
-  return report(node, data_s, wall_s, out_dir.string(), o.allow_lost);
+  for (size_t v = 0; v < runs.size(); ++v) {
+    const EstimatorNode& node = pipe.estimator(v);
+    writeStatus(node.status(), wall_s, data_s, (runs[v].out / "status.txt").string());
+    code = std::max(code, report(node, data_s, wall_s, runs[v].out.string(), o.allow_lost, runs[v].who()));
+  }
+  return code;
 }
 
 /// The work of main: --print-config, or the pipeline on --dataset.
@@ -197,8 +281,8 @@ int run(const RunOptions& o) {
     std::cout << options.toString();
     return 0;
   }
-  if (o.dataset.empty() || o.out.empty()) {
-    std::cerr << "meshnav_run: --dataset and --out are required (see --help)\n";
+  if ((o.dataset.empty() && o.fleet.empty()) || o.out.empty()) {
+    std::cerr << "meshnav_run: --dataset (or --fleet) and --out are required (see --help)\n";
     return 2;
   }
   if (!o.strategy.empty()) options.strategy = o.strategy;

@@ -5,17 +5,34 @@
 /// (RANGE → estimator and calibrator, POSE/ANCHORS → calibrator and mission, CALIB_CMD,
 /// ANCHOR_INIT, ESTIMATOR_CMD, CALIB_STATUS), but deterministic: every message a node emits is
 /// queued and delivered in FIFO order after the node returns, exactly once, never re-entrantly.
+///
+/// **A fleet** (`meshnav_run --fleet`, docs/fleet.md): several vehicles share one anchor map. Each
+/// vehicle has its own estimator node (its own setup: tags, IMU, baro); one calibrator takes the
+/// ranges and poses of every vehicle (a pose history per vehicle) and one mission drives it. An
+/// ANCHOR_INIT goes to every vehicle's estimator, with the pair biases of the other vehicles' tags
+/// left out (and their rows of the joint covariance). ANCHORS towards the calibrator: per anchor the
+/// belief with the smallest covariance trace among the vehicles' latest. ESTIMATOR_CMD goes to every
+/// vehicle; the mission hears the first vehicle's ESTIMATOR_STATUS. A single vehicle is a fleet of
+/// one, vehicle 0. A range of a vehicle's dataset to another vehicle's tag goes nowhere (counted,
+/// "inter_vehicle_range:NAME" in `diagnostics()`): relative ranging between vehicles is not modelled.
+/// An anchor–anchor range in several vehicles' datasets (the same time and pair: one mesh heard by
+/// all) reaches the calibrator once; each estimator fuses its own dataset's.
 
 #include <deque>
 #include <functional>
+#include <map>
+#include <string>
 #include <memory>
 #include <optional>
+#include <set>
+#include <tuple>
 #include <variant>
 #include <vector>
 
 #include "calibrator/calibrator_options.h"
 #include "calibrator/node/calibrator_node.h"
 #include "calibrator/node/calibrator_node_options.h"
+#include "common/diagnostics.h"
 #include "common/messages.h"
 #include "common/setup.h"
 #include "estimator/core/estimator_options.h"
@@ -37,11 +54,19 @@ struct PipelineOptions {
   double pose_to_calibrator_hz = 50.0; ///< POSE decimation towards the calibrator (0: every pose) [Hz]
 };
 
-/// What the pipeline emits (the channels a logger would record).
+/// One vehicle of a fleet: a name (its output folder) and its setup. The anchors of every vehicle's
+/// setup must be the fleet's shared map (`mergeFleetSetups`, fleet.h).
+struct Vehicle {
+  std::string name;
+  SystemSetup setup;
+};
+
+/// What the pipeline emits (the channels a logger would record); the per-vehicle ones say whose
+/// (the vehicle's index in the constructor's list, 0 for a single vehicle).
 struct PipelineSinks {
-  std::function<void(const PoseEstimate&)> pose;
-  std::function<void(const std::vector<AnchorEstimate>&)> anchors;
-  std::function<void(const EstimatorStatus&)> estimator_status;
+  std::function<void(size_t vehicle, const PoseEstimate&)> pose;
+  std::function<void(size_t vehicle, const std::vector<AnchorEstimate>&)> anchors;
+  std::function<void(size_t vehicle, const EstimatorStatus&)> estimator_status;
   std::function<void(const AnchorInit&)> anchor_init;
   std::function<void(const CalibStatus&)> calib_status;
   std::function<void(const MissionStatus&)> mission_status;
@@ -49,35 +74,63 @@ struct PipelineSinks {
 
 class Pipeline {
  public:
+  /// One vehicle.
   Pipeline(const PipelineOptions& options, const SystemSetup& setup, PipelineSinks sinks = {});
+  /// A fleet: `fleet_setup` is what the calibrator knows (every vehicle's tags and the shared
+  /// anchors, `mergeFleetSetups`); throws std::invalid_argument for an empty list or a tag that is
+  /// not in `fleet_setup`.
+  Pipeline(const PipelineOptions& options, std::vector<Vehicle> vehicles, const SystemSetup& fleet_setup,
+           PipelineSinks sinks = {});
   ~Pipeline();
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
 
   /// One sensor sample (IMU, baro, range, flight state, height) or command, then every message it causes.
-  void onInput(const estimator::EstimatorInput& in);
+  void onInput(const estimator::EstimatorInput& in) { onInput(0, in); }
+  /// The same for vehicle `vehicle` (out of range: std::out_of_range).
+  void onInput(size_t vehicle, const estimator::EstimatorInput& in);
 
-  estimator::EstimatorNode& estimator() { return *estimator_; }
-  const estimator::EstimatorNode& estimator() const { return *estimator_; }
+  size_t vehicleCount() const { return vehicles_.size(); }
+  const std::string& vehicleName(size_t v) const { return vehicles_.at(v).name; }
+  /// The estimator of vehicle `v` (0: the only one of a single vehicle).
+  estimator::EstimatorNode& estimator(size_t v = 0) { return *estimators_.at(v); }
+  const estimator::EstimatorNode& estimator(size_t v = 0) const { return *estimators_.at(v); }
   /// Null when calibration is disabled.
   const calib::CalibratorNode* calibrator() const { return calibrator_.get(); }
   const mission::MissionNode* mission() const { return mission_.get(); }
-  /// ANCHOR_INITs handed to the estimator so far (initial beliefs, for evaluation).
+  /// ANCHOR_INITs handed to the estimators so far, as the calibrator sent them (initial beliefs,
+  /// for evaluation).
   const std::vector<AnchorInit>& anchorInits() const { return anchor_inits_; }
+  /// The pipeline's own counters (a fleet's inter-vehicle ranges).
+  const Diagnostics& diagnostics() const { return diag_; }
 
  private:
-  using Event = std::variant<PoseEstimate, std::vector<AnchorEstimate>, EstimatorStatus, AnchorInit, CalibStatus,
-                             CalibCommand, EstimatorCommand, MissionStatus>;
+  using Message = std::variant<PoseEstimate, std::vector<AnchorEstimate>, EstimatorStatus, AnchorInit, CalibStatus,
+                               CalibCommand, EstimatorCommand, MissionStatus>;
+  struct Event {
+    size_t vehicle = 0;  ///< whose estimator sent it (estimator outputs only)
+    Message msg;
+  };
   void drain();
+  /// False for an anchor–anchor range another vehicle's dataset already gave the calibrator (within
+  /// 10 s; counted "mesh_range_from_another_vehicle").
+  bool firstInFleet(const RangeSample& r);
+  /// ANCHORS of vehicle v towards the calibrator: per anchor the tightest of the vehicles' latest.
+  void forwardAnchors(size_t v, const std::vector<AnchorEstimate>& anchors);
 
   PipelineOptions options_;
   PipelineSinks sinks_;
-  std::unique_ptr<estimator::EstimatorNode> estimator_;
+  std::vector<Vehicle> vehicles_;
+  SystemSetup fleet_setup_;  ///< what the calibrator knows
+  std::vector<std::unique_ptr<estimator::EstimatorNode>> estimators_;
+  std::vector<std::map<SensorId, AnchorEstimate>> anchor_beliefs_;  ///< per vehicle, its latest ANCHORS
   std::unique_ptr<calib::CalibratorNode> calibrator_;
   std::unique_ptr<mission::MissionNode> mission_;
   std::deque<Event> queue_;
   std::vector<AnchorInit> anchor_inits_;
-  std::optional<Timestamp> last_pose_to_calibrator_;
+  Diagnostics diag_;
+  std::set<std::tuple<int64_t, SensorId, SensorId>> mesh_ranges_;  ///< (µs, ids) given to the calibrator
+  std::vector<std::optional<Timestamp>> last_pose_to_calibrator_;  ///< per vehicle
   bool t0_set_ = false;
 };
 

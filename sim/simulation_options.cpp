@@ -29,12 +29,14 @@ void SimulationOptions::validate() const {
     require(s.x() >= 3.0 && s.y() >= 3.0 && s.x() <= 100.0 && s.y() <= 100.0, "hall (--hall) X and Y must be in [3, 100] m");
     require(s.z() >= 2.5 && s.z() <= 30.0, "hall (--hall) Z must be in [2.5, 30] m");
   }
+  require(tag_id_offset >= 0 && tag_id_offset <= 1000000 && tag_id_offset % 1000 == 0,
+          "tag_id_offset must be a multiple of 1000 in [0, 1000000]");
   if (duration_s) require(*duration_s >= 30.0 && *duration_s <= 3600.0, "duration_s (--duration) must be in [30, 3600] s");
 }
 
 bool SimulationOptions::isPaperScenario() const {
   return trajectory_kind == TrajectoryKind::Spiral && !hall_size_m && anchor_layout == AnchorLayoutKind::Paper &&
-         n_tags == 2 && n_known_anchors == 4 && n_unknown_anchors == 5;
+         n_tags == 2 && n_known_anchors == 4 && n_unknown_anchors == 5 && tag_id_offset == 0;
 }
 
 std::string SimulationOptions::toString() const {

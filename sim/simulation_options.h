@@ -44,6 +44,12 @@ struct SimulationOptions {
   int n_known_anchors = 4;                      ///< --known: anchors written to setup.yaml (3–5)
   int n_unknown_anchors = 5;                    ///< --unknown: further anchors, truth.yaml only
   std::optional<double> duration_s;             ///< --duration [s]; nullopt: 140 s × duration_scale
+  /// A fleet's vehicle k (--fleet, fleet_simulation.h): its tags' ids are the single vehicle's + this
+  /// (1000·k), so that every tag of the fleet has its own id.
+  int tag_id_offset = 0;
+  /// Seed of the anchor layout (a fleet's one world: every vehicle among the same anchors);
+  /// nullopt: `seed`.
+  std::optional<uint64_t> layout_seed;
 
   /// The hall box: `Hall::ofSize(*hall_size_m)` or the paper's.
   Hall hall() const { return hall_size_m ? Hall::ofSize(*hall_size_m) : Hall::paper(); }

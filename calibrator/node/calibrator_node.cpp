@@ -55,7 +55,7 @@ const char* CalibratorNode::toString(State s) {
 }
 
 CalibratorNode::CalibratorNode(const CalibratorOptions& options, const SystemSetup& setup, CalibratorSinks sinks,
-                               const CalibratorNodeOptions& node_options)
+                               const CalibratorNodeOptions& node_options, std::map<SensorId, size_t> vehicle_of_tag)
     : node_options_(node_options),
       setup_(setup),
       sinks_(std::move(sinks)),
@@ -64,6 +64,14 @@ CalibratorNode::CalibratorNode(const CalibratorOptions& options, const SystemSet
       collect_new_anchors_(node_options.collect_from_start),
       time_guard_(guardOptions(node_options)) {
   node_options_.validate();
+  size_t n_vehicles = 1;
+  for (const auto& [tag, v] : vehicle_of_tag) {
+    if (!setup_.isTag(tag))
+      throw std::invalid_argument("calibrator: vehicle_of_tag names " + std::to_string(tag) + ", not a tag of the setup");
+    n_vehicles = std::max(n_vehicles, v + 1);
+  }
+  vehicle_of_tag_ = std::move(vehicle_of_tag);
+  histories_.resize(n_vehicles);
   if (!(options.sigma_range_m > 0.0)) throw std::invalid_argument("calibrator option sigma_range must be > 0");
 }
 
@@ -160,7 +168,7 @@ void CalibratorNode::addRange(SensorId x, Track& track, const RangeSample& r) {
   }
 }
 
-void CalibratorNode::onPose(const PoseEstimate& p_in) {
+void CalibratorNode::onPose(const PoseEstimate& p_in, size_t vehicle) {
   PoseEstimate p = p_in;
   const double qn = p.q_ItoG.norm();
   if (!p.p_IinG.allFinite() || !p.q_ItoG.coeffs().allFinite() || !(qn > 0.5 && qn < 2.0) ||
@@ -168,32 +176,38 @@ void CalibratorNode::onPose(const PoseEstimate& p_in) {
     diag_.report("bad_pose", "pose at t=" + formatSeconds(p.t) + " has a non-finite value or a bad quaternion");
     return;
   }
-  if (!admitTime("POSE", p.t)) return;
-  p.q_ItoG.normalize();
-  const Duration window = Duration::fromSec(node_options_.history_window_s);
-  if (!poses_.empty() && p.t < poses_.back().t - window) {
-    diag_.report("pose_too_old", "pose at t=" + formatSeconds(p.t) + " is older than the history window (newest " +
-                                     formatSeconds(poses_.back().t) + ")");
+  if (vehicle >= histories_.size()) {
+    diag_.report("bad_pose", "pose at t=" + formatSeconds(p.t) + " of vehicle " + std::to_string(vehicle) +
+                                 ", which carries no tag of the setup");
     return;
   }
-  if (poses_.empty() || p.t > poses_.back().t) {
-    poses_.push_back(p);
+  if (!admitTime("POSE", p.t)) return;
+  std::vector<PoseEstimate>& poses = histories_[vehicle];
+  p.q_ItoG.normalize();
+  const Duration window = Duration::fromSec(node_options_.history_window_s);
+  if (!poses.empty() && p.t < poses.back().t - window) {
+    diag_.report("pose_too_old", "pose at t=" + formatSeconds(p.t) + " is older than the history window (newest " +
+                                     formatSeconds(poses.back().t) + ")");
+    return;
+  }
+  if (poses.empty() || p.t > poses.back().t) {
+    poses.push_back(p);
   } else {
-    auto it = std::lower_bound(poses_.begin(), poses_.end(), p.t,
+    auto it = std::lower_bound(poses.begin(), poses.end(), p.t,
                                [](const PoseEstimate& a, Timestamp t) { return a.t < t; });
-    if (it != poses_.end() && it->t == p.t) {
+    if (it != poses.end() && it->t == p.t) {
       *it = p;  // same instant: the newer message wins
     } else {
-      poses_.insert(it, p);
+      poses.insert(it, p);
       diag_.count("poses_out_of_order");
     }
   }
   // Trim the history (amortised: only when the slack is exceeded).
-  const Timestamp cutoff = poses_.back().t - window;
-  if (poses_.front().t < cutoff - Duration::fromSec(kPruneSlackS)) {
-    auto it = std::lower_bound(poses_.begin(), poses_.end(), cutoff,
+  const Timestamp cutoff = poses.back().t - window;
+  if (poses.front().t < cutoff - Duration::fromSec(kPruneSlackS)) {
+    auto it = std::lower_bound(poses.begin(), poses.end(), cutoff,
                                [](const PoseEstimate& a, Timestamp t) { return a.t < t; });
-    poses_.erase(poses_.begin(), it);
+    poses.erase(poses.begin(), it);
   }
   advance(p.t);
   runPeriodic();
@@ -338,9 +352,10 @@ bool CalibratorNode::admitTime(const std::string& kind, Timestamp t) {
     newest_ = t;
     next_status_.reset();
     next_prune_.reset();
-    poses_.erase(std::upper_bound(poses_.begin(), poses_.end(), t,
-                                  [](Timestamp x, const PoseEstimate& p) { return x < p.t; }),
-                 poses_.end());
+    for (auto& poses : histories_)
+      poses.erase(std::upper_bound(poses.begin(), poses.end(), t,
+                                   [](Timestamp x, const PoseEstimate& p) { return x < p.t; }),
+                  poses.end());
     for (auto& [id, tr] : tracks_) tr.next_auto_check = t;
   }
   return true;
@@ -419,9 +434,15 @@ CalibStatus CalibratorNode::status() const {
   s.counters = diag_.snapshot();
   s.counters["ranges_waiting_for_pose"] = last_waiting_for_pose_;
   s.counters["ranges_waiting_for_reference"] = last_waiting_for_reference_;
-  s.counters["poses_held"] = static_cast<int64_t>(poses_.size());
+  s.counters["poses_held"] = static_cast<int64_t>(poseHistorySize());
   s.counters["anchors_calibrated"] = static_cast<int64_t>(calibratedAnchors().size());
   return s;
+}
+
+size_t CalibratorNode::poseHistorySize() const {
+  size_t n = 0;
+  for (const auto& poses : histories_) n += poses.size();
+  return n;
 }
 
 std::vector<SensorId> CalibratorNode::calibratedAnchors() const {

@@ -58,6 +58,12 @@
 /// **Duplicates**: a range with the time and ids of one already received (within
 /// `time_max_offset` of data time) is dropped and counted ("RANGE:duplicate").
 ///
+/// **Several vehicles** (`./meshnav run --fleet`, pipeline.h): the setup then holds the tags of every
+/// vehicle and `vehicle_of_tag` says whose each is; POSE of vehicle v goes to `onPose(p, v)` and
+/// fills v's own pose history, and a range of a tag is placed with its vehicle's history. Anchors
+/// are shared, so one calibration uses the ranges of every vehicle's tags. A single vehicle is
+/// vehicle 0 (the default).
+///
 /// **Bad input** (non-finite or absurd range, self-range, ids ≤ 0, tag-typed ids not in the setup,
 /// the IMU/baro ids, non-finite poses or covariances, poses older than the history window) is
 /// logged, counted and dropped; it never throws. Not thread-safe: call from one thread.
@@ -93,11 +99,14 @@ struct CalibratorSinks {
 class CalibratorNode {
  public:
   /// Throws std::invalid_argument for invalid node options.
+  /// `vehicle_of_tag`: the vehicle index of each tag of `setup` (tags not listed: vehicle 0); throws
+  /// std::invalid_argument when it names an id that is not a tag of the setup.
   CalibratorNode(const CalibratorOptions& options, const SystemSetup& setup, CalibratorSinks sinks = {},
-                 const CalibratorNodeOptions& node_options = {});
+                 const CalibratorNodeOptions& node_options = {}, std::map<SensorId, size_t> vehicle_of_tag = {});
 
   void onRange(const RangeSample& r);
-  void onPose(const PoseEstimate& p);
+  /// A pose of vehicle `vehicle` (0 for a single vehicle; an index no tag has is refused, "bad_pose").
+  void onPose(const PoseEstimate& p, size_t vehicle = 0);
   /// The estimator's current anchor beliefs (ANCHORS); those of calibrated anchors become their
   /// reference positions and covariances.
   void onAnchors(const std::vector<AnchorEstimate>& anchors);
@@ -119,8 +128,10 @@ class CalibratorNode {
   const Diagnostics& diagnostics() const { return diag_; }
   const CalibratorNodeOptions& nodeOptions() const { return node_options_; }
   const CalibratorOptions& options() const { return calibrator_.options(); }
-  /// Poses held in the history.
-  size_t poseHistorySize() const { return poses_.size(); }
+  /// Poses held in the histories (every vehicle's).
+  size_t poseHistorySize() const;
+  /// Vehicles, i.e. pose histories (1 + the largest index in `vehicle_of_tag`).
+  size_t vehicleCount() const { return histories_.size(); }
   /// Identities of executed commands kept to recognise a re-sent one.
   static constexpr size_t kMaxCommandKeys = 1024;
 
@@ -149,6 +160,8 @@ class CalibratorNode {
   /// Position and covariance of a stationary reference (known or calibrated anchor).
   std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> anchorReference(SensorId id) const;
   std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> tagPosition(SensorId tag, Timestamp t) const;
+  /// The pose history of the vehicle that carries `tag`.
+  const std::vector<PoseEstimate>& historyOf(SensorId tag) const;
   bool isReference(SensorId id) const;
   bool isUnknownAnchor(SensorId id, UwbType type) const;
 
@@ -178,7 +191,8 @@ class CalibratorNode {
   ObservationBuilder prior_source_;  ///< only for the a-priori pair biases of setup.yaml
   Diagnostics diag_;
 
-  std::vector<PoseEstimate> poses_;  ///< sorted by time, within the history window
+  std::map<SensorId, size_t> vehicle_of_tag_;
+  std::vector<std::vector<PoseEstimate>> histories_;  ///< per vehicle: sorted by time, within the history window
   std::map<SensorId, AnchorEstimate> beliefs_;
   std::map<SensorId, Track> tracks_;
   std::set<std::tuple<int64_t, SensorId, SensorId>> seen_ranges_;  ///< (µs, ids) within time_max_offset

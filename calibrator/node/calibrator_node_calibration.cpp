@@ -22,9 +22,14 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> CalibratorNode::tagPo
   const auto lever = setup_.rel_tag_positions.find(tag);
   if (lever == setup_.rel_tag_positions.end()) return std::nullopt;
   const auto& opt = calibrator_.options();
-  const auto pose = interpolateEstimate(poses_, t, Duration::fromSec(opt.max_pose_gap_s));
+  const auto pose = interpolateEstimate(historyOf(tag), t, Duration::fromSec(opt.max_pose_gap_s));
   if (!pose) return std::nullopt;
   return tagPositionAtPose(*pose, lever->second, opt.min_tag_position_sigma_m);
+}
+
+const std::vector<PoseEstimate>& CalibratorNode::historyOf(SensorId tag) const {
+  const auto it = vehicle_of_tag_.find(tag);
+  return histories_[it == vehicle_of_tag_.end() ? 0 : it->second];
 }
 
 std::optional<std::pair<Eigen::Vector3d, Eigen::Matrix3d>> CalibratorNode::anchorReference(SensorId id) const {
@@ -51,7 +56,7 @@ CalibratorNode::Built CalibratorNode::buildObservations(SensorId x, Track& tr) {
         o.p_RinG = tp->first;
         o.cov_p_RinG_m2 = tp->second;
         b.obs.push_back(o);
-      } else if (poses_.empty() || r.t > poses_.back().t) {
+      } else if (const auto& poses = historyOf(ref); poses.empty() || r.t > poses.back().t) {
         ++b.waiting_for_pose;  // the pose may still come
       } else {
         ++b.dropped_no_pose;   // a gap in (or before) the pose history: never usable

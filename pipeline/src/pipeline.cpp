@@ -1,72 +1,138 @@
 #include "pipeline/pipeline.h"
 
+#include <stdexcept>
+
+#include "pipeline/fleet.h"
+
 namespace meshnav::pipeline {
 
 Pipeline::Pipeline(const PipelineOptions& options, const SystemSetup& setup, PipelineSinks sinks)
-    : options_(options), sinks_(std::move(sinks)) {
-  estimator::EstimatorSinks es;
-  es.pose = [this](const PoseEstimate& p) { queue_.emplace_back(p); };
-  es.anchors = [this](const std::vector<AnchorEstimate>& a) { queue_.emplace_back(a); };
-  es.status = [this](const EstimatorStatus& s) { queue_.emplace_back(s); };
-  estimator_ = std::make_unique<estimator::EstimatorNode>(options_.estimator, setup, es);
+    : Pipeline(options, std::vector<Vehicle>{Vehicle{"", setup}}, setup, std::move(sinks)) {}
+
+Pipeline::Pipeline(const PipelineOptions& options, std::vector<Vehicle> vehicles, const SystemSetup& fleet_setup,
+                   PipelineSinks sinks)
+    : options_(options), sinks_(std::move(sinks)), vehicles_(std::move(vehicles)), fleet_setup_(fleet_setup) {
+  if (vehicles_.empty()) throw std::invalid_argument("pipeline: no vehicle");
+  std::map<SensorId, size_t> vehicle_of_tag;
+  for (size_t v = 0; v < vehicles_.size(); ++v) {
+    for (const auto& [tag, lever] : vehicles_[v].setup.rel_tag_positions) {
+      if (!fleet_setup.isTag(tag))
+        throw std::invalid_argument("pipeline: tag " + std::to_string(tag) + " of vehicle " + vehicles_[v].name +
+                                    " is not in the fleet's setup");
+      vehicle_of_tag[tag] = v;
+    }
+    estimator::EstimatorSinks es;
+    es.pose = [this, v](const PoseEstimate& p) { queue_.push_back({v, p}); };
+    es.anchors = [this, v](const std::vector<AnchorEstimate>& a) { queue_.push_back({v, a}); };
+    es.status = [this, v](const EstimatorStatus& s) { queue_.push_back({v, s}); };
+    estimators_.push_back(std::make_unique<estimator::EstimatorNode>(options_.estimator, vehicles_[v].setup, es));
+  }
+  anchor_beliefs_.resize(vehicles_.size());
+  last_pose_to_calibrator_.resize(vehicles_.size());
   if (options_.calibration_enabled) {
     calib::CalibratorNodeOptions node_opts = options_.calibrator_node;
     if (!options_.mission) node_opts.auto_mode = true;
     calib::CalibratorSinks cs;
-    cs.anchor_init = [this](const AnchorInit& a) { queue_.emplace_back(a); };
-    cs.status = [this](const CalibStatus& s) { queue_.emplace_back(s); };
-    calibrator_ = std::make_unique<calib::CalibratorNode>(options_.calibrator, setup, cs, node_opts);
+    cs.anchor_init = [this](const AnchorInit& a) { queue_.push_back({0, a}); };
+    cs.status = [this](const CalibStatus& s) { queue_.push_back({0, s}); };
+    calibrator_ = std::make_unique<calib::CalibratorNode>(options_.calibrator, fleet_setup, cs, node_opts,
+                                                          std::move(vehicle_of_tag));
   }
   if (options_.mission) {
     mission::MissionSinks ms;
-    ms.calib_cmd = [this](const CalibCommand& c) { queue_.emplace_back(c); };
-    ms.estimator_cmd = [this](const EstimatorCommand& c) { queue_.emplace_back(c); };
-    ms.status = [this](const MissionStatus& s) { queue_.emplace_back(s); };
+    ms.calib_cmd = [this](const CalibCommand& c) { queue_.push_back({0, c}); };
+    ms.estimator_cmd = [this](const EstimatorCommand& c) { queue_.push_back({0, c}); };
+    ms.status = [this](const MissionStatus& s) { queue_.push_back({0, s}); };
     mission_ = std::make_unique<mission::MissionNode>(*options_.mission, ms);
   }
 }
 
 Pipeline::~Pipeline() = default;
 
-void Pipeline::onInput(const estimator::EstimatorInput& in) {
+void Pipeline::onInput(size_t vehicle, const estimator::EstimatorInput& in) {
+  estimator::EstimatorNode& node = *estimators_.at(vehicle);
   const Timestamp t = estimator::inputTime(in);
   if (!t0_set_) {
-    // Mission times are relative to the dataset's first sample.
+    // Mission times are relative to the dataset's (the fleet's) first sample.
     if (mission_) mission_->setT0(t);
     t0_set_ = true;
   }
-  estimator_->onInput(in);
+  if (vehicles_.size() > 1)
+    if (const auto* r = std::get_if<RangeSample>(&in)) {
+      const SystemSetup& mine = vehicles_[vehicle].setup;
+      const auto foreign = [&](SensorId id) { return fleet_setup_.isTag(id) && !mine.isTag(id); };
+      if (foreign(r->id_initiator) || foreign(r->id_responder)) {
+        // A range to another vehicle's tag: no estimator models it yet, the calibrator needs it not.
+        diag_.count("inter_vehicle_range:" + vehicles_[vehicle].name);
+        return;
+      }
+    }
+  node.onInput(in);
   if (calibrator_) {
-    if (const auto* r = std::get_if<RangeSample>(&in)) calibrator_->onRange(*r);
+    if (const auto* r = std::get_if<RangeSample>(&in); r && firstInFleet(*r)) calibrator_->onRange(*r);
     calibrator_->tick(t);
   }
   if (mission_) mission_->onTime(t);
   drain();
 }
 
+bool Pipeline::firstInFleet(const RangeSample& r) {
+  if (vehicles_.size() == 1 || fleet_setup_.isTag(r.id_initiator) || fleet_setup_.isTag(r.id_responder)) return true;
+  // The anchors' mesh is heard by every vehicle: the same sample in several datasets is one range.
+  constexpr int64_t kKeepUs = 10'000'000;
+  while (!mesh_ranges_.empty() && std::get<0>(*mesh_ranges_.begin()) < r.t.us - kKeepUs)
+    mesh_ranges_.erase(mesh_ranges_.begin());
+  const auto key = pairKey(r.id_initiator, r.id_responder);
+  if (mesh_ranges_.emplace(r.t.us, key.first, key.second).second) return true;
+  diag_.count("mesh_range_from_another_vehicle");
+  return false;
+}
+
+void Pipeline::forwardAnchors(size_t v, const std::vector<AnchorEstimate>& anchors) {
+  if (vehicles_.size() == 1) {
+    calibrator_->onAnchors(anchors);
+    return;
+  }
+  auto& mine = anchor_beliefs_[v];
+  mine.clear();
+  for (const auto& a : anchors) mine[a.id] = a;
+  std::map<SensorId, AnchorEstimate> best;
+  for (const auto& beliefs : anchor_beliefs_)
+    for (const auto& [id, a] : beliefs) {
+      auto it = best.find(id);
+      if (it == best.end() || a.cov_p_m2.trace() < it->second.cov_p_m2.trace()) best[id] = a;
+    }
+  std::vector<AnchorEstimate> merged;
+  for (const auto& [id, a] : best) merged.push_back(a);
+  calibrator_->onAnchors(merged);
+}
+
 void Pipeline::drain() {
   while (!queue_.empty()) {
     Event ev = std::move(queue_.front());
     queue_.pop_front();
+    const size_t v = ev.vehicle;
     std::visit(
-        [this](auto& m) {
+        [this, v](auto& m) {
           using T = std::decay_t<decltype(m)>;
           if constexpr (std::is_same_v<T, PoseEstimate>) {
-            if (calibrator_ && (options_.pose_to_calibrator_hz <= 0.0 || !last_pose_to_calibrator_ ||
-                                (m.t - *last_pose_to_calibrator_).sec() >= 1.0 / options_.pose_to_calibrator_hz)) {
-              calibrator_->onPose(m);
-              last_pose_to_calibrator_ = m.t;
+            auto& last = last_pose_to_calibrator_[v];
+            if (calibrator_ &&
+                (options_.pose_to_calibrator_hz <= 0.0 || !last || (m.t - *last).sec() >= 1.0 / options_.pose_to_calibrator_hz)) {
+              calibrator_->onPose(m, v);
+              last = m.t;
             }
-            if (sinks_.pose) sinks_.pose(m);
+            if (sinks_.pose) sinks_.pose(v, m);
           } else if constexpr (std::is_same_v<T, std::vector<AnchorEstimate>>) {
-            if (calibrator_) calibrator_->onAnchors(m);
-            if (sinks_.anchors) sinks_.anchors(m);
+            if (calibrator_) forwardAnchors(v, m);
+            if (sinks_.anchors) sinks_.anchors(v, m);
           } else if constexpr (std::is_same_v<T, EstimatorStatus>) {
-            if (mission_) mission_->onEstimatorStatus(m);
-            if (sinks_.estimator_status) sinks_.estimator_status(m);
+            if (mission_ && v == 0) mission_->onEstimatorStatus(m);
+            if (sinks_.estimator_status) sinks_.estimator_status(v, m);
           } else if constexpr (std::is_same_v<T, AnchorInit>) {
             anchor_inits_.push_back(m);
-            estimator_->onAnchorInit(m);
+            for (size_t i = 0; i < estimators_.size(); ++i)
+              estimators_[i]->onAnchorInit(vehicles_.size() == 1 ? m : restrictToVehicle(m, vehicles_[i].setup, fleet_setup_));
             if (sinks_.anchor_init) sinks_.anchor_init(m);
           } else if constexpr (std::is_same_v<T, CalibStatus>) {
             if (mission_) mission_->onCalibStatus(m);
@@ -74,12 +140,12 @@ void Pipeline::drain() {
           } else if constexpr (std::is_same_v<T, CalibCommand>) {
             if (calibrator_) calibrator_->onCommand(m);
           } else if constexpr (std::is_same_v<T, EstimatorCommand>) {
-            estimator_->onCommand(m);
+            for (auto& e : estimators_) e->onCommand(m);
           } else if constexpr (std::is_same_v<T, MissionStatus>) {
             if (sinks_.mission_status) sinks_.mission_status(m);
           }
         },
-        ev);
+        ev.msg);
   }
 }
 

@@ -6,12 +6,15 @@
 #include <spdlog/spdlog.h>
 
 #include <exception>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
 
 #include "common/cli_main.h"
 #include "common/dataset.h"
+#include "sim/fleet_simulation.h"
 #include "sim/scenario_simulator.h"
 #include "sim/uncertain_anchors.h"
 
@@ -31,6 +34,7 @@ struct SimCli {
   double duration_s = 0.0;
   double bias_max_m = 0.0;
   double uncertain_sigma_m = 0.0;
+  int fleet = 0;
   bool no_initial_pose = false, uncertain_known = false;
 };
 
@@ -43,6 +47,12 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
       ->type_name("N")
       ->check(CLI::NonNegativeNumber);
   cli.optional("out", c.out, "output dataset folder (created if needed)")->type_name("DIR")->required();
+  cli.optional("fleet", c.fleet,
+               "simulate N vehicles (1-16) in one hall among the same anchors: vehicle k with seed --seed + k, tag "
+               "ids + 1000 k, the anchors' mesh ranges of vehicle 0; writes the datasets --out/v0 ... and "
+               "--out/fleet.yaml for 'meshnav run --fleet' (docs/fleet.md)")
+      ->type_name("N")
+      ->check(CLI::Range(1, 16));
   cli.optional("trajectory", c.trajectory,
                "spiral|figure8|lawnmower|helix|hover|walk (default spiral: the paper's flight). hover starts in the "
                "air; walk is a hand-held rig at 0.9-1.5 m with no take-off, no landed state and no barometer "
@@ -139,11 +149,34 @@ void applyScenarioOptions(const meshnav::Cli& cli, SimCli& c) {
   }
   if (cli.given("uncertain-anchors") && !(c.uncertain_sigma_m > 0.0 && c.uncertain_sigma_m < 10.0))
     throw std::invalid_argument("--uncertain-anchors must be in (0, 10) m");
+  if (cli.given("fleet") && cli.given("uncertain-anchors"))
+    throw std::invalid_argument("--uncertain-anchors is not supported with --fleet (its a-priori pair biases are drawn per vehicle)");
   if (c.uncertain_known && !cli.given("uncertain-anchors"))
     throw std::invalid_argument("--uncertain-known-anchors needs --uncertain-anchors M");
   o.seed = static_cast<uint64_t>(c.seed);
   o.with_initial_pose = !c.no_initial_pose;
   o.validate();
+}
+
+/// --fleet N: the datasets out/v0 ... and out/fleet.yaml.
+int simulateFleet(const meshnav::sim::SimulationOptions& options, int n, const std::string& out) {
+  const auto fleet = meshnav::sim::simulateFleet(options, n);
+  std::filesystem::create_directories(out);
+  std::ofstream file(std::filesystem::path(out) / "fleet.yaml");
+  file << "# a simulated fleet (meshnav_sim --fleet " << n << " --seed " << options.seed
+       << "): one hall, one anchor map; docs/fleet.md\nvehicles:\n";
+  for (size_t k = 0; k < fleet.size(); ++k) {
+    const std::string name = "v" + std::to_string(k);
+    const std::string dir = (std::filesystem::path(out) / name).string();
+    spdlog::info("vehicle {}: {}", name, fleet[k].trajectory_description);
+    meshnav::writeDataset(fleet[k].dataset, dir);
+    std::cout << name << ": " << fleet[k].summary() << "\n";
+    file << "  - {name: " << name << ", dataset: " << name << "}\n";
+  }
+  file.close();
+  if (!file) throw std::runtime_error(out + "/fleet.yaml: cannot write");
+  std::cout << "Fleet of " << n << " written to " << out << " (fleet.yaml)" << std::endl;
+  return 0;
 }
 
 /// The work of main: the scenario options checked (a bad combination: exit 2), then the sequence
@@ -157,6 +190,7 @@ int simulate(const meshnav::Cli& cli, SimCli& c) {
   }
   const auto& options = c.sim;
   spdlog::info("simulating: {}", options.toString());
+  if (cli.given("fleet")) return simulateFleet(options, c.fleet, c.out);
   const meshnav::sim::ScenarioSimulator simulator(options);
   meshnav::sim::SimulationResult result = simulator.run();
   if (cli.given("uncertain-anchors")) {

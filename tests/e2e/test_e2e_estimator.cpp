@@ -1,12 +1,14 @@
 /// End to end: simulate the paper scenario, run meshnav_run (centralized EKF, DP and DAH) and
 /// compare estimate.csv with the ground truth: seed 1 with the known anchors 101–104 only, and
-/// seed 10 with 106–110 given as known-but-uncertain (σ 0.3 m) and refined online.
+/// seed 10 with 106–110 given as known-but-uncertain (σ 0.3 m) and refined online; and a simulated
+/// fleet of two vehicles sharing one anchor map (`meshnav_run --fleet`).
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "common/dataset.h"
 #include "common/estimate_io.h"
@@ -27,6 +29,8 @@ struct PoseMetrics {
   int n = 0;
 };
 
+PoseMetrics comparePoses(const std::string& name, const fs::path& data, const fs::path& out);
+
 /// Simulates `seed` (extra meshnav_sim args), runs meshnav_run (extra args) and compares
 /// estimate.csv with the ground truth at every ground-truth sample.
 PoseMetrics runSequence(const std::string& name, int seed, const std::string& sim_args, const std::string& run_args) {
@@ -35,16 +39,22 @@ PoseMetrics runSequence(const std::string& name, int seed, const std::string& si
   const meshnav::test::TempDir tmp("e2e_estimator_" + name);
   const fs::path& dir = tmp.path();
   const fs::path data = dir / "data", out = dir / "run";
-  PoseMetrics m;
   EXPECT_EQ(run(std::string(MESHNAV_SIM_BIN) + " --seed " + std::to_string(seed) + " " + sim_args + " --out " +
                 data.string() + " > " + (dir / "sim.log").string() + " 2>&1"),
             0);
   EXPECT_EQ(run(std::string(MESHNAV_RUN_BIN) + " " + run_args + " --dataset " + data.string() + " --out " +
                 out.string() + " > " + (dir / "run.log").string() + " 2>&1"),
             0);
+  return comparePoses(name + ", seed " + std::to_string(seed), data, out);
+}
+
+/// Checks that the run folder `out` holds every output and compares its estimate.csv with the
+/// ground truth of the dataset folder `data` at every ground-truth sample.
+PoseMetrics comparePoses(const std::string& name, const fs::path& data, const fs::path& out) {
   for (const char* f : {"estimate.csv", "anchors.csv", "timings.csv", "status.txt"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
 
+  PoseMetrics m;
   Diagnostics diag;
   const auto truth = readTumCsv((data / "groundtruth.csv").string(), diag);
   const auto est = readEstimateCsv((out / "estimate.csv").string(), diag);
@@ -73,7 +83,7 @@ PoseMetrics runSequence(const std::string& name, int seed, const std::string& si
   m.rmse_p_m = std::sqrt(sq_p / m.n);
   m.rmse_q_deg = std::sqrt(sq_q / m.n) * 180.0 / M_PI;
   m.anees_p = nees / m.n;
-  std::cout << name << ", seed " << seed << ": position RMSE " << m.rmse_p_m << " m, orientation RMSE " << m.rmse_q_deg
+  std::cout << name << ": position RMSE " << m.rmse_p_m << " m, orientation RMSE " << m.rmse_q_deg
             << " deg, position ANEES " << m.anees_p << " (" << m.n << " samples)" << std::endl;
   return m;
 }
@@ -121,4 +131,54 @@ TEST(EndToEnd, UncertainAnchorsDpAndDahOnSimulatedSeed10) {
   std::ofstream(cfg) << yaml;
   const PoseMetrics fused = runSequence("uncertain_dah_fused", 10, sim, base + "dah --config " + cfg.string());
   EXPECT_GT(fused.anees_p, 2.0 * dah.anees_p) << "fusing them should be visibly overconfident";
+}
+
+// `meshnav_sim --fleet 2` and `meshnav_run --fleet`: two vehicles in one hall among the same
+// anchors, one calibrator for both (mission S2: 106–110 calibrated at 80 s and 100 s). Each vehicle
+// gets its own run folder with every output, each estimates its pose as well as a single vehicle
+// does (the bounds of runAndCheck), and both end up fusing the five calibrated anchors close to
+// their true positions. A fleet file naming a missing dataset key is refused with file and key.
+TEST(EndToEnd, FleetOfTwoSimulatedVehiclesSharesOneAnchorMap) {
+  const meshnav::test::TempDir tmp("e2e_fleet");
+  const fs::path data = tmp / "data", out = tmp / "run";
+  ASSERT_EQ(run(std::string(MESHNAV_SIM_BIN) + " --fleet 2 --seed 2 --out " + data.string() + " > " +
+                (tmp / "sim.log").string() + " 2>&1"),
+            0);
+  ASSERT_TRUE(fs::exists(data / "fleet.yaml"));
+  ASSERT_EQ(run(std::string(MESHNAV_RUN_BIN) + " --fleet " + (data / "fleet.yaml").string() + " --mission " +
+                MESHNAV_SOURCE_DIR + "/config/missions/paper_s2.yaml --out " + out.string() + " > " +
+                (tmp / "run.log").string() + " 2>&1"),
+            0);
+  EXPECT_TRUE(fs::exists(out / "calibration.yaml"));
+  for (const char* v : {"v0", "v1"}) {
+    const PoseMetrics m = comparePoses(std::string("fleet vehicle ") + v, data / v, out / v);
+    EXPECT_LE(m.rmse_p_m, 0.15) << v;
+    EXPECT_LE(m.rmse_q_deg, 3.0) << v;
+    EXPECT_GE(m.anees_p, 1.0) << v;
+    EXPECT_LE(m.anees_p, 6.0) << v;
+
+    Diagnostics diag;
+    const Dataset ds = readDataset((data / v).string(), diag, true);
+    ASSERT_TRUE(ds.truth.has_value());
+    std::map<SensorId, AnchorEstimate> last;
+    for (const auto& a : readAnchorsCsv((out / v / "anchors.csv").string(), diag)) last[a.id] = a;
+    EXPECT_EQ(diag.total(), 0) << diag.summary();
+    for (SensorId id : {106, 107, 108, 109, 110}) {
+      ASSERT_TRUE(last.count(id)) << v << " never fused anchor " << id;
+      const double err = (last[id].p_AinG - ds.truth->anchor_positions.at(id)).norm();
+      std::cout << v << ": anchor " << id << " final error " << err << " m" << std::endl;
+      EXPECT_LE(err, 0.15) << v << " anchor " << id;
+    }
+  }
+
+  const fs::path bad = tmp / "bad_fleet.yaml";
+  std::ofstream(bad) << "vehicles:\n  - {name: v0, dataset: data/v0}\n  - {name: v1}\n";
+  const fs::path log = tmp / "bad.log";
+  EXPECT_NE(run(std::string(MESHNAV_RUN_BIN) + " --fleet " + bad.string() + " --out " + (tmp / "bad").string() +
+                " > " + log.string() + " 2>&1"),
+            0);
+  std::ifstream in(log);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find(bad.string()), std::string::npos) << text;
+  EXPECT_NE(text.find("vehicles[1].dataset"), std::string::npos) << text;
 }

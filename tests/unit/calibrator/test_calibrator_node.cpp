@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <random>
 #include <set>
 
@@ -70,9 +71,10 @@ struct TimedCommand {
 /// Feeds ground-truth poses and ranges of `ds` in time order (poses first on equal times), with
 /// `cmds` issued before the first input at or after their times (at the end of the data when none
 /// is); stops before the first input after `t_end_s`. `pose_filter` may drop or alter poses.
+/// Each pose goes to every vehicle of `vehicles` (the node's pose histories; one vehicle: 0).
 void replay(CalibratorNode& node, const Dataset& ds, std::vector<TimedCommand> cmds,
             double t_end_s = std::numeric_limits<double>::infinity(),
-            const std::function<bool(PoseEstimate&)>& pose_filter = {}) {
+            const std::function<bool(PoseEstimate&)>& pose_filter = {}, const std::vector<size_t>& vehicles = {0}) {
   size_t ip = 0, ir = 0, ic = 0;
   const auto& poses = ds.ground_truth;
   const auto& ranges = ds.ranges;
@@ -86,7 +88,8 @@ void replay(CalibratorNode& node, const Dataset& ds, std::vector<TimedCommand> c
     }
     if (pose_next) {
       PoseEstimate e = asEstimate(poses[ip++]);
-      if (!pose_filter || pose_filter(e)) node.onPose(e);
+      if (!pose_filter || pose_filter(e))
+        for (size_t v : vehicles) node.onPose(e, v);
     } else {
       node.onRange(ranges[ir++]);
     }
@@ -301,6 +304,42 @@ TEST(CalibratorNode, AutoModeCalibratesEveryUnknownAnchorByItself) {
   CalibratorNode quiet(CalibratorOptions{}, setup(), sinksInto(manual));
   replay(quiet, seed1().dataset, {}, 60.0);
   EXPECT_TRUE(manual.inits.empty());
+}
+
+TEST(CalibratorNode, EachTagIsPlacedWithItsOwnVehiclesPoseHistory) {
+  // Seed 1's tags 100 and 105 as if they were on two vehicles of a fleet (vehicle 0 and 1).
+  const std::vector<TimedCommand> cmds = {{80.0, command(CalibCommand::Action::Calibrate, {106, 107})}};
+  const std::map<SensorId, size_t> fleet{{100, 0}, {105, 1}};
+  Outputs single, both, only0;
+  CalibratorNode one(CalibratorOptions{}, setup(), sinksInto(single));
+  replay(one, seed1().dataset, cmds);
+  // Both vehicles given the same (true) poses: the very same calibration as one vehicle.
+  CalibratorNode two(CalibratorOptions{}, setup(), sinksInto(both), {}, fleet);
+  EXPECT_EQ(two.vehicleCount(), 2u);
+  replay(two, seed1().dataset, cmds, std::numeric_limits<double>::infinity(), {}, {0, 1});
+  ASSERT_EQ(single.inits.size(), 2u);
+  ASSERT_EQ(both.inits.size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(both.inits[k].id, single.inits[k].id);
+    EXPECT_LT((both.inits[k].p_AinG - single.inits[k].p_AinG).norm(), 1e-9) << both.inits[k].id;
+    EXPECT_EQ(refIds(both.inits[k]), refIds(single.inits[k]));
+  }
+  EXPECT_EQ(two.poseHistorySize(), 2 * one.poseHistorySize());
+  // Only vehicle 0 reports poses: 105's ranges have no pose to be placed with, 100's do.
+  CalibratorNode lone(CalibratorOptions{}, setup(), sinksInto(only0), {}, fleet);
+  replay(lone, seed1().dataset, cmds, std::numeric_limits<double>::infinity(), {}, {0});
+  ASSERT_EQ(only0.inits.size(), 2u);
+  for (const auto& a : only0.inits) {
+    EXPECT_TRUE(refIds(a).count(100)) << a.id;
+    EXPECT_FALSE(refIds(a).count(105)) << a.id << " has a bias for a tag whose vehicle sent no pose";
+    EXPECT_LT(positionError(a), 0.3) << a.id;
+  }
+  const CalibStatus st = lone.status();
+  EXPECT_GT(st.counters.at("ranges_waiting_for_pose"), 100) << "105's ranges wait for vehicle 1's poses";
+  // A pose of a vehicle that carries no tag is bad input; a map naming a non-tag is refused.
+  lone.onPose(asEstimate(seed1().dataset.ground_truth.back()), 2);
+  EXPECT_EQ(lone.diagnostics().get("bad_pose"), 1);
+  EXPECT_THROW(CalibratorNode(CalibratorOptions{}, setup(), {}, {}, {{101, 1}}), std::invalid_argument);
 }
 
 TEST(CalibratorNode, OutOfOrderPosesGiveTheSameResultAsInOrder) {

@@ -41,7 +41,7 @@ RunResult runPipeline(const Flight& f, bool with_mission) {
   if (with_mission) o.mission = mission::loadMission(std::string(MESHNAV_SOURCE_DIR) + "/config/missions/paper_s2.yaml");
   RunResult r;
   pipeline::PipelineSinks sinks;
-  sinks.pose = [&](const PoseEstimate& p) { r.poses.push_back(p); };
+  sinks.pose = [&](size_t, const PoseEstimate& p) { r.poses.push_back(p); };
   sinks.anchor_init = [&](const AnchorInit& a) { r.inits.push_back(a); };
   pipeline::Pipeline p(o, f.ds.setup, sinks);
   for (const auto& in : f.inputs) p.onInput(in);
