@@ -45,7 +45,7 @@
 #include "estimator/filter/joint_set_bound.h"
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/node/estimator_node.h"
-#include "estimator/node/motion_aligner.h"
+#include "estimator/init/motion_aligner.h"
 #include "estimator/testing/synthetic_scenario.h"
 #include "estimator/uwb/range_model.h"
 #ifdef MESHNAV_BENCH_WITH_SIM

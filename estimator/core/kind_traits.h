@@ -19,7 +19,7 @@
 ///                                 "Restarts"),
 ///   - `toVector(v)`, `peersOf(v)`, `fromVector(x, peers)`  its value as a list of numbers (and the
 ///                                 peer ids of per-peer states) for the restart checkpoint
-///                                 (estimator/node/checkpoint.h); fromVector throws
+///                                 (estimator/restart/checkpoint.h); fromVector throws
 ///                                 std::invalid_argument on a list that does not fit.
 /// A kind whose state is one number derives `kDim`, `kBody`, `Value`, `boxplus`, `boxminus`,
 /// `check` and the vector form from ScalarStateKind (below). The strategies, NominalState and the node's recovery iterate over the

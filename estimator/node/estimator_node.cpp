@@ -50,13 +50,9 @@ EstimatorNode::Snapshot EstimatorNode::Snapshot::copy() const {
   return s;
 }
 
-using node_internal::alignerOptions;
 using node_internal::weakestPositionAxis;
 
 namespace {
-bool carriedHeightUsed(const EstimatorOptions& o, const SystemSetup& setup) {
-  return setup.carried_height && o.carried_height.enabled;
-}
 
 /// The options with the setup's noise figures, and for a carried rig (setup `carried_height`) the
 /// height model turned into the carried-height pseudo-sensor: reading σ, the bias's prior σ from
@@ -74,30 +70,6 @@ EstimatorOptions withSetup(EstimatorOptions o, const SystemSetup& setup) {
   return o;
 }
 
-/// The height model's lever arm: the rangefinder's, or none for the carried height (h = p_z + b).
-Eigen::Vector3d heightLever(const EstimatorOptions& o, const SystemSetup& setup) {
-  return carriedHeightUsed(o, setup) ? Eigen::Vector3d::Zero() : setup.height_p_IH;
-}
-
-/// The barometer is the in-motion alignment's height source when the setup gives its reference
-/// pressure (absolute heights) and no carried height is stated.
-bool baroAligns(const EstimatorOptions& o, const SystemSetup& setup) {
-  return o.init.motion_use_baro && !carriedHeightUsed(o, setup) && setup.baro_reference_pressure_pa && o.baro.enabled;
-}
-
-/// The alignment's options; its height model is the baro's (lever p_IP, no tilt correction, bias
-/// prior baro.init_bias_sigma_m) when the baro aligns, else the height model's.
-MotionAlignerOptions alignerOptionsFor(const EstimatorOptions& o, const SystemSetup& setup) {
-  MotionAlignerOptions a = alignerOptions(o, baroAligns(o, setup) ? setup.baro_p_IP : heightLever(o, setup));
-  if (baroAligns(o, setup)) {
-    a.height_tilt_correction = false;
-    a.sigma_bias_height_m = o.baro.init_bias_sigma_m;
-  }
-  if (o.flight_volume.enabled) a.flight_volume = setup.flight_volume;
-  a.volume_margin_m = o.flight_volume.candidate_margin_m;
-  return a;
-}
-
 }  // namespace
 
 EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup& setup, EstimatorSinks sinks)
@@ -109,26 +81,23 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
     : options_(withSetup(options, setup)),
       setup_(setup),
       sinks_(std::move(sinks)),
-      baro_model_(setup.baro_p_IP),
-      height_model_(heightLever(options, setup), options_.height.tilt_correction,
-                    options_.height.max_tilt_deg * M_PI / 180.0),
+      gate_(options_, diag_),
+      init_(options_, setup_, diag_, timings_),
+      gravity_(options_.init.motion_window_s, options_.init.gravity_early_check_nis_ratio, diag_),
+      volume_(options_.flight_volume, setup_, diag_),
+      outputs_(options_.pose_output_rate_hz, options_.anchors_output_rate_hz, options_.status_rate_hz),
+      baro_(options_.baro, setup.baro_id, setup.baro_p_IP),
+      height_(options_.height, setup.height_id, heightLever(options_, setup), carriedHeightUsed(options_, setup)),
       zupt_model_(Eigen::Vector3d(0.0, 0.0, -options.gravity_m_s2)),
-      aligner_(alignerOptionsFor(options_, setup), setup.rel_tag_positions),
-      still_detector_(StillnessOptions{}, options_.imu.acc_noise_density, options_.imu.gyro_noise_density,
-                      options_.gravity_m_s2),
       health_(options_.health),
-      time_guard_(options_.time) {
+      recovery_(options_.recovery, options_.init.motion_window_s),
+      reentry_(options_.uwb, diag_),
+      resume_(options_, setup_, diag_) {
   options_.validate();
-  carried_height_ = carriedHeightUsed(options_, setup_);
-  if (setup_.flight_volume && options_.flight_volume.enabled)
-    plane_mirror_ = AnchorPlaneMirror::of(setup_.abs_anchor_positions, *setup_.flight_volume);
-  baro_aligns_ = baroAligns(options_, setup_);
   if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
   skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
   rerun_enabled_ = options_.refine.rerun_on_anchor_join && (options_.strategy != "dah" || options_.refine.rerun_with_dah);
   rerun_async_ = options_.refine.rerun_mode == "async";
-  if (options_.baro.gate_probability > 0) baro_gate_ = chi2Quantile(1, options_.baro.gate_probability);
-  if (options_.height.gate_probability > 0) height_gate_ = chi2Quantile(1, options_.height.gate_probability);
   resetAll();
 }
 
@@ -136,25 +105,16 @@ void EstimatorNode::reportSetupGeometry() {
   const auto layout = AnchorLayout::of(setup_.abs_anchor_positions);
   if (!layout || !layout->nearlyCollinear()) return;
   // Anchors in a wall of the flight volume: the mirror image behind the wall is told apart.
-  if (plane_mirror_ && std::abs(plane_mirror_->normal().dot(layout->acrossLine_G())) > 0.9) return;
+  if (volume_.plane() && std::abs(volume_.plane()->normal().dot(layout->acrossLine_G())) > 0.9) return;
   diag_.report("known_anchors_nearly_collinear", "estimator: " + layout->describe());
 }
 
 void EstimatorNode::resetAll() {
-  initializer_ = std::make_unique<StaticInitializer>(options_, setup_);
-  aligner_.clear();
-  last_align_try_.reset();
-  last_side_constraint_.reset();
-  gravity_check_at_.reset();
-  gravity_checks_ = 0;
-  gravity_z_sign_ = -1.0;
-  gravity_flip_pending_ = false;
-  gravity_early_check_due_ = gravity_early_checked_ = false;
-  check_after_gap_until_.reset();
-  last_flip_try_.reset();
-  aligner_.setGravityAlongPlusZ(false);
+  init_.reset();
+  volume_.reset();
+  gravity_.reset();
+  recovery_.reset();
   zupt_model_ = ZuptModel(gravityG());
-  last_recovery_try_.reset();
   cur_ = Snapshot{};
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);
   cur_.network = std::make_shared<const UwbNetwork>(setup_, options_.uwb.sigma_range_m);
@@ -162,14 +122,12 @@ void EstimatorNode::resetAll() {
   clearRerunHistory();
   rerun_anchors_.clear();
   rerun_pending_ = false;
-  reentry_ = ReentryHold{};
-  last_tag_range_accepted_.reset();
-  pending_height_bias_.reset();
-  last_align_height_.reset();
-  seen_.clear();
-  baro_reference_pa_.reset();
+  reentry_.reset();
+  height_.setBiasPrior(std::nullopt);
+  gate_.forgetKeys();
+  baro_.setReference(std::nullopt);
   instance_stats_.clear();
-  last_pose_pub_.reset();
+  outputs_.resetPose();
 }
 
 void EstimatorNode::event(bool first, const std::string& kind, const std::string& message) {
@@ -180,55 +138,15 @@ void EstimatorNode::event(bool first, const std::string& kind, const std::string
     diag_.report(kind, message);
 }
 
-/// With uwb.use_corrected_range, a correction larger than this is no correction (a source that
-/// leaves range_corr at 0, like old serial-bridge logs and real-t1-a3-loiter) [m].
-constexpr double kMaxRangeCorrection_m = 1.0;
-
-bool EstimatorNode::validate(const EstimatorInput& in) {
-  std::string bad;
-  Timestamp t = inputTime(in);
-  if (const auto* s = std::get_if<ImuSample>(&in)) {
-    if (!s->acc_m_s2.allFinite() || !s->gyro_rad_s.allFinite() ||
-        s->acc_m_s2.norm() > plausible::kMaxSpecificForce_m_s2 || s->gyro_rad_s.norm() > plausible::kMaxAngularRate_rad_s)
-      bad = where("IMU", t) + ": non-finite or absurd reading";
-  } else if (const auto* s = std::get_if<BaroSample>(&in)) {
-    if (!std::isfinite(s->pressure_pa) || s->pressure_pa < plausible::kMinPressure_pa ||
-        s->pressure_pa > plausible::kMaxPressure_pa)
-      bad = where("BARO", t) + ": non-finite or absurd pressure " + std::to_string(s->pressure_pa);
-  } else if (const auto* s = std::get_if<HeightSample>(&in)) {
-    if (!std::isfinite(s->range_m) || s->range_m < 0.0 || s->range_m > plausible::kMaxHeight_m)
-      bad = where("HEIGHT", t) + ": non-finite or absurd range to the floor " + std::to_string(s->range_m);
-  } else if (const auto* s = std::get_if<RangeSample>(&in)) {
-    const double z = options_.uwb.use_corrected_range ? s->range_corr_m : s->range_m;
-    if (!std::isfinite(z) || z < -0.5 || z > options_.uwb.max_range_m || !std::isfinite(s->R_m2) || s->R_m2 < 0)
-      bad = where("RANGE", t) + ": bad range " + std::to_string(z) + " m between " + std::to_string(s->id_initiator) +
-            " and " + std::to_string(s->id_responder);
-    else if (options_.uwb.use_corrected_range && std::abs(s->range_corr_m - s->range_m) > kMaxRangeCorrection_m)
-      bad = where("RANGE", t) + ": corrected range " + std::to_string(s->range_corr_m) + " m is more than " +
-            std::to_string(kMaxRangeCorrection_m) + " m from the raw " + std::to_string(s->range_m) +
-            " m (not given? old logs carry 0)";
-    else if (s->id_initiator == s->id_responder || s->id_initiator <= 0 || s->id_responder <= 0)
-      bad = where("RANGE", t) + ": invalid ids " + std::to_string(s->id_initiator) + ", " +
-            std::to_string(s->id_responder);
-  } else if (const auto* a = std::get_if<AnchorInit>(&in)) {
-    if (const std::string e = anchorInitValueError(*a); !e.empty()) bad = where("ANCHOR_INIT", t) + ": " + e;
-  } else if (const auto* c = std::get_if<EstimatorCommand>(&in);
-             c && c->action == EstimatorCommand::Action::AddAnchor) {
-    if (const std::string e = anchorInitValueError(c->anchorToAdd()); !e.empty())
-      bad = where("ESTIMATOR_CMD", t) + ": " + e;
-  }
-  if (!bad.empty()) {
-    diag_.report("bad_input", bad);
-    return false;
-  }
-  return true;
-}
-
 void EstimatorNode::onInput(const EstimatorInput& in_raw) {
-  if (!validate(in_raw)) return;
+  if (!gate_.valid(in_raw)) return;
   EstimatorInput in = in_raw;
-  if (!admitTime(in)) return;
-  if (!admitOnce(in_raw)) return;
+  switch (gate_.admitTime(in)) {
+    case InputGate::Verdict::kRefused: return;
+    case InputGate::Verdict::kClockBack: startOverAfterClockBack(); break;
+    case InputGate::Verdict::kAdmitted: break;
+  }
+  if (!gate_.admitOnce(in_raw, newest_)) return;
   // Commands are not measurements: they apply now (at the newest time) unless they are newer.
   if (newest_ && (std::holds_alternative<AnchorInit>(in) || std::holds_alternative<EstimatorCommand>(in))) {
     if (auto* a = std::get_if<AnchorInit>(&in)) a->t = std::max(a->t, *newest_);
@@ -241,25 +159,25 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     return;
   }
   const Timestamp t = inputTime(in);
-  feedAligner(in);
+  init_.feed(in, *cur_.network, cur_.filter.get());
+  if (std::holds_alternative<ImuSample>(in)) init_.pruneStillness(oldestReplayUs(t.us));
   if (!initialized()) {
     // Only measurements drive the clock: a command stamped far ahead before the first measurement
     // would otherwise leave every later measurement too old.
     if (!std::holds_alternative<AnchorInit>(in) && !std::holds_alternative<EstimatorCommand>(in))
       newest_ = newest_ ? std::max(*newest_, t) : t;
-    if (const auto* s = std::get_if<ImuSample>(&in); s && resume_ && tryResume(*s)) {
-      publishPeriodic();
-      return;
+    if (const auto* s = std::get_if<ImuSample>(&in); s && resume_.offered()) {
+      if (auto b = resume_.at(*s, pending_anchor_inits_)) {
+        initialize(*b);
+        publishPeriodic();
+        return;
+      }
     }
     feedInitializer(in);
     publishPeriodic();
     return;
   }
-  if (std::holds_alternative<ImuSample>(in)) {
-    if (gravity_early_check_due_) earlyGravityCheck(t);
-    if (gravity_check_at_ && t >= *gravity_check_at_) checkGravityDirection(t);
-    if (gravity_flip_pending_ && (!last_flip_try_ || (t - *last_flip_try_).sec() >= 0.5)) adoptGravityAlongPlusZ(t);
-  }
+  if (std::holds_alternative<ImuSample>(in)) runGravityDirection(t);
   if (t < init_time_) {
     diag_.count("before_init");
     return;
@@ -293,8 +211,7 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   // Anchors calibrated together arrive as consecutive ANCHOR_INITs: one re-run for all of them.
   if (rerun_pending_ && !rerun_ && !std::holds_alternative<AnchorInit>(in)) startRerun();
   retireHistory(*newest_ - Duration::fromSec(options_.window_s));
-  const int64_t oldest_still_us = oldestReplayUs(newest_->us);
-  while (!still_at_.empty() && still_at_.begin()->first < oldest_still_us) still_at_.erase(still_at_.begin());
+  init_.pruneStillness(oldestReplayUs(newest_->us));
   updateHealth(*newest_);
   publishPeriodic();
 }
@@ -314,7 +231,7 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
         if constexpr (std::is_same_v<T, BaroSample>) processBaro(m, first);
         if constexpr (std::is_same_v<T, RangeSample>) processRange(m, first);
         if constexpr (std::is_same_v<T, HeightSample>) {
-          if (carried_height_)
+          if (init_.carriedHeight())
             event(first, "height_ignored_carried_height");  // the carried height uses the height instance
           else
             processHeight(m, first);
@@ -345,8 +262,7 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
     event(first, "imu_gap",
           where("IMU", s.t) + ": no IMU sample for " + std::to_string(gap_s) + " s; propagated on " +
               options_.imu.gap_readings + " readings with inflated noise");
-    const double check_s = options_.recovery.after_gap_check_min_s;
-    if (check_s > 0.0 && gap_s >= check_s) check_after_gap_until_ = s.t + Duration::fromSec(options_.init.motion_window_s);
+    recovery_.noteImuGap(s.t, gap_s);
   }
   if (s.t > t0) {
     // Readings interpolated to the middle of [t0, s.t] (held when no earlier reading).
@@ -359,26 +275,19 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
   cur_.prev_imu = previous;
   cur_.last_imu = s;
   updateMeanReading(s, previous);
-  if (!have_flight_state_) cur_.landed = landedAt(s.t);
+  if (!init_.haveFlightState()) cur_.landed = init_.landedAt(s.t, cur_.landed);
   if (cur_.landed && previous && s.t > previous->t)
     cur_.rest_rate.add(s.gyro_rad_s, (s.t - previous->t).sec(), options_.imu.max_dt_s);
   else if (!cur_.landed)
     cur_.rest_rate.reset();
   if (options_.zupt.enabled && cur_.landed && (s.t - cur_.last_zupt).sec() >= 1.0 / options_.zupt.rate_hz - 1e-9)
     processZupt(s, first);
-  if (carried_height_ &&
+  if (init_.carriedHeight() &&
       (s.t - cur_.last_carried_height).sec() >= 1.0 / options_.carried_height.rate_hz - 1e-9) {
     cur_.last_carried_height = s.t;
     processHeight(HeightSample{s.t, setup_.carried_height->height_m}, first);
   }
-  if (first && sinks_.pose) {
-    const bool due = options_.pose_output_rate_hz <= 0.0 || !last_pose_pub_ ||
-                     (s.t - *last_pose_pub_).sec() >= 1.0 / options_.pose_output_rate_hz - 1e-6;
-    if (due) {
-      last_pose_pub_ = s.t;
-      sinks_.pose(makePose());
-    }
-  }
+  if (first && sinks_.pose && outputs_.poseDue(s.t)) sinks_.pose(poseOf(*cur_.filter));
 }
 
 void EstimatorNode::applyCommand(const EstimatorCommand& c, bool first) {
@@ -406,37 +315,14 @@ void EstimatorNode::applyCommand(const EstimatorCommand& c, bool first) {
   }
 }
 
-PoseEstimate EstimatorNode::makePose() const {
-  const FusionStrategy& f = *cur_.filter;
-  const NominalState& x = f.state();
-  const Eigen::MatrixXd P = f.covariance(x.imu_id, x.imu_id);
-  PoseEstimate e;
-  e.t = x.t;
-  e.p_IinG = x.imu.p_IinG;
-  e.v_IinG = x.imu.v_IinG;
-  e.q_ItoG = x.imu.q_ItoG;
-  e.bias_gyro_rad_s = x.imu.bias_gyro_rad_s;
-  e.bias_acc_m_s2 = x.imu.bias_acc_m_s2;
-  e.cov_p_m2 = P.block<3, 3>(ImuErr::kP, ImuErr::kP);
-  e.cov_v = P.block<3, 3>(ImuErr::kV, ImuErr::kV);
-  e.cov_theta_rad2 = P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta);
-  return e;
-}
-
 std::optional<PoseEstimate> EstimatorNode::pose() const {
   if (!initialized()) return std::nullopt;
-  return makePose();
+  return poseOf(*cur_.filter);
 }
 
 std::vector<AnchorEstimate> EstimatorNode::anchors() const {
-  std::vector<AnchorEstimate> out;
-  if (!initialized()) return out;
-  const NominalState& x = cur_.filter->state();
-  for (const auto& [id, p] : cur_.network->exactAnchors()) out.push_back({x.t, id, p, Eigen::Matrix3d::Zero()});
-  for (const auto& [id, a] : x.values<AnchorKind>())
-    out.push_back({x.t, id, a.p_AinG, cur_.filter->covariance(id, id).topLeftCorner<3, 3>()});
-  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
-  return out;
+  if (!initialized()) return {};
+  return anchorsOf(*cur_.filter, *cur_.network);
 }
 
 EstimatorStatus EstimatorNode::status() const {
@@ -481,15 +367,8 @@ EstimatorStatus EstimatorNode::status() const {
 void EstimatorNode::publishPeriodic() {
   if (!newest_) return;
   const Timestamp now = *newest_;
-  auto due = [&](std::optional<Timestamp>& next, double rate_hz) {
-    if (next && now < *next) return false;
-    const Duration period = Duration::fromSec(1.0 / rate_hz);
-    next = (next && now - *next < period) ? *next + period : now + period;
-    return true;
-  };
-  if (initialized() && sinks_.anchors && due(next_anchor_pub_, options_.anchors_output_rate_hz))
-    sinks_.anchors(anchors());
-  if (sinks_.status && due(next_status_pub_, options_.status_rate_hz)) sinks_.status(status());
+  if (initialized() && sinks_.anchors && outputs_.anchorsDue(now)) sinks_.anchors(anchors());
+  if (sinks_.status && outputs_.statusDue(now)) sinks_.status(status());
 }
 
 }  // namespace meshnav::estimator

@@ -60,24 +60,25 @@
 #include "common/diagnostics.h"
 #include "common/messages.h"
 #include "common/setup.h"
-#include "common/time_guard.h"
 #include "common/types.h"
-#include "estimator/baro/baro_model.h"
-#include "estimator/height/height_model.h"
+#include "estimator/baro/baro_updater.h"
+#include "estimator/height/height_updater.h"
 #include "estimator/core/estimator_options.h"
 #include "estimator/filter/fusion_strategy.h"
-#include "estimator/node/checkpoint.h"
+#include "estimator/restart/resume.h"
 #include "estimator/node/estimator_input.h"
 #include "estimator/health/health_monitor.h"
+#include "estimator/health/recovery_policy.h"
 #include "estimator/imu/imu_readings.h"
 #include "estimator/imu/process_noise_adapter.h"
-#include "estimator/node/anchor_plane_mirror.h"
-#include "estimator/node/motion_aligner.h"
-#include "estimator/node/static_initializer.h"
+#include "estimator/health/flight_volume_guard.h"
+#include "estimator/init/gravity_direction.h"
+#include "estimator/init/initialization.h"
+#include "estimator/node/input_gate.h"
+#include "estimator/node/output_schedule.h"
 #include "estimator/zupt/rest_rate_mean.h"
-#include "estimator/zupt/stillness_detector.h"
 #include "estimator/node/step_timings.h"
-#include "estimator/uwb/reentry_check.h"
+#include "estimator/uwb/reentry_gate.h"
 #include "estimator/uwb/uwb_network.h"
 #include "estimator/zupt/zupt_model.h"
 
@@ -133,7 +134,7 @@ class EstimatorNode {
   /// newer than c.t, the estimated anchors and the baro reference and bias come back from `c`, and
   /// the pose too when the outage is at most `init.resume_max_outage_s` (else the pose is
   /// initialized as usual: in flight by the MotionAligner). Older: counted "resume_refused".
-  void resumeFrom(EstimatorCheckpoint c) { resume_ = std::move(c); }
+  void resumeFrom(EstimatorCheckpoint c) { resume_.offer(std::move(c)); }
   /// A re-run computed on a worker (`refine.rerun_mode` async) has not been swapped in yet.
   bool rerunRunning() const { return rerun_ != nullptr; }
   /// Waits for the running re-run, swaps it in and runs (and waits for) a re-run queued behind it:
@@ -194,11 +195,12 @@ class EstimatorNode {
     std::shared_ptr<const Snapshot> checkpoint;
   };
 
-  bool validate(const EstimatorInput& in);
-  /// The time guard on `in` (may restamp a command); false: refused and counted.
-  bool admitTime(EstimatorInput& in);
-  /// False (counted "<KIND>:duplicate") when an input with the same key came before.
-  bool admitOnce(const EstimatorInput& in);
+  struct GravityAdapter;  ///< the node as GravityDirection's context (estimator_node_gravity.cpp)
+  /// What GravityDirection has due at IMU time `t` (comparison, re-initialization with +z).
+  void runGravityDirection(Timestamp t);
+  /// The clock jumped back past everything the node holds: it starts over, streams forgotten.
+  void startOverAfterClockBack();
+  /// Before initialization: the input to the initializers (anchors held for later).
   void feedInitializer(const EstimatorInput& in);
   void initialize(const InitialBelief& b);
   /// Known-but-uncertain setup anchors (abs_anchor_sigmas) as estimated instances, with their
@@ -215,12 +217,6 @@ class EstimatorNode {
   void processRange(const RangeSample& s, bool first);
   void processHeight(const HeightSample& s, bool first);
   void processZupt(const ImuSample& s, bool first);
-  /// A height for the in-motion alignment, thinned to height.align_rate_hz (all sources).
-  void addAlignHeight(const AlignHeight& h);
-  /// A height reading (rangefinder or carried height) for the in-motion alignment, thinned.
-  void feedAlignerHeight(const HeightSample& h);
-  /// A height from the baro's pressure against the setup's reference, for the in-motion alignment.
-  void feedAlignerBaro(const BaroSample& b);
   /// Instance statistics, health and the "gated_<type>" counter of a scalar update (baro, height).
   void countScalarUpdate(Timestamp t, SensorId id, const std::string& type, const UpdateResult& r);
   void applyAnchorInit(const AnchorInit& a, bool first);
@@ -239,55 +235,21 @@ class EstimatorNode {
   void propagateFilterStep(const ImuReading& u, Timestamp t);
   /// Low-passes the readings into cur_.mean_reading (restarted after a gap).
   void updateMeanReading(const ImuSample& s, const std::optional<ImuSample>& previous);
-  /// Gravity in G: (0, 0, ∓|g|) by the gravity check's sign.
-  Eigen::Vector3d gravityG() const;
-  /// Feeds the aligner (and stillness) with an input in arrival order.
-  void feedAligner(const EstimatorInput& in);
-  /// aligner_.solve timed as the step "align": it runs inside the input that triggered it and is a
-  /// real recording's longest step (ISAS-Walk1: median 109 ms, up to 0.4 s per solve).
-  std::optional<AlignmentResult> solveAlignment(const Eigen::Vector3d& bias_gyro_rad_s);
-  void tryMotionInitialization(Timestamp t);
-  /// A full alignment window after the first initialization (not earlier: a window that still
-  /// held the rest before a hand-held start chose the wrong side on ISAS-Walk1), and again a
-  /// window later while undecided (at most kMaxGravityChecks times): does gravity point along −z
-  /// of G as assumed? Logs the aligner's GravityCheck. An anchor frame that fits decisively
-  /// better upside down (counter `anchor_frame_z_down`) is taken as it is: without baro and
-  /// heights (which measure along −z), the filter is re-initialized by the aligner with gravity
-  /// along +z of G and propagates with it from then on (`adoptGravityAlongPlusZ`).
-  void checkGravityDirection(Timestamp t);
-  /// The median range NIS over its expected value, as the process-noise adapter took it: at or
-  /// above `init.gravity_early_check_nis_ratio` before the first check, the check runs at the next
-  /// IMU sample (`earlyGravityCheck`), once. A wrong gravity sign shows there first (ISAS-Walk1
-  /// started mid-walk: 12× within 2 s of an in-motion initialization, 3.3 m off by the scheduled check).
-  void noteRangeNisRatio(double ratio);
-  /// The early check: acts only when +z fits decisively better (as checkGravityDirection), else
-  /// leaves the scheduled check as it was; not with baro or heights.
-  void earlyGravityCheck(Timestamp t);
-  std::optional<MotionAligner::GravityCheck> runGravityCheck();
+  /// Gravity in G: (0, 0, ∓|g|) by the gravity direction's sign.
+  Eigen::Vector3d gravityG() const { return gravity_.gravityG(options_.gravity_m_s2); }
   /// Baro readings or heights seen (both measure along −z of G).
   bool hasVerticalSensor() const;
-  /// The frame fits decisively better upside down: gravity along +z from now on, unless baro or
-  /// heights measure along −z (then a warning only).
-  void takeGravityAlongPlusZ(Timestamp t, const MotionAligner::GravityCheck& c);
-  /// Re-initializes the pose with gravity along +z (anchors and biases kept, as a recovery);
-  /// retried every 0.5 s while the aligner refuses.
-  void adoptGravityAlongPlusZ(Timestamp t);
-  InitialBelief beliefFromAlignment(const AlignmentResult& r) const;
+  /// Re-initializes the pose from the aligner with gravity along +z (anchors and biases kept, as
+  /// a recovery); false when the aligner refuses now.
+  bool reinitializeWithPlusZ(Timestamp t);
   void updateHealth(Timestamp t);
   void tryRecover(Timestamp t);
-  /// An estimate more than `flight_volume.mirror_margin_m` outside the setup's flight volume whose
-  /// mirror image across the coplanar known anchors' plane is inside is that mirror image: position
-  /// and velocity are reflected (P ← J P Jᵀ), counted (`mirrored_into_flight_volume`) and logged.
+  /// The flight volume's models on the estimate (FlightVolumeGuard): a mirror image is reflected
+  /// into the volume, else the position is truncated to the volume's side of the anchors' plane.
   void checkFlightVolume(Timestamp t);
-  /// Otherwise the position is truncated to the volume's side of that plane
-  /// (AnchorPlaneMirror::sideConstraint, at most `flight_volume.side_constraint_rate_hz`).
-  void constrainToVolumeSide(Timestamp t);
-  /// χ² (4 dof) between the filter's position and yaw and an aligned pose, both covariances.
-  double disagreement(const AlignmentResult& r) const;
   /// Replaces the IMU instance (state, covariance, time); every other instance keeps its mean and
   /// marginal covariance (cross-covariances dropped). History before `t` is forgotten.
   void replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu);
-  bool landedAt(Timestamp t) const;
   /// Pops history entries older than `oldest_kept`; with re-runs on they move to archive_, which
   /// is cut to `refine.max_history_s` at a checkpoint (counted "rerun_history_cut", logged).
   void retireHistory(Timestamp oldest_kept);
@@ -334,70 +296,38 @@ class EstimatorNode {
   int64_t oldestReplayUs(int64_t newest_us) const;
   /// Re-processes the entries after `it` on cur_ (refreshing their snapshots), as replays do.
   void replayAfter(std::deque<Entry>::iterator it);
-  /// processRange's part for tag ranges after an aiding gap (UwbOptions reentry_*): false when the
-  /// range is not fused now (held, or rejected by the joint check); `count` is set when a released
-  /// range is fused for the first time (its counters and health were deferred).
-  bool reentryAdmit(const RangeSample& s, SensorId anchor, const Linearization& lin, bool first, bool* count);
-  /// Releases the held ranges once reentry_hold_s passed: ReentryCheck decides,
+  /// Releases the ranges held after a gap once uwb.reentry_hold_s passed (ReentryGate decides),
   /// then the node rewinds to the first held range and re-processes from there.
   void releaseReentryIfDue();
   void event(bool first, const std::string& kind, const std::string& message = "");
   void publishPeriodic();
   void resetAll();
-  PoseEstimate makePose() const;
 
   EstimatorOptions options_;
   SystemSetup setup_;
   EstimatorSinks sinks_;
   Diagnostics diag_;
   StepTimings timings_;
-  std::unique_ptr<StaticInitializer> initializer_;
+  InputGate gate_;
+  Initialization init_;
+  GravityDirection gravity_;
+  FlightVolumeGuard volume_;
+  OutputSchedule outputs_;
   std::vector<AnchorInit> pending_anchor_inits_;
-  std::optional<EstimatorCheckpoint> resume_;  ///< resumeFrom, until the first IMU sample
-  /// Its baro reference and kept instances (Restart::kKept), until initialized.
-  std::optional<EstimatorCheckpoint> resume_kept_;
-  /// Initializes from resume_ at IMU sample `s` when it is fresh enough; true if it did.
-  bool tryResume(const ImuSample& s);
-  /// Adds the checkpoint's kept instances (Restart::kKept) to `f` at `t`, replacing their priors:
-  /// each with its value and marginal covariance grown by its kind's random walk over t − c.t; a
-  /// baro bias only when the reference pressure is the checkpoint's. Counted "resumed_instances".
-  void restoreKeptInstances(FusionStrategy& f, const EstimatorCheckpoint& c, Timestamp t);
-  BaroModel baro_model_;
-  HeightModel height_model_;
-  /// setup `carried_height` in use: the height model reads the carried height (CarriedHeightOptions).
-  bool carried_height_ = false;
-  /// The baro (setup reference pressure given) is the in-motion alignment's height source.
-  bool baro_aligns_ = false;
-  /// The height bias the in-motion alignment estimated (mean, variance), for the height instance.
-  std::optional<std::pair<double, double>> pending_height_bias_;
-  std::optional<Timestamp> last_align_height_;  ///< thinning of heights fed to the aligner
+  BaroUpdater baro_;
+  HeightUpdater height_;
   ZuptModel zupt_model_;
-  double range_gate_ = 0.0, baro_gate_ = 0.0, height_gate_ = 0.0;
+  double range_gate_ = 0.0;
   /// dah without uwb.dah_fuse_estimated_anchor_pairs: ranges between two estimated anchors are left out.
   bool skip_estimated_anchor_pairs_ = false;
   /// The anchors added at the filter time `anchor_batch_t_` (a batch: no other input between them).
   std::vector<SensorId> anchor_batch_;
   std::optional<Timestamp> anchor_batch_t_;
 
-  MotionAligner aligner_;
-  StillnessDetector still_detector_;
-  std::map<int64_t, bool> still_at_;   ///< stillness per IMU time [µs] (arrival order), pruned
-  bool have_flight_state_ = false;
-  std::optional<double> last_pressure_pa_;
   HealthMonitor health_;
-  std::optional<AnchorPlaneMirror> plane_mirror_;  ///< setup flight_volume and coplanar known anchors
-  std::optional<Timestamp> last_side_constraint_;
-  std::optional<Timestamp> last_align_try_, last_recovery_try_, last_health_eval_;
-  std::optional<Timestamp> gravity_check_at_;  ///< when checkGravityDirection runs (once)
-  int gravity_checks_ = 0;
-  static constexpr int kMaxGravityChecks = 3;
-  double gravity_z_sign_ = -1.0;  ///< gravity along −z of G (−1, the convention) or +z (+1)
-  bool gravity_flip_pending_ = false;
-  bool gravity_early_check_due_ = false, gravity_early_checked_ = false;
-  /// After an IMU gap of recovery.after_gap_check_min_s: until then the aligned pose is compared
-  /// with the filter every recovery.retry_s, as while degraded.
-  std::optional<Timestamp> check_after_gap_until_;
-  std::optional<Timestamp> last_flip_try_;
+  RecoveryPolicy recovery_;
+  ReentryGate reentry_;
+  Resume resume_;  ///< resumeFrom's checkpoint, until the initialization
 
   Snapshot cur_;
   std::deque<Entry> history_;
@@ -408,28 +338,12 @@ class EstimatorNode {
   /// refine.rerun_on_anchor_join for this strategy (dah: and refine.rerun_with_dah).
   bool rerun_enabled_ = false;
   bool applying_pending_inits_ = false;  ///< initialize() is applying held anchors (no re-run)
-  /// Tag ranges after an aiding gap (reentryAdmit): held until released, then their fate by key.
-  enum class HeldFate { kRejected, kAcceptedUncounted, kAccepted };
-  struct ReentryHold {
-    std::optional<Timestamp> since;  ///< time of the first held range (holding while set)
-    std::vector<std::pair<InputOrder, ReentryCheck::Held>> held;
-    Eigen::Matrix3d P_pp = Eigen::Matrix3d::Zero();  ///< position covariance at the first held range [m²]
-    std::map<InputOrder, HeldFate> decided;
-    int64_t n_seen = 0;                  ///< tag ranges seen live (their mean rate decides whether a hold can check)
-    std::optional<Timestamp> first_seen;
-  };
-  ReentryHold reentry_;
-  std::optional<Timestamp> last_tag_range_accepted_;
   bool rerun_async_ = false;             ///< refine.rerun_mode async: re-runs on a worker
   std::unique_ptr<RunningRerun> rerun_;  ///< the worker re-run not swapped in yet
   std::function<void()> rerun_worker_hook_;
-  std::set<InputOrder> seen_;  ///< keys of the inputs admitted within the window (duplicates)
   std::optional<Timestamp> newest_;   ///< newest input time seen (also before init)
-  TimeGuard time_guard_;
   Timestamp init_time_;
-  std::optional<double> baro_reference_pa_;
   std::map<SensorId, InstanceStatus> instance_stats_;
-  std::optional<Timestamp> last_pose_pub_, next_anchor_pub_, next_status_pub_;
 };
 
 }  // namespace meshnav::estimator

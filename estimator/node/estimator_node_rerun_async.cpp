@@ -15,17 +15,15 @@ namespace meshnav::estimator {
 EstimatorNode::~EstimatorNode() { abandonRerun(); }
 
 void EstimatorNode::copyReplayContext(const EstimatorNode& live) {
-  have_flight_state_ = live.have_flight_state_;
-  still_at_ = live.still_at_;
-  baro_reference_pa_ = live.baro_reference_pa_;
-  pending_height_bias_ = live.pending_height_bias_;
+  init_.copyStillnessFrom(live.init_);
+  baro_.setReference(live.baro_.reference());
+  height_ = live.height_;
   rerun_anchors_ = live.rerun_anchors_;
-  gravity_z_sign_ = live.gravity_z_sign_;
-  check_after_gap_until_ = live.check_after_gap_until_;
+  gravity_.takeSignOf(live.gravity_);
+  recovery_.copyGapWindowFrom(live.recovery_);
   zupt_model_ = live.zupt_model_;
   // Ranges after a gap: rejected ones stay out of the re-run, held ones wait for the live node's release.
-  reentry_.decided = live.reentry_.decided;
-  reentry_.held = live.reentry_.held;
+  reentry_.copyFatesFrom(live.reentry_);
 }
 
 void EstimatorNode::launchRerun(RerunJob job, std::chrono::steady_clock::time_point t_job) {

@@ -20,25 +20,11 @@ using node_internal::weakestPositionAxis;
 using node_internal::whiteImuNoise;
 
 void EstimatorNode::feedInitializer(const EstimatorInput& in) {
-  std::visit(
-      [&](const auto& m) {
-        using T = std::decay_t<decltype(m)>;
-        if constexpr (std::is_same_v<T, ImuSample>) initializer_->addImu(m);
-        if constexpr (std::is_same_v<T, BaroSample>) initializer_->addBaro(m);
-        if constexpr (std::is_same_v<T, RangeSample>) initializer_->addRange(m);
-        if constexpr (std::is_same_v<T, FlightStateSample>) initializer_->addFlightState(m);
-        if constexpr (std::is_same_v<T, AnchorInit>) pending_anchor_inits_.push_back(m);
-        if constexpr (std::is_same_v<T, EstimatorCommand>)
-          if (m.action == EstimatorCommand::Action::AddAnchor) pending_anchor_inits_.push_back(m.anchorToAdd());
-      },
-      in);
-  if (!std::holds_alternative<ImuSample>(in)) return;
-  if (auto belief = initializer_->tryInitialize()) {
-    initialize(*belief);
-    return;
-  }
-  // At rest the landed data decides; in motion (or when it cannot fix the pose) the aligner.
-  if (!initializer_->isStatic() || initializer_->waitingFor().rfind("motion", 0) == 0) tryMotionInitialization(inputTime(in));
+  // Anchors that come before the pose are held and applied at the initialization.
+  if (const auto* a = std::get_if<AnchorInit>(&in)) pending_anchor_inits_.push_back(*a);
+  if (const auto* c = std::get_if<EstimatorCommand>(&in); c && c->action == EstimatorCommand::Action::AddAnchor)
+    pending_anchor_inits_.push_back(c->anchorToAdd());
+  if (auto belief = init_.tryInitialize(in, cur_.landed)) initialize(*belief);
 }
 
 /// Known-but-uncertain setup anchors (abs_anchor_sigmas) as estimated anchor instances.
@@ -103,26 +89,24 @@ void EstimatorNode::logInitialization(const InitialBelief& b) const {
   if (b.height_bias)
     spdlog::info("estimator: the alignment used {} heights: rangefinder bias {:.3f} m (σ {:.3f} m)", b.n_heights_used,
                  b.height_bias->first, std::sqrt(b.height_bias->second));
-  if (!baro_reference_pa_ && options_.baro.enabled)
+  if (!baro_.reference() && baro_.enabled())
     spdlog::warn("estimator: no baro reference pressure (none in setup, no landed baro data): baro unused");
 }
 
 void EstimatorNode::initialize(const InitialBelief& b) {
-  if (gravity_checks_ == 0 && !gravity_check_at_)
-    gravity_check_at_ = b.t + Duration::fromSec(options_.init.motion_window_s);
-  auto filter = makeStrategy(options_, gravity_z_sign_);
+  gravity_.onInitialized(b.t);
+  auto filter = makeStrategy(options_, gravity_.zSign());
   filter->reset(setup_.imu_id, b.imu, b.cov, b.t);
   if (options_.baro.enabled && b.baro_reference_pa) {
-    baro_reference_pa_ = b.baro_reference_pa;
+    baro_.setReference(b.baro_reference_pa);
     filter->addInstance<BaroBiasKind>(setup_.baro_id, b.baro_bias_m, Eigen::MatrixXd::Constant(1, 1, b.baro_bias_var_m2));
-  } else if (options_.baro.enabled && resume_kept_ && resume_kept_->baro_reference_pa) {
-    baro_reference_pa_ = resume_kept_->baro_reference_pa;  // a restart in flight: the predecessor's
+  } else if (options_.baro.enabled && resume_.keptBaroReference()) {
+    baro_.setReference(resume_.keptBaroReference());  // a restart in flight: the predecessor's
   }                                                        // reference (its bias: a kept instance)
-  pending_height_bias_ = b.height_bias;  // the height instance is added at the first usable height
+  height_.setBiasPrior(b.height_bias);  // the height instance is added at the first usable height
   addSetupAnchorStates(*filter);
   addTagBiasStates(*filter);
-  if (resume_kept_) restoreKeptInstances(*filter, *resume_kept_, b.t);  // replace the priors
-  resume_kept_.reset();
+  resume_.restoreKept(*filter, b.t, baro_.reference());  // replace the priors
   cur_.filter = std::move(filter);
   cur_.mean_reading.reset();
   cur_.last_imu = b.last_imu;
@@ -139,125 +123,7 @@ void EstimatorNode::initialize(const InitialBelief& b) {
 
 std::string EstimatorNode::waitingFor() const {
   if (initialized()) return "";
-  return initializer_->waitingFor() + (aligner_.reason().empty() ? "" : "; " + aligner_.reason());
-}
-
-void EstimatorNode::addAlignHeight(const AlignHeight& h) {
-  // Thinned to height.align_rate_hz: a vertical constraint, not a trajectory.
-  if (options_.height.align_rate_hz <= 0.0) return;
-  if (last_align_height_ && (h.t - *last_align_height_).sec() < 1.0 / options_.height.align_rate_hz - 1e-6 &&
-      h.t >= *last_align_height_)
-    return;
-  last_align_height_ = h.t;
-  aligner_.addHeight(h);
-}
-
-void EstimatorNode::feedAlignerHeight(const HeightSample& h) {
-  if (options_.height.enabled && h.range_m >= options_.height.min_range_m)  // usable readings only
-    addAlignHeight({h.t, h.range_m, options_.height.sigma_m});
-}
-
-void EstimatorNode::feedAlignerBaro(const BaroSample& b) {
-  const double ref = *setup_.baro_reference_pressure_pa;
-  const double sigma_m = std::abs(atmosphere::dHeightDPressure(b.pressure_pa, ref)) * options_.baro.pressure_sigma_pa;
-  addAlignHeight({b.t, atmosphere::heightFromPressure(b.pressure_pa, ref), sigma_m});
-}
-
-void EstimatorNode::feedAligner(const EstimatorInput& in) {
-  if (const auto* s = std::get_if<ImuSample>(&in)) {
-    aligner_.addImu(*s);
-    if (carried_height_) feedAlignerHeight(HeightSample{s->t, setup_.carried_height->height_m});
-    // Stillness is the evidence of rest only while no flight state was received.
-    if (!have_flight_state_ && options_.zupt.detect_stillness) {
-      const bool still = still_detector_.add(*s);
-      still_at_[s->t.us] = still;
-      // Kept for rewinds within the window (also pruned there); bounded while not initialized too.
-      const int64_t oldest_us = oldestReplayUs(s->t.us);
-      while (!still_at_.empty() && still_at_.begin()->first < oldest_us) still_at_.erase(still_at_.begin());
-      if (!initialized()) initializer_->addStillness(still);
-    }
-  } else if (std::holds_alternative<FlightStateSample>(in)) {
-    have_flight_state_ = true;
-  } else if (const auto* b = std::get_if<BaroSample>(&in)) {
-    last_pressure_pa_ = b->pressure_pa;
-    if (baro_aligns_) feedAlignerBaro(*b);
-  } else if (const auto* h = std::get_if<HeightSample>(&in)) {
-    if (!carried_height_ && !baro_aligns_) feedAlignerHeight(*h);
-  } else if (const auto* r = std::get_if<RangeSample>(&in)) {
-    SensorId tag = r->id_initiator, anchor = r->id_responder;
-    if (!cur_.network->isTag(tag)) std::swap(tag, anchor);
-    if (!cur_.network->isTag(tag) || cur_.network->isTag(anchor)) return;
-    const Eigen::Vector3d* p = cur_.network->exactAnchor(anchor);
-    std::optional<Eigen::Vector3d> p_est;
-    if (!p && cur_.filter && cur_.filter->state().values<AnchorKind>().count(anchor))
-      p_est = cur_.filter->state().values<AnchorKind>().at(anchor).p_AinG;
-    if (!p && !p_est && setup_.abs_anchor_positions.count(anchor)) p_est = setup_.abs_anchor_positions.at(anchor);
-    if (!p && !p_est) return;
-    const PairBias pb = cur_.network->pairBias(tag, anchor);
-    AlignRange a;
-    a.t = r->t;
-    a.tag = tag;
-    a.anchor = anchor;
-    a.p_AinG = p ? *p : *p_est;
-    a.d_m = ((options_.uwb.use_corrected_range ? r->range_corr_m : r->range_m) - pb.gamma_m) / pb.beta;
-    a.sigma_m = cur_.network->rangeSigma(tag, anchor, r->R_m2);
-    aligner_.addRange(a);
-  }
-}
-
-bool EstimatorNode::landedAt(Timestamp t) const {
-  if (have_flight_state_ || !options_.zupt.detect_stillness) return cur_.landed;
-  auto it = still_at_.find(t.us);
-  return it != still_at_.end() && it->second;
-}
-
-std::optional<AlignmentResult> EstimatorNode::solveAlignment(const Eigen::Vector3d& bias_gyro_rad_s) {
-  ScopedStepTimer timer(timings_, "align");
-  return aligner_.solve(bias_gyro_rad_s);
-}
-
-void EstimatorNode::tryMotionInitialization(Timestamp t) {
-  if (last_align_try_ && (t - *last_align_try_).sec() < 0.5) return;
-  last_align_try_ = t;
-  const int relinearized_before = aligner_.relinearizations();
-  const auto r = solveAlignment(Eigen::Vector3d::Zero());
-  if (aligner_.relinearizations() > relinearized_before) diag_.count("init_motion_relinearized");
-  if (!r) {
-    diag_.count("init_motion_refused");
-    return;
-  }
-  initialize(beliefFromAlignment(*r));
-}
-
-InitialBelief EstimatorNode::beliefFromAlignment(const AlignmentResult& r) const {
-  InitialBelief b;
-  b.t = r.t;
-  b.imu = r.imu;
-  b.cov = r.cov;
-  b.from_ranges = true;
-  b.n_ranges_used = r.n_ranges;
-  b.range_fit_rms_m = r.rms_m;
-  b.last_imu = r.last_imu;
-  b.landed = landedAt(r.t);
-  if (r.n_heights > 0 && !baro_aligns_) {
-    b.height_bias = std::make_pair(r.height_bias_m, r.height_bias_var_m2);
-    b.n_heights_used = r.n_heights;
-  }
-  const double baro_z = (r.imu.p_IinG + r.imu.q_ItoG * setup_.baro_p_IP).z();
-  if (setup_.baro_reference_pressure_pa) {
-    b.baro_reference_pa = *setup_.baro_reference_pressure_pa;
-    b.baro_bias_m = 0.0;
-    b.baro_bias_var_m2 = std::pow(options_.baro.init_bias_sigma_m, 2);
-    if (baro_aligns_ && r.n_heights > 0) {  // the alignment estimated the baro's bias with the pose
-      b.baro_bias_m = r.height_bias_m;
-      b.baro_bias_var_m2 = r.height_bias_var_m2;
-    }
-  } else if (last_pressure_pa_) {  // reference: the current pressure at the aligned height
-    b.baro_reference_pa = *last_pressure_pa_;
-    b.baro_bias_m = -baro_z;
-    b.baro_bias_var_m2 = r.cov(ImuErr::kP + 2, ImuErr::kP + 2) + 0.05;
-  }
-  return b;
+  return init_.waitingFor();
 }
 
 void EstimatorNode::propagateFilter(const ImuReading& u, Timestamp t) {
@@ -296,8 +162,6 @@ void EstimatorNode::propagateFilter(const ImuReading& u, Timestamp t) {
                               std::pow(options_.imu.gap_sigma_gyro_rad_s, 2), dt));
 }
 
-Eigen::Vector3d EstimatorNode::gravityG() const { return {0.0, 0.0, gravity_z_sign_ * options_.gravity_m_s2}; }
-
 void EstimatorNode::updateMeanReading(const ImuSample& s, const std::optional<ImuSample>& previous) {
   const ImuState& x = cur_.filter->state().imu;
   const Eigen::Vector3d a_G = x.q_ItoG * (s.acc_m_s2 - x.bias_acc_m_s2) + gravityG();
@@ -327,10 +191,9 @@ void EstimatorNode::propagateFilterStep(const ImuReading& u, Timestamp t) {
 
 void EstimatorNode::updateHealth(Timestamp t) {
   if (!initialized()) return;
-  if (reentry_.since) return;  // ranges are arriving, held for their joint check (at most uwb.reentry_hold_s)
+  if (reentry_.holding()) return;  // ranges are arriving, held for their joint check (at most uwb.reentry_hold_s)
   checkFlightVolume(t);  // after every input: a slide across the plane takes a few tenths of a second
-  if (last_health_eval_ && (t - *last_health_eval_).sec() < 0.1) return;
-  last_health_eval_ = t;
+  if (!recovery_.evaluationDue(t)) return;
   const auto [sigma_p, axis] = weakestPositionAxis(cur_.filter->covariance(setup_.imu_id, setup_.imu_id)
                                                        .block<3, 3>(ImuErr::kP, ImuErr::kP));
   if (health_.evaluate(t, sigma_p)) {
@@ -343,48 +206,29 @@ void EstimatorNode::updateHealth(Timestamp t) {
       spdlog::warn("{}", msg);
   }
   // Degraded by gating alone, with the accepted ranges fitting, is what NLOS outliers look like:
-  // a re-alignment from those ranges is then more likely wrong than the filter (docs/robustness.md).
-  const bool compare = options_.recovery.degraded_disagreement_chi2 > 0.0;
-  if (health_.health() == Health::Lost ||
-      (health_.health() == Health::Degraded && compare && !health_.acceptedRangesFit(t)) ||
-      (compare && check_after_gap_until_ && t <= *check_after_gap_until_))
-    tryRecover(t);
-}
-
-double EstimatorNode::disagreement(const AlignmentResult& r) const {
-  const ImuState& x = cur_.filter->state().imu;
-  const Eigen::MatrixXd P = cur_.filter->covariance(setup_.imu_id, setup_.imu_id);
-  Eigen::Vector4d d;
-  d.head<3>() = r.imu.p_IinG - x.p_IinG;
-  d(3) = std::remainder(so3::yawOf(r.imu.q_ItoG) - so3::yawOf(x.q_ItoG), 2.0 * M_PI);
-  Eigen::Matrix4d S = Eigen::Matrix4d::Zero();
-  S.topLeftCorner<3, 3>() = P.block<3, 3>(ImuErr::kP, ImuErr::kP) + r.cov.block<3, 3>(ImuErr::kP, ImuErr::kP);
-  S(3, 3) = so3::yawVariance(x.q_ItoG, P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta)) +
-            so3::yawVariance(r.imu.q_ItoG, r.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta));
-  return d.dot(S.ldlt().solve(d));
+  // a re-alignment from those ranges is then more likely wrong than the filter (RecoveryPolicy).
+  const Health h = health_.health();
+  if (recovery_.alignmentDue(t, h, h == Health::Degraded && health_.acceptedRangesFit(t))) tryRecover(t);
 }
 
 void EstimatorNode::tryRecover(Timestamp t) {
-  if (!options_.recovery.enabled) return;
-  if (last_recovery_try_ && (t - *last_recovery_try_).sec() < options_.recovery.retry_s) return;
-  last_recovery_try_ = t;
   const bool lost = health_.health() == Health::Lost;
-  const auto r = solveAlignment(cur_.filter->state().imu.bias_gyro_rad_s);
+  const auto r = init_.align(cur_.filter->state().imu.bias_gyro_rad_s);
   if (!r) {
     if (!lost) return;  // degraded: nothing to compare with
     diag_.count("recovery_refused");
-    spdlog::warn("estimator: lost at t={}, cannot re-initialize yet: {}", formatSeconds(t), aligner_.reason());
+    spdlog::warn("estimator: lost at t={}, cannot re-initialize yet: {}", formatSeconds(t), init_.alignerReason());
     return;
   }
   // Degraded: replace only a filter that the aligned pose contradicts (a runaway not yet gated out).
   if (!lost) {
-    const double chi2 = disagreement(*r);
-    if (chi2 <= options_.recovery.degraded_disagreement_chi2) return;
-    const bool after_gap = check_after_gap_until_ && t <= *check_after_gap_until_;
+    const double chi2 = RecoveryPolicy::disagreement(cur_.filter->state().imu,
+                                                     cur_.filter->covariance(setup_.imu_id, setup_.imu_id), *r);
+    if (!recovery_.contradicts(chi2)) return;
+    const bool after_gap = recovery_.afterGap(t);
     diag_.count(after_gap ? "recovery_after_imu_gap" : "recovery_degraded");
     spdlog::warn("estimator: {} at t={} and the aligned pose disagrees (chi2 {:.1f} > {:.1f})",
-                 after_gap ? "after an IMU gap" : "degraded", formatSeconds(t), chi2,
-                 options_.recovery.degraded_disagreement_chi2);
+                 after_gap ? "after an IMU gap" : "degraded", formatSeconds(t), chi2, recovery_.bound());
   }
   const ImuState before = cur_.filter->state().imu;
   replaceImu(r->imu, r->cov, r->t, r->last_imu);
@@ -396,54 +240,25 @@ void EstimatorNode::tryRecover(Timestamp t) {
 }
 
 void EstimatorNode::checkFlightVolume(Timestamp t) {
-  if (!plane_mirror_) return;
-  const FusionStrategy& f = *cur_.filter;
+  if (!volume_.active() || !cur_.last_imu) return;
+  FusionStrategy& f = *cur_.filter;
   const ImuState& x = f.state().imu;
-  if (!cur_.last_imu) return;
-  if (!plane_mirror_->isMirrorImage(x.p_IinG, options_.flight_volume.mirror_margin_m)) {
-    constrainToVolumeSide(t);
+  if (volume_.isMirrorImage(x.p_IinG)) {
+    const auto m = volume_.mirrorImage(t, x, f.covariance(setup_.imu_id, setup_.imu_id));
+    replaceImu(m->x, m->P, f.state().t, *cur_.last_imu);
     return;
   }
-  ImuState m = x;
-  m.p_IinG = plane_mirror_->mirror(x.p_IinG);
-  m.v_IinG = plane_mirror_->reflection() * x.v_IinG;
-  ImuMatrix J = ImuMatrix::Identity();
-  J.block<3, 3>(ImuErr::kP, ImuErr::kP) = plane_mirror_->reflection();
-  J.block<3, 3>(ImuErr::kV, ImuErr::kV) = plane_mirror_->reflection();
-  const ImuMatrix P = J * f.covariance(setup_.imu_id, setup_.imu_id) * J.transpose();
-  diag_.count("mirrored_into_flight_volume");
-  spdlog::warn("estimator: at t={} the estimate [{:.2f}, {:.2f}, {:.2f}] m is {:.2f} m outside the flight volume and "
-               "its mirror image across the known anchors' plane is inside: taken as the mirror image (moved {:.2f} m)",
-               formatSeconds(t), x.p_IinG.x(), x.p_IinG.y(), x.p_IinG.z(),
-               setup_.flight_volume->distanceOutside(x.p_IinG), (m.p_IinG - x.p_IinG).norm());
-  replaceImu(m, P, f.state().t, *cur_.last_imu);
-}
-
-void EstimatorNode::constrainToVolumeSide(Timestamp t) {
-  const double rate = options_.flight_volume.side_constraint_rate_hz;
-  if (rate <= 0.0 || (last_side_constraint_ && (t - *last_side_constraint_).sec() < 1.0 / rate - 1e-9)) return;
-  last_side_constraint_ = t;
-  FusionStrategy& f = *cur_.filter;
-  const Eigen::Vector3d n = plane_mirror_->inwardNormal();
-  const double mu = plane_mirror_->inwardDistance(f.state().imu.p_IinG);
+  if (!volume_.sideConstraintDue(t)) return;
   const Eigen::Matrix3d P_pp = f.covariance(setup_.imu_id, setup_.imu_id).block<3, 3>(ImuErr::kP, ImuErr::kP);
-  const auto c = AnchorPlaneMirror::sideConstraint(mu, n.dot(P_pp * n));
-  if (!c) return;
-  Linearization lin;  // r = z − nᵀ(p̂ − c_plane), H = nᵀ on δp
-  lin.residual = Eigen::VectorXd::Constant(1, c->z - mu);
-  lin.R = Eigen::MatrixXd::Constant(1, 1, c->R);
-  JacobianBlock b{setup_.imu_id, Eigen::MatrixXd::Zero(1, ImuErr::kDim)};
-  b.H.block<1, 3>(0, ImuErr::kP) = n.transpose();
-  lin.blocks.push_back(std::move(b));
-  f.update(lin, 0.0);  // not gated: a constraint, not a sensor
-  diag_.count("flight_volume_side_constraint");
+  if (const auto lin = volume_.sideConstraint(t, setup_.imu_id, x.p_IinG, P_pp))
+    f.update(*lin, 0.0);  // not gated: a constraint, not a sensor
 }
 
 void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu) {
   cur_.mean_reading.reset();  // low-passed in the attitude and gravity being replaced
   const FusionStrategy& old = *cur_.filter;
   const NominalState& s = old.state();
-  auto f = makeStrategy(options_, gravity_z_sign_);
+  auto f = makeStrategy(options_, gravity_.zSign());
   f->reset(setup_.imu_id, x, P, t);
   // Every instance keeps its mean; its marginal covariance as its kind says (the baro bias, which
   // may have absorbed the runaway, is widened to the init σ; tag γ keep their variances).
@@ -465,8 +280,7 @@ void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp 
   cur_.rest_rate.reset();
   history_.clear();  // a rewind must not restore the state before the re-initialization
   clearRerunHistory();  // nor a re-run (it starts from the new pose, with the anchors it has)
-  reentry_ = ReentryHold{};  // held ranges were in the history; the new pose comes from ranges
-  last_tag_range_accepted_ = t;
+  reentry_.restart(t);  // held ranges were in the history; the new pose comes from ranges
   init_time_ = t;
   health_.reset(t);
 }

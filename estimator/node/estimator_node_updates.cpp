@@ -19,19 +19,14 @@ namespace meshnav::estimator {
 using node_internal::where;
 
 void EstimatorNode::processBaro(const BaroSample& s, bool first) {
-  if (!options_.baro.enabled) return;
-  if (!baro_reference_pa_) {
+  if (!baro_.enabled()) return;
+  if (!baro_.reference()) {
     event(first, "baro_no_reference");
     return;
   }
   propagateTo(s.t);
   ScopedStepTimer timer(timings_, "baro_update");
-  BaroMeasurement z;
-  z.t = s.t;
-  z.baro_id = setup_.baro_id;
-  z.height_m = atmosphere::heightFromPressure(s.pressure_pa, *baro_reference_pa_);
-  z.sigma_m = std::abs(atmosphere::dHeightDPressure(s.pressure_pa, *baro_reference_pa_)) * options_.baro.pressure_sigma_pa;
-  const UpdateResult r = cur_.filter->update(baro_model_.linearize(z, cur_.filter->state()), baro_gate_);
+  const UpdateResult r = baro_.update(*cur_.filter, s);
   if (first) countScalarUpdate(s.t, setup_.baro_id, "baro", r);
 }
 
@@ -47,36 +42,21 @@ void EstimatorNode::countScalarUpdate(Timestamp t, SensorId id, const std::strin
 }
 
 void EstimatorNode::processHeight(const HeightSample& s, bool first) {
-  if (!options_.height.enabled) return;
-  if (s.range_m < options_.height.min_range_m) {
-    event(first, "height_below_min_range");  // clamped at the bottom of the sensor's range
+  if (!height_.enabled()) return;
+  if (const std::string why = height_.refusal(*cur_.filter, s); !why.empty()) {
+    if (why == "height_id_is_an_anchor")
+      event(first, why,
+            where("HEIGHT", s.t) + ": height_id " + std::to_string(setup_.height_id) +
+                " is an estimated anchor's id; heights not used (set height_id in setup.yaml)");
+    else
+      event(first, why);
     return;
   }
-  if (!carried_height_ && !height_model_.valid(cur_.filter->state())) {
-    event(first, "height_tilted");
-    return;
-  }
-  if (cur_.filter->state().values<AnchorKind>().count(setup_.height_id)) {
-    event(first, "height_id_is_an_anchor",
-          where("HEIGHT", s.t) + ": height_id " + std::to_string(setup_.height_id) +
-              " is an estimated anchor's id; heights not used (set height_id in setup.yaml)");
-    return;
-  }
-  if (!cur_.filter->state().values<HeightBiasKind>().count(setup_.height_id)) {
-    // The floor is at z = 0 of G: the bias is near zero unless the sensor sits far from the IMU.
-    const double b = pending_height_bias_ ? pending_height_bias_->first : 0.0;
-    const double var = pending_height_bias_ ? pending_height_bias_->second : std::pow(options_.height.init_bias_sigma_m, 2);
-    cur_.filter->addInstance<HeightBiasKind>(setup_.height_id, b, Eigen::MatrixXd::Constant(1, 1, var));
-    if (first)
-      spdlog::info("estimator: {} {} added at t={} with bias {:.3f} m (σ {:.3f} m)",
-                   carried_height_ ? "carried height" : "height sensor", setup_.height_id, formatSeconds(s.t), b,
-                   std::sqrt(var));
-  }
+  height_.ensureBiasState(*cur_.filter, s.t, first);
   propagateTo(s.t);
   ScopedStepTimer timer(timings_, "height_update");
-  const HeightMeasurement z{s.t, setup_.height_id, s.range_m, options_.height.sigma_m};
-  const UpdateResult r = cur_.filter->update(height_model_.linearize(z, cur_.filter->state()), height_gate_);
-  if (first) countScalarUpdate(s.t, setup_.height_id, carried_height_ ? "carried_height" : "height", r);
+  const UpdateResult r = height_.update(*cur_.filter, s);
+  if (first) countScalarUpdate(s.t, setup_.height_id, height_.typeName(), r);
 }
 
 void EstimatorNode::processRange(const RangeSample& s, bool first) {
@@ -118,7 +98,9 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
   lin.huber_max_prior_ratio = options_.uwb.huber_max_prior_ratio;
   const bool tag_range = cur_.network->isTag(z.a) || cur_.network->isTag(z.b);
   bool count = first;
-  if (tag_range && !reentryAdmit(s, cur_.network->isTag(z.a) ? z.b : z.a, lin, first, &count)) return;
+  if (tag_range &&
+      !reentry_.admit(s, cur_.network->isTag(z.a) ? z.b : z.a, lin, *cur_.filter, init_time_, first, &count))
+    return;
   const UpdateResult r = cur_.filter->update(lin, range_gate_);
   // H P Hᵀ / R from NIS = ν²/S, S = H P Hᵀ + R (scalar range).
   const double nu2 = lin.residual(0) * lin.residual(0), R = lin.R(0, 0);
@@ -130,10 +112,10 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
                  cur_.noise_adapter.scale(), formatSeconds(s.t), cur_.noise_adapter.lastRatio());
   }
   // Every batch's median NIS, whether λ changed or not (it holds at its bound, or while H P Hᵀ ≫ R).
-  if (first && cur_.noise_adapter.decisions() != decisions) noteRangeNisRatio(cur_.noise_adapter.lastRatio());
+  if (first && cur_.noise_adapter.decisions() != decisions) gravity_.noteRangeNisRatio(cur_.noise_adapter.lastRatio());
   if (!count) return;
   if (!r.accepted) diag_.count("gated_range");
-  if (tag_range && r.accepted) last_tag_range_accepted_ = s.t;
+  if (tag_range && r.accepted) reentry_.noteAccepted(s.t);
   // Tag ranges tell whether the pose is right; ranges between anchors do not.
   if (tag_range)
     health_.onUpdate(s.t, "range", cur_.network->isTag(z.a) ? z.b : z.a, r.accepted, r.nis);
@@ -238,7 +220,7 @@ void EstimatorNode::processZupt(const ImuSample& s, bool first) {
   z.sigma_acc_m_s2 = options_.zupt.sigma_acc_m_s2;
   // ω row: the mean reading since the last ZUPT, σ² = (rest rotation allowed)² + σ_ω² λ / T
   // (RestRateMean; λ the IMU noise scale); the latest reading with the loosest σ before any interval.
-  const double rest_sigma = have_flight_state_ ? options_.zupt.sigma_gyro_rad_s : options_.zupt.stillness_sigma_gyro_rad_s;
+  const double rest_sigma = init_.haveFlightState() ? options_.zupt.sigma_gyro_rad_s : options_.zupt.stillness_sigma_gyro_rad_s;
   if (cur_.rest_rate.span() > 0.0) {
     const double mean_sigma = cur_.rest_rate.sigma(options_.imu.gyro_noise_density * std::sqrt(cur_.noise_adapter.scale()));
     z.gyro_rad_s = cur_.rest_rate.mean();
@@ -247,9 +229,9 @@ void EstimatorNode::processZupt(const ImuSample& s, bool first) {
     z.gyro_rad_s = s.gyro_rad_s;
     z.sigma_gyro_rad_s = std::max(rest_sigma, options_.zupt.stillness_sigma_gyro_rad_s);
   }
-  z.sigma_vel_m_s = have_flight_state_ ? options_.zupt.sigma_vel_m_s : options_.zupt.stillness_sigma_vel_m_s;
+  z.sigma_vel_m_s = init_.haveFlightState() ? options_.zupt.sigma_vel_m_s : options_.zupt.stillness_sigma_vel_m_s;
   const Linearization lin = zupt_model_.linearize(z, f.state());
-  const double gate = have_flight_state_ ? 0.0 : chi2Quantile(static_cast<int>(lin.residual.size()),
+  const double gate = init_.haveFlightState() ? 0.0 : chi2Quantile(static_cast<int>(lin.residual.size()),
                                                               options_.zupt.stillness_gate_probability);
   if (!f.update(lin, gate).accepted) event(first, "gated_zupt");
   cur_.last_zupt = s.t;

@@ -14,7 +14,7 @@
 #include "common/time.h"
 #include "estimator/core/estimator_options.h"
 #include "estimator/core/imu_state.h"
-#include "estimator/node/motion_aligner.h"
+#include "estimator/init/motion_aligner.h"
 
 namespace meshnav::estimator::node_internal {
 

@@ -2,14 +2,14 @@
 ///   IMU, BARO, RANGE, FLIGHT_STATE, ANCHOR_INIT, ESTIMATOR_CMD -> POSE, ANCHORS, ESTIMATOR_STATUS.
 /// ESTIMATOR_STATUS goes out at the node's data-time rate and, as the process heartbeat, every
 /// --heartbeat seconds of wall time (also before any data arrives, so bridges can wait for it).
-/// With --state-dir the node's checkpoint (estimator/node/checkpoint.h) is written there every
+/// With --state-dir the node's checkpoint (estimator/restart/checkpoint.h) is written there every
 /// --state-period seconds of data time and read back at start: a respawned estimator resumes
 /// with its anchors (and its pose after a short outage) instead of starting over.
 #include <iostream>
 
 #include "common/setup.h"
 #include "estimator/filter/strategy_factory.h"
-#include "estimator/node/checkpoint.h"
+#include "estimator/restart/checkpoint.h"
 #include "estimator/node/estimator_node.h"
 #include "transport/channels.h"
 #include "transport/process_main.h"

@@ -4,7 +4,7 @@
 /// quaternion and only instances of registered kinds whose covariance fits their value.
 #include <cmath>
 
-#include "estimator/node/checkpoint.h"
+#include "estimator/restart/checkpoint.h"
 #include "fuzz/support/fuzz_target.h"
 #include "fuzz/support/scratch_file.h"
 

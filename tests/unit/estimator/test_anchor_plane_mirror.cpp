@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "estimator/node/anchor_plane_mirror.h"
+#include "estimator/health/anchor_plane_mirror.h"
 
 using namespace meshnav;
 using namespace meshnav::estimator;

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <string>
 
-#include "estimator/node/checkpoint.h"
+#include "estimator/restart/checkpoint.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/testing/synthetic_scenario.h"
 #include "tests/support/test_util.h"

@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "estimator/node/motion_aligner.h"
+#include "estimator/init/motion_aligner.h"
 #include "sim/imu_simulator.h"
 #include "sim/paper_scenario.h"
 #include "sim/spiral_trajectory.h"

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "common/atmosphere.h"
-#include "estimator/node/static_initializer.h"
+#include "estimator/init/static_initializer.h"
 
 using namespace meshnav;
 using namespace meshnav::estimator;

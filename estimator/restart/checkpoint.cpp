@@ -1,4 +1,4 @@
-#include "estimator/node/checkpoint.h"
+#include "estimator/restart/checkpoint.h"
 
 #include <yaml-cpp/yaml.h>
 

@@ -1,4 +1,4 @@
-#include "estimator/node/anchor_plane_mirror.h"
+#include "estimator/health/anchor_plane_mirror.h"
 
 #include "common/principal_axes.h"
 

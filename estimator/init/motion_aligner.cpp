@@ -3,7 +3,7 @@
 /// and the observation model (residuals and analytic Jacobians of ranges and heights). The fit
 /// (starts, Levenberg–Marquardt, covariance and acceptance) is in motion_aligner_fit.cpp.
 
-#include "estimator/node/motion_aligner.h"
+#include "estimator/init/motion_aligner.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -12,7 +12,7 @@
 #include <set>
 
 #include "estimator/core/so3.h"
-#include "estimator/node/motion_aligner_internals.h"
+#include "estimator/init/motion_aligner_internals.h"
 
 namespace meshnav::estimator {
 

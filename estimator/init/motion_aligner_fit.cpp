@@ -12,8 +12,8 @@
 
 #include "estimator/core/huber.h"
 #include "estimator/core/so3.h"
-#include "estimator/node/motion_aligner.h"
-#include "estimator/node/motion_aligner_internals.h"
+#include "estimator/init/motion_aligner.h"
+#include "estimator/init/motion_aligner_internals.h"
 
 namespace meshnav::estimator {
 

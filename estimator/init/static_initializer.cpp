@@ -1,4 +1,4 @@
-#include "estimator/node/static_initializer.h"
+#include "estimator/init/static_initializer.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
