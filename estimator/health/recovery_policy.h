@@ -1,7 +1,7 @@
 #pragma once
 /// @file recovery_policy.h
 /// @brief When the estimator compares its pose with a fresh alignment and replaces it
-/// (RecoveryOptions, docs/robustness.md "Health and recovery").
+/// (RecoveryOptions, docs/robustness.md "Health", "Recovery").
 ///
 /// The model: the aligner's pose from the last window of ranges and IMU increments (position and
 /// yaw with covariance P_a) and the filter's (P_f) are two estimates of the same pose; their

@@ -88,14 +88,14 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       outputs_(options_.pose_output_rate_hz, options_.anchors_output_rate_hz, options_.status_rate_hz),
       baro_(options_.baro, setup.baro_id, setup.baro_p_IP),
       height_(options_.height, setup.height_id, heightLever(options_, setup), carriedHeightUsed(options_, setup)),
+      range_(options_.uwb, options_.strategy == "dah"),
+      anchor_join_(options_.uwb, options_.strategy == "dah", setup_, diag_),
       zupt_model_(Eigen::Vector3d(0.0, 0.0, -options.gravity_m_s2)),
       health_(options_.health),
       recovery_(options_.recovery, options_.init.motion_window_s),
       reentry_(options_.uwb, diag_),
       resume_(options_, setup_, diag_) {
   options_.validate();
-  if (options_.uwb.gate_probability > 0) range_gate_ = chi2Quantile(1, options_.uwb.gate_probability);
-  skip_estimated_anchor_pairs_ = options_.strategy == "dah" && !options_.uwb.dah_fuse_estimated_anchor_pairs;
   rerun_enabled_ = options_.refine.rerun_on_anchor_join && (options_.strategy != "dah" || options_.refine.rerun_with_dah);
   rerun_async_ = options_.refine.rerun_mode == "async";
   resetAll();

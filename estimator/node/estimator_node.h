@@ -78,6 +78,8 @@
 #include "estimator/node/output_schedule.h"
 #include "estimator/zupt/rest_rate_mean.h"
 #include "estimator/node/step_timings.h"
+#include "estimator/uwb/anchor_join.h"
+#include "estimator/uwb/range_updater.h"
 #include "estimator/uwb/reentry_gate.h"
 #include "estimator/uwb/uwb_network.h"
 #include "estimator/zupt/zupt_model.h"
@@ -145,14 +147,11 @@ class EstimatorNode {
     pollRerun(false);
     abandonRerun();
   }
-  /// Test hook: called on the re-run worker before it starts (a test holds the worker there until
-  /// it releases it; the hook must return before the node is destroyed or re-initialized).
-  void setRerunWorkerHook(std::function<void()> hook) { rerun_worker_hook_ = std::move(hook); }
-  /// Fault injection for tests and drills: moves the pose estimate by `dp_m` (G) and turns it by
-  /// `dyaw_rad` about z, keeping its covariance, as a corrupted state would look to the filter.
-  void injectPoseError(const Eigen::Vector3d& dp_m, double dyaw_rad);
 
  private:
+  friend class EstimatorNodeTesting;  ///< the test hooks (estimator/testing/estimator_node_testing.h)
+  /// A fault in the pose (EstimatorNodeTesting::injectPoseError).
+  void injectPoseError(const Eigen::Vector3d& dp_m, double dyaw_rad);
   /// The node without the start-up report: a re-run's replay node (launchRerun), whose setup the
   /// live node has reported already.
   struct Quiet {};
@@ -220,9 +219,6 @@ class EstimatorNode {
   /// Instance statistics, health and the "gated_<type>" counter of a scalar update (baro, height).
   void countScalarUpdate(Timestamp t, SensorId id, const std::string& type, const UpdateResult& r);
   void applyAnchorInit(const AnchorInit& a, bool first);
-  /// dah: puts the just added anchor `id` into its joint set (uwb.dah_joint_anchors).
-  /// At most `uwb.dah_joint_max_anchors` anchors stay in it (boundJointSetAnchors).
-  void joinAnchorSet(SensorId id);
   void applyCommand(const EstimatorCommand& c, bool first);
   /// Propagates to a measurement's time `t` past the last IMU sample, with the readings
   /// extrapolated along the last two samples to the step's middle (readingPast, imu_readings.h).
@@ -316,13 +312,9 @@ class EstimatorNode {
   std::vector<AnchorInit> pending_anchor_inits_;
   BaroUpdater baro_;
   HeightUpdater height_;
+  RangeUpdater range_;
+  AnchorJoin anchor_join_;
   ZuptModel zupt_model_;
-  double range_gate_ = 0.0;
-  /// dah without uwb.dah_fuse_estimated_anchor_pairs: ranges between two estimated anchors are left out.
-  bool skip_estimated_anchor_pairs_ = false;
-  /// The anchors added at the filter time `anchor_batch_t_` (a batch: no other input between them).
-  std::vector<SensorId> anchor_batch_;
-  std::optional<Timestamp> anchor_batch_t_;
 
   HealthMonitor health_;
   RecoveryPolicy recovery_;

@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <mutex>
 
+#include "estimator/testing/estimator_node_testing.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/testing/synthetic_scenario.h"
 #include "node_test_helpers.h"
@@ -65,7 +66,7 @@ struct Pair {
   explicit Pair(const Dataset& ds)
       : sync(options("sync"), ds.setup),
         async(options("async"), ds.setup, EstimatorSinks{[this](const PoseEstimate&) { ++async_poses; }, {}, {}}) {
-    async.setRerunWorkerHook([this] { gate.hold(); });
+    EstimatorNodeTesting::setRerunWorkerHook(async, [this] { gate.hold(); });
   }
   void feed(const EstimatorInput& in) {
     sync.onInput(in);
@@ -188,7 +189,7 @@ TEST(AnchorRerunAsync, AReInitializationAbandonsARunningReRun) {
   Pair p(ds);
   size_t i = p.joinAt(inputs, 0, 20.0, 106);
   p.gate.release();  // the worker may finish or not: the fault drops it either way
-  p.async.injectPoseError(Eigen::Vector3d(1.0, 0.0, 0.0), 0.0);  // replaces the IMU instance: no re-run base left
+  EstimatorNodeTesting::injectPoseError(p.async, Eigen::Vector3d(1.0, 0.0, 0.0), 0.0);  // replaces the IMU instance: no re-run base left
   EXPECT_FALSE(p.async.rerunRunning());
   EXPECT_EQ(p.async.diagnostics().get("rerun_abandoned"), 1);
   for (; i < inputs.size(); ++i) p.async.onInput(inputs[i]);

@@ -10,6 +10,7 @@
 // the dense covariance.
 #include <gtest/gtest.h>
 
+#include "estimator/testing/estimator_node_testing.h"
 #include "estimator/filter/centralized_ekf.h"
 #include "estimator/filter/dense_ekf_update.h"
 #include "estimator/filter/joint_set_bound.h"
@@ -325,7 +326,7 @@ TEST(DahJointSets, NodePutsAnchorsAddedTogetherIntoOneSetWithTheImu) {
     EXPECT_EQ(set.size(), 4u);  // the synthetic setup has no tag γ states (uwb.dah_joint_tag_biases)
     f->checkInvariants();
     // A re-initialization (here the test hook's pose fault) keeps the set together.
-    node.injectPoseError(Eigen::Vector3d(1.0, 0.0, 0.0), 0.3);
+    EstimatorNodeTesting::injectPoseError(node, Eigen::Vector3d(1.0, 0.0, 0.0), 0.3);
     const auto* g = dynamic_cast<const ModularFilter*>(node.filter());
     ASSERT_NE(g, nullptr);
     std::vector<SensorId> after = g->instances().jointSet(201), before = set;

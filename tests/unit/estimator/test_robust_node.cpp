@@ -10,6 +10,7 @@
 #include <map>
 #include <optional>
 
+#include "estimator/testing/estimator_node_testing.h"
 #include "estimator/node/estimator_node.h"
 #include "sim/scenario_simulator.h"
 #include "sim/uncertain_anchors.h"
@@ -63,7 +64,7 @@ TEST(RobustNode, RecoversFromACorruptedPoseWithinFiveSeconds) {
     node.onInput(in);
     const Timestamp t = inputTime(in);
     if (!injected && t.sec() >= 40.0) {
-      node.injectPoseError(Eigen::Vector3d(4.0, 3.0, 0.0), M_PI / 2.0);  // 5 m and 90° of yaw
+      EstimatorNodeTesting::injectPoseError(node, Eigen::Vector3d(4.0, 3.0, 0.0), M_PI / 2.0);  // 5 m and 90° of yaw
       injected = true;
     }
     if (!injected || back_at >= 0.0 || !std::holds_alternative<ImuSample>(in)) continue;
