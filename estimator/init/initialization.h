@@ -83,7 +83,8 @@ class Initialization {
   bool haveFlightState() const { return have_flight_state_; }
   /// Baro readings or aligner heights were seen (vertical sensors, along −z of G).
   bool sawVerticalSensor() const { return last_pressure_pa_ || last_align_height_; }
-  /// The baro aligns (setup reference pressure): its heights are absolute.
+  /// The baro is the alignment's height source (`baroAligns(options, setup)`: init.motion_use_baro,
+  /// baro.enabled, a setup reference pressure, no carried height): its heights are absolute.
   bool baroAligns() const { return baro_aligns_; }
   /// The setup's carried height is in use (a pseudo-sensor at the IMU rate).
   bool carriedHeight() const { return carried_height_; }
@@ -117,8 +118,9 @@ class Initialization {
 
 /// The setup's carried height is used (setup `carried_height` and `carried_height.enabled`).
 bool carriedHeightUsed(const EstimatorOptions& o, const SystemSetup& setup);
-/// The barometer is the in-motion alignment's height source: the setup gives its reference
-/// pressure (absolute heights) and no carried height is stated.
+/// The barometer is the in-motion alignment's height source: `init.motion_use_baro` and
+/// `baro.enabled`, the setup gives its reference pressure (absolute heights) and no carried height
+/// is stated.
 bool baroAligns(const EstimatorOptions& o, const SystemSetup& setup);
 /// The height model's lever arm: the rangefinder's, or none for the carried height (h = p_z + b).
 Eigen::Vector3d heightLever(const EstimatorOptions& o, const SystemSetup& setup);

@@ -90,6 +90,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       height_(options_.height, setup.height_id, heightLever(options_, setup), carriedHeightUsed(options_, setup)),
       range_(options_.uwb, options_.strategy == "dah"),
       anchor_join_(options_.uwb, options_.strategy == "dah", setup_, diag_),
+      propagation_(options_.imu),
       zupt_model_(Eigen::Vector3d(0.0, 0.0, -options.gravity_m_s2)),
       health_(options_.health),
       recovery_(options_.recovery, options_.init.motion_window_s),
@@ -249,9 +250,11 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
 void EstimatorNode::propagateTo(Timestamp t) {
   if (!cur_.last_imu || t <= cur_.filter->state().t) return;
   ScopedStepTimer timer(timings_, "propagate");
-  propagateFilter(readingPast(*cur_.last_imu, cur_.prev_imu, cur_.filter->state().t, t,
-                              options_.imu.extrapolate_max_period_s),
-                  t);
+  propagation_.toTime(*cur_.filter, t, propagationInputs());
+}
+
+ImuPropagation::Inputs EstimatorNode::propagationInputs() const {
+  return {cur_.last_imu, cur_.prev_imu, cur_.mean_reading, gravityG(), cur_.noise_adapter.scale()};
 }
 
 void EstimatorNode::processImu(const ImuSample& s, bool first) {
@@ -265,16 +268,13 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
     recovery_.noteImuGap(s.t, gap_s);
   }
   if (s.t > t0) {
-    // Readings interpolated to the middle of [t0, s.t] (held when no earlier reading).
-    const ImuReading u =
-        cur_.last_imu ? readingBetween(*cur_.last_imu, s, t0, s.t) : ImuReading{s.acc_m_s2, s.gyro_rad_s};
     ScopedStepTimer timer(timings_, "propagate");
-    propagateFilter(u, s.t);
+    propagation_.toSample(f, s, propagationInputs());
   }
   const std::optional<ImuSample> previous = cur_.last_imu;
   cur_.prev_imu = previous;
   cur_.last_imu = s;
-  updateMeanReading(s, previous);
+  propagation_.updateMean(cur_.mean_reading, cur_.filter->state().imu, s, previous, gravityG());
   if (!init_.haveFlightState()) cur_.landed = init_.landedAt(s.t, cur_.landed);
   if (cur_.landed && previous && s.t > previous->t)
     cur_.rest_rate.add(s.gyro_rad_s, (s.t - previous->t).sec(), options_.imu.max_dt_s);

@@ -69,6 +69,7 @@
 #include "estimator/node/estimator_input.h"
 #include "estimator/health/health_monitor.h"
 #include "estimator/health/recovery_policy.h"
+#include "estimator/imu/imu_propagation.h"
 #include "estimator/imu/imu_readings.h"
 #include "estimator/imu/process_noise_adapter.h"
 #include "estimator/health/flight_volume_guard.h"
@@ -223,14 +224,8 @@ class EstimatorNode {
   /// Propagates to a measurement's time `t` past the last IMU sample, with the readings
   /// extrapolated along the last two samples to the step's middle (readingPast, imu_readings.h).
   void propagateTo(Timestamp t);
-  /// Propagation on the readings `u` held over [filter time, t], with λ's and `u`'s extra white
-  /// noise; the part beyond `imu.max_dt_s` after the last IMU sample is a gap: propagated on what
-  /// `imu.gap_readings` says, with the gap noise.
-  void propagateFilter(const ImuReading& u, Timestamp t);
-  /// One propagation on `u` with the innovation-driven extra IMU noise (no gap handling).
-  void propagateFilterStep(const ImuReading& u, Timestamp t);
-  /// Low-passes the readings into cur_.mean_reading (restarted after a gap).
-  void updateMeanReading(const ImuSample& s, const std::optional<ImuSample>& previous);
+  /// What ImuPropagation reads besides the filter (cur_'s samples, mean reading, g, λ).
+  ImuPropagation::Inputs propagationInputs() const;
   /// Gravity in G: (0, 0, ∓|g|) by the gravity direction's sign.
   Eigen::Vector3d gravityG() const { return gravity_.gravityG(options_.gravity_m_s2); }
   /// Baro readings or heights seen (both measure along −z of G).
@@ -314,6 +309,7 @@ class EstimatorNode {
   HeightUpdater height_;
   RangeUpdater range_;
   AnchorJoin anchor_join_;
+  ImuPropagation propagation_;
   ZuptModel zupt_model_;
 
   HealthMonitor health_;

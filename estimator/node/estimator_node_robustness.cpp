@@ -17,7 +17,6 @@
 namespace meshnav::estimator {
 
 using node_internal::weakestPositionAxis;
-using node_internal::whiteImuNoise;
 
 void EstimatorNode::feedInitializer(const EstimatorInput& in) {
   // Anchors that come before the pose are held and applied at the initialization.
@@ -124,69 +123,6 @@ void EstimatorNode::initialize(const InitialBelief& b) {
 std::string EstimatorNode::waitingFor() const {
   if (initialized()) return "";
   return init_.waitingFor();
-}
-
-void EstimatorNode::propagateFilter(const ImuReading& u, Timestamp t) {
-  FusionStrategy& f = *cur_.filter;
-  const Timestamp t0 = f.state().t;
-  // Held readings beyond max_dt after the last sample: the part of the step in the gap.
-  const Timestamp stale_from =
-      cur_.last_imu ? std::max(t0, cur_.last_imu->t + Duration::fromSec(options_.imu.max_dt_s)) : t;
-  const std::string& mode = options_.imu.gap_readings;
-  if (stale_from < t && mode != "held") {  // the string only in a gap
-    // In the gap no reading. "held" repeats the last one for the whole gap, which turns a drone's
-    // momentary rotation rate into tens of degrees (docs/robustness.md, "IMU gaps"); "mean"
-    // repeats the low-passed readings (a steady turn as held, an oscillation averaged out);
-    // "still" takes the vehicle as keeping its velocity and attitude (a = 0 in G, ω = 0).
-    if (stale_from > t0) propagateFilterStep(u, stale_from);
-    const ImuState& x = f.state().imu;
-    const bool mean = mode == "mean" && cur_.mean_reading;
-    // Acceleration in G (0 for "still") and angular rate, as the readings they would give.
-    const Eigen::Vector3d a_G = mean ? cur_.mean_reading->acc_m_s2 : Eigen::Vector3d::Zero();
-    ImuReading gap;
-    gap.acc_m_s2 = x.bias_acc_m_s2 + x.q_ItoG.conjugate() * (a_G - gravityG());
-    // Turning about the vertical at the low-passed rate; no tilting (a vehicle's tilt swings
-    // about level: integrating a low-passed tilt rate for seconds leaves the attitude tilted
-    // after the gap, and gravity leaks into the position).
-    const double yaw_rate = mean ? cur_.mean_reading->gyro_rad_s.z() : 0.0;
-    gap.gyro_rad_s = x.bias_gyro_rad_s + x.q_ItoG.conjugate() * Eigen::Vector3d(0.0, 0.0, yaw_rate);
-    propagateFilterStep(gap, t);
-  } else {
-    propagateFilterStep(u, t);
-  }
-  const double dt = (t - stale_from).sec();
-  if (dt <= 0.0) return;
-  // Their error as white noise (velocity and attitude random walk; position the integrated
-  // velocity noise).
-  f.addImuNoise(whiteImuNoise(std::pow(options_.imu.gap_sigma_acc_m_s2, 2),
-                              std::pow(options_.imu.gap_sigma_gyro_rad_s, 2), dt));
-}
-
-void EstimatorNode::updateMeanReading(const ImuSample& s, const std::optional<ImuSample>& previous) {
-  const ImuState& x = cur_.filter->state().imu;
-  const Eigen::Vector3d a_G = x.q_ItoG * (s.acc_m_s2 - x.bias_acc_m_s2) + gravityG();
-  const Eigen::Vector3d w_G = x.q_ItoG * (s.gyro_rad_s - x.bias_gyro_rad_s);
-  const double dt = previous ? (s.t - previous->t).sec() : 0.0;
-  if (!cur_.mean_reading || dt <= 0.0 || dt > options_.imu.max_dt_s) {  // (re)start after a gap
-    cur_.mean_reading = ImuReading{a_G, w_G};
-    return;
-  }
-  const double a = 1.0 - std::exp(-dt / options_.imu.gap_mean_time_constant_s);
-  cur_.mean_reading->acc_m_s2 += a * (a_G - cur_.mean_reading->acc_m_s2);
-  cur_.mean_reading->gyro_rad_s += a * (w_G - cur_.mean_reading->gyro_rad_s);
-}
-
-void EstimatorNode::propagateFilterStep(const ImuReading& u, Timestamp t) {
-  FusionStrategy& f = *cur_.filter;
-  const Timestamp t0 = f.state().t;
-  f.propagate(u.acc_m_s2, u.gyro_rad_s, t);
-  // The IMU noise beyond its stated densities that the range innovations show (λ − 1 of it), and
-  // an extrapolated reading's own excess (λ times its extra_noise_scale), in one addition.
-  const double lambda = cur_.noise_adapter.scale();
-  const double extra = lambda - 1.0 + lambda * u.extra_noise_scale;
-  if (extra > 0.0 && t > t0)
-    f.addImuNoise(whiteImuNoise(extra * std::pow(options_.imu.acc_noise_density, 2),
-                                extra * std::pow(options_.imu.gyro_noise_density, 2), (t - t0).sec()));
 }
 
 void EstimatorNode::updateHealth(Timestamp t) {

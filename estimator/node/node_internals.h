@@ -42,19 +42,6 @@ inline MotionAlignerOptions alignerOptions(const EstimatorOptions& o, const Eige
   return a;
 }
 
-/// Discrete covariance of white specific-force noise (density² qa [m²/s³]) and angular-rate
-/// noise (qw [rad²/s]) integrated over dt: velocity and attitude random walks, position the
-/// integrated velocity noise (qa dt³/3, cross term qa dt²/2).
-inline ImuMatrix whiteImuNoise(double qa, double qw, double dt) {
-  ImuMatrix Q = ImuMatrix::Zero();
-  const Eigen::Matrix3d I3 = Eigen::Matrix3d::Identity();
-  Q.block<3, 3>(ImuErr::kP, ImuErr::kP) = I3 * qa * dt * dt * dt / 3.0;
-  Q.block<3, 3>(ImuErr::kP, ImuErr::kV) = Q.block<3, 3>(ImuErr::kV, ImuErr::kP) = I3 * qa * dt * dt / 2.0;
-  Q.block<3, 3>(ImuErr::kV, ImuErr::kV) = I3 * qa * dt;
-  Q.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) = I3 * qw * dt;
-  return Q;
-}
-
 /// Largest principal position σ [m] and its direction (G).
 inline std::pair<double, Eigen::Vector3d> weakestPositionAxis(const Eigen::Matrix3d& P) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(0.5 * (P + P.transpose()));

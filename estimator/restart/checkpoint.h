@@ -5,10 +5,12 @@
 /// estimator/core/kind_traits.h) and every estimated anchor with its pair biases
 /// (docs/robustness.md, "Restarts").
 ///
-/// A restarted estimator process reads the checkpoint its predecessor wrote (`--state-dir`) and,
-/// when the first IMU sample is at most `init.resume_max_age_s` newer, starts from it at once:
-/// the position moved by v·Δt and the covariance grown by the IMU-gap noise over Δt (velocity
-/// random walk `imu.gap_sigma_acc_m_s2`, position its integral; attitude by the gyro density).
+/// A restarted estimator process reads the checkpoint its predecessor wrote (`--state-dir`); how
+/// it resumes from it is Resume's (estimator/restart/resume.h): a checkpoint at most
+/// `init.resume_max_age_s` older than the first IMU sample gives back the anchors, the baro
+/// reference and the kept instances, and across an outage of at most `init.resume_max_outage_s`
+/// the pose too, moved by v·Δt with its covariance grown by the largest acceleration and rotation
+/// rate assumed meanwhile (`init.resume_max_acc_m_s2`, `init.resume_max_rate_deg_s`).
 /// The kept instances (Restart::kKept: baro bias, height bias, tag γ) come back with their value
 /// and marginal covariance grown by their random walk over Δt, whatever the outage.
 /// Cross-covariances between instances are not kept (marginals only), as in a recovery.

@@ -162,8 +162,10 @@ TEST(RecoveryPolicy, YawDifferenceWrapsAtPi) {
   const double d = 2.0 * M_PI - 6.2;
   EXPECT_NEAR(RecoveryPolicy::disagreement(x, P, a), d * d / 0.0009, 1e-6);
   // Either way round.
-  EXPECT_NEAR(RecoveryPolicy::disagreement(pose({0, 0, 1}, -3.1), P, AlignmentResult{at(0), x, a.cov}),
-              d * d / 0.0009, 1e-6);
+  AlignmentResult b;
+  b.imu = x;
+  b.cov = a.cov;
+  EXPECT_NEAR(RecoveryPolicy::disagreement(pose({0, 0, 1}, -3.1), P, b), d * d / 0.0009, 1e-6);
 }
 
 TEST(RecoveryPolicy, ContradictsBeyondTheBoundOnly) {
