@@ -76,6 +76,7 @@ void writeTimings(const StepTimings& timings, const std::string& path) {
   out << "step,count,mean_us,median_us,max_us\n";
   for (const auto& [type, s] : timings.stats())
     out << type << ',' << s.count << ',' << s.mean_us << ',' << s.median_us << ',' << s.max_us << '\n';
+  checkedFlush(out, path);
 }
 
 void writeStatus(const EstimatorStatus& st, double wall_s, double data_s, const std::string& path) {
@@ -92,6 +93,7 @@ void writeStatus(const EstimatorStatus& st, double wall_s, double data_s, const 
   for (const auto& i : st.instances)
     out << "  - {id: " << i.id << ", type: " << i.type << ", n_updates: " << i.n_updates
         << ", n_rejected: " << i.n_rejected << "}\n";
+  checkedFlush(out, path);
 }
 
 /// Feeds every input of `inputs` (time order, each to its vehicle) to the pipeline, with a progress line every 25 %.

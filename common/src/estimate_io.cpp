@@ -3,7 +3,9 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 
@@ -43,8 +45,17 @@ std::optional<Eigen::Matrix3d> upper(const CsvRow& r, const char* const names[6]
 
 }  // namespace
 
+void checkedFlush(std::ofstream& out, const std::string& path, int first_errno) {
+  errno = 0;
+  out.flush();
+  if (out) return;
+  const int err = first_errno ? first_errno : errno;
+  throw std::runtime_error(path + ": write failed (" + (err ? std::string(std::strerror(err)) : "stream error") +
+                           "; the file is incomplete)");
+}
+
 EstimateCsvWriter::EstimateCsvWriter(const std::string& path, bool append)
-    : out_(openOut(path, kEstimateHeader, append)) {}
+    : path_(path), out_(openOut(path, kEstimateHeader, append)) {}
 
 void EstimateCsvWriter::write(const PoseEstimate& e) {
   const auto& P = e.cov_p_m2;
@@ -55,23 +66,27 @@ void EstimateCsvWriter::write(const PoseEstimate& e) {
                 formatSeconds(e.t).c_str(), e.p_IinG.x(), e.p_IinG.y(), e.p_IinG.z(), e.q_ItoG.x(), e.q_ItoG.y(),
                 e.q_ItoG.z(), e.q_ItoG.w(), P(0, 0), P(0, 1), P(0, 2), P(1, 1), P(1, 2), P(2, 2), Q(0, 0), Q(0, 1),
                 Q(0, 2), Q(1, 1), Q(1, 2), Q(2, 2));
+  errno = 0;
   out_ << buf;
+  if (!out_ && errno_ == 0) errno_ = errno;
 }
 
-void EstimateCsvWriter::flush() { out_.flush(); }
+void EstimateCsvWriter::flush() { checkedFlush(out_, path_, errno_); }
 
 AnchorsCsvWriter::AnchorsCsvWriter(const std::string& path, bool append)
-    : out_(openOut(path, kAnchorsHeader, append)) {}
+    : path_(path), out_(openOut(path, kAnchorsHeader, append)) {}
 
 void AnchorsCsvWriter::write(const AnchorEstimate& a) {
   const auto& P = a.cov_p_m2;
   char buf[384];
   std::snprintf(buf, sizeof(buf), "%s,%d,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", formatSeconds(a.t).c_str(),
                 a.id, a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z(), P(0, 0), P(0, 1), P(0, 2), P(1, 1), P(1, 2), P(2, 2));
+  errno = 0;
   out_ << buf;
+  if (!out_ && errno_ == 0) errno_ = errno;
 }
 
-void AnchorsCsvWriter::flush() { out_.flush(); }
+void AnchorsCsvWriter::flush() { checkedFlush(out_, path_, errno_); }
 
 std::vector<PoseEstimate> readEstimateCsv(const std::string& path, Diagnostics& diag) {
   static const char* const kP[6] = {"pxx", "pxy", "pxz", "pyy", "pyz", "pzz"};

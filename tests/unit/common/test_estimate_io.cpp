@@ -37,3 +37,31 @@ TEST(EstimateIo, QuaternionFarFromUnitIsSkipped) {
   EXPECT_DOUBLE_EQ(e[0].q_ItoG.norm(), 1.0);
   EXPECT_EQ(diag.get("estimate.csv:bad_quaternion"), 2);
 }
+
+// Issue 36: a run on a full disk ended with exit 0 and a torn estimate.csv. A write that fails
+// is not silent: flush() throws naming the file (/dev/full fails every write with ENOSPC).
+TEST(EstimateIo, AFailedWriteIsReportedByFlushNamingTheFile) {
+  EstimateCsvWriter w("/dev/full");
+  PoseEstimate e;
+  e.t = Timestamp::fromSec(1.0);
+  for (int i = 0; i < 100; ++i) w.write(e);
+  try {
+    w.flush();
+    FAIL() << "flush on /dev/full did not throw";
+  } catch (const std::runtime_error& ex) {
+    EXPECT_NE(std::string(ex.what()).find("/dev/full: write failed"), std::string::npos) << ex.what();
+  }
+  AnchorsCsvWriter a("/dev/full");
+  a.write(AnchorEstimate{});
+  EXPECT_THROW(a.flush(), std::runtime_error);
+}
+
+// A writer whose writes succeed flushes without a word, as often as asked.
+TEST(EstimateIo, FlushOfAGoodFileDoesNotThrow) {
+  const test::TempDir d("estimate_io_flush");
+  EstimateCsvWriter w((d / "estimate.csv").string());
+  PoseEstimate e;
+  w.write(e);
+  EXPECT_NO_THROW(w.flush());
+  EXPECT_NO_THROW(w.flush());
+}
