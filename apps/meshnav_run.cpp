@@ -36,7 +36,7 @@ constexpr char kDescription[] =
 /// The command line of meshnav_run.
 struct RunOptions {
   std::string dataset, fleet, out, strategy, config, mission, calib_config;
-  bool no_calibration = false, allow_lost = false, print_config = false;
+  bool no_calibration = false, allow_lost = false, print_config = false, print_model_parameters = false;
 };
 
 void declareOptions(Cli& cli, RunOptions& o) {
@@ -69,6 +69,8 @@ void declareOptions(Cli& cli, RunOptions& o) {
       ->type_name("FILE");
   cli.flag("allow-lost", o.allow_lost, "exit 0 even if the estimate ends lost or never initialized (default: exit 3)");
   cli.flag("print-config", o.print_config, "print the estimator options (defaults or --config) as YAML and exit");
+  cli.flag("print-model-parameters", o.print_model_parameters,
+           "print the estimator's model parameters (fixed in code, not options; docs/configuration.md) and exit");
 }
 
 void writeTimings(const StepTimings& timings, const std::string& path) {
@@ -281,6 +283,10 @@ int run(const RunOptions& o) {
   EstimatorOptions options = o.config.empty() ? EstimatorOptions{} : EstimatorOptions::fromYaml(o.config);
   if (o.print_config) {
     std::cout << options.toString();
+    return 0;
+  }
+  if (o.print_model_parameters) {
+    std::cout << options.modelParametersString();
     return 0;
   }
   if ((o.dataset.empty() && o.fleet.empty()) || o.out.empty()) {

@@ -82,9 +82,10 @@ void printOption(std::ostream& os, const T& value) {
 /// Options read from `yaml`: every field of `list` (a missing key keeps its default), unknown
 /// keys refused (file and key), then `validate()`, whose message gets the file's name in front
 /// ("<file>: <what>").
+/// `base`: the values a missing key keeps (default: `Opts{}`; e.g. a profile's).
 template <class Opts, class List>
-Opts readOptionsList(YamlOptions& yaml, List&& list) {
-  Opts o;
+Opts readOptionsList(YamlOptions& yaml, List&& list, Opts base = Opts{}) {
+  Opts o = std::move(base);
   list(o, [&](const auto& key, auto& field, auto&&...) { readOption(yaml, key, field); });
   yaml.rejectUnknown();
   try {

@@ -27,36 +27,82 @@ const std::string kStrategyNames = strategyNames(" | ");
 /// Every option, in the order of the shipped file (config/estimator.yaml): the single list used
 /// for loading, printing and that file, so they cannot drift apart.
 const Field kFields[] = {
+    {"profile", field<&EstimatorOptions::profile>, "auto | drone | handheld: which platform models are on (docs/configuration.md); the keys below override it"},
     {"strategy", field<&EstimatorOptions::strategy>, kStrategyNames.c_str()},
     {"gravity_m_s2", field<&EstimatorOptions::gravity_m_s2>, "|g| [m/s^2]"},
     {"window_s", field<&EstimatorOptions::window_s>, "out-of-sequence window [s]"},
     {"pose_output_rate_hz", field<&EstimatorOptions::pose_output_rate_hz>, "POSE rate, 0 = every IMU step [Hz]"},
     {"anchors_output_rate_hz", field<&EstimatorOptions::anchors_output_rate_hz>, "ANCHORS rate (data time) [Hz]"},
     {"status_rate_hz", field<&EstimatorOptions::status_rate_hz>, "ESTIMATOR_STATUS rate (data time) [Hz]"},
-    {"joseph_form", field<&EstimatorOptions::joseph_form>, "Joseph covariance update (false: P - K S K^T, symmetrized)"},
     {"imu.acc_noise_density", field<&EstimatorOptions::imu, &ImuNoiseOptions::acc_noise_density>, "[m/s^2/sqrt(Hz)]"},
     {"imu.gyro_noise_density", field<&EstimatorOptions::imu, &ImuNoiseOptions::gyro_noise_density>, "[rad/s/sqrt(Hz)]"},
     {"imu.acc_bias_rw", field<&EstimatorOptions::imu, &ImuNoiseOptions::acc_bias_rw>, "[m/s^3/sqrt(Hz)]"},
     {"imu.gyro_bias_rw", field<&EstimatorOptions::imu, &ImuNoiseOptions::gyro_bias_rw>, "[rad/s^2/sqrt(Hz)]"},
     {"imu.max_dt_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::max_dt_s>, "longer IMU gaps are counted as imu_gap and inflated [s]"},
+    {"imu.gap_readings", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_readings>, "mean | still | held: in a gap propagate on the low-passed readings, as if the vehicle kept its velocity and attitude, or on the last reading repeated"},
+    {"init.duration_s", field<&EstimatorOptions::init, &InitOptions::duration_s>, "landed data before initializing [s]"},
+    {"init.min_ranges", field<&EstimatorOptions::init, &InitOptions::min_ranges>, "tag-anchor ranges needed without initial_pose [-]"},
+    {"init.sigma_bias_gyro_rad_s", field<&EstimatorOptions::init, &InitOptions::sigma_bias_gyro_rad_s>, "[rad/s]"},
+    {"init.sigma_bias_acc_m_s2", field<&EstimatorOptions::init, &InitOptions::sigma_bias_acc_m_s2>, "[m/s^2]"},
+    {"init.motion_window_s", field<&EstimatorOptions::init, &InitOptions::motion_window_s>, "in-motion alignment window [s]"},
+    {"init.resume_max_age_s", field<&EstimatorOptions::init, &InitOptions::resume_max_age_s>, "a restart resumes from a checkpoint at most this old [s]"},
+    {"init.resume_max_outage_s", field<&EstimatorOptions::init, &InitOptions::resume_max_outage_s>, "longer restart outages re-initialize the pose (anchors kept) [s]"},
+    {"baro.enabled", field<&EstimatorOptions::baro, &BaroOptions::enabled>, ""},
+    {"baro.pressure_sigma_pa", field<&EstimatorOptions::baro, &BaroOptions::pressure_sigma_pa>, "[Pa]"},
+    {"baro.bias_rw_m_per_sqrt_s", field<&EstimatorOptions::baro, &BaroOptions::bias_rw_m_per_sqrt_s>, "height bias random walk [m/sqrt(s)]"},
+    {"baro.init_bias_sigma_m", field<&EstimatorOptions::baro, &BaroOptions::init_bias_sigma_m>, "bias sigma with a given reference pressure [m]"},
+    {"height.enabled", field<&EstimatorOptions::height, &HeightOptions::enabled>, "downward rangefinder (height.csv)"},
+    {"height.sigma_m", field<&EstimatorOptions::height, &HeightOptions::sigma_m>, "range noise sigma [m]"},
+    {"height.bias_rw_m_per_sqrt_s", field<&EstimatorOptions::height, &HeightOptions::bias_rw_m_per_sqrt_s>, "bias random walk [m/sqrt(s)]"},
+    {"height.init_bias_sigma_m", field<&EstimatorOptions::height, &HeightOptions::init_bias_sigma_m>, "prior sigma of the bias around 0 [m]"},
+    {"height.min_range_m", field<&EstimatorOptions::height, &HeightOptions::min_range_m>, "shorter readings are not used (clamped at the sensor's minimum) [m]"},
+    {"carried_height.enabled", field<&EstimatorOptions::carried_height, &CarriedHeightOptions::enabled>, "used when setup.yaml has carried_height (hand-held rig)"},
+    {"carried_height.sigma_m", field<&EstimatorOptions::carried_height, &CarriedHeightOptions::sigma_m>, "sigma of one reading (gait bob and sway) [m]"},
+    {"carried_height.bias_rw_m_per_sqrt_s", field<&EstimatorOptions::carried_height, &CarriedHeightOptions::bias_rw_m_per_sqrt_s>, "random walk of the carrying height [m/sqrt(s)]"},
+    {"uwb.enabled", field<&EstimatorOptions::uwb, &UwbOptions::enabled>, ""},
+    {"uwb.sigma_range_m", field<&EstimatorOptions::uwb, &UwbOptions::sigma_range_m>, "fallback range sigma [m]"},
+    {"uwb.gate_probability", field<&EstimatorOptions::uwb, &UwbOptions::gate_probability>, "chi^2 gate, 0 = off [-]"},
+    {"uwb.huber_k", field<&EstimatorOptions::uwb, &UwbOptions::huber_k>, "Huber threshold of the range update in innovation sigmas, 0 = off [-]"},
+    {"uwb.use_corrected_range", field<&EstimatorOptions::uwb, &UwbOptions::use_corrected_range>, "fuse range_corr instead of range_raw (one more than 1 m from it is bad input)"},
+    {"uwb.max_range_m", field<&EstimatorOptions::uwb, &UwbOptions::max_range_m>, "longer ranges are bad input [m]"},
+    {"uwb.estimate_tag_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_tag_biases>, "estimate tag-anchor gamma (setup anchors, sigma_gamma > 0) as states"},
+    {"uwb.estimate_anchor_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_anchor_biases>, "estimate a calibrated anchor's gamma (ANCHOR_INIT, sigma_gamma > 0) as states of its instance"},
+    {"uwb.estimate_setup_anchor_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_setup_anchor_biases>, "the same for known-but-uncertain setup anchors (towards exact and smaller-id uncertain anchors)"},
+    {"uwb.fuse_calibrated_anchor_pairs", field<&EstimatorOptions::uwb, &UwbOptions::fuse_calibrated_anchor_pairs>, "fuse ranges between two calibrated anchors (their correlated calibration errors are not known)"},
+    {"uwb.dah_fuse_estimated_anchor_pairs", field<&EstimatorOptions::uwb, &UwbOptions::dah_fuse_estimated_anchor_pairs>, "dah only: fuse ranges between two estimated anchors (overconfident, see docs)"},
+    {"uwb.dah_joint_anchors", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_anchors>, "dah only: anchors updated jointly: none | batch (added together, e.g. by a re-run) | all"},
+    {"uwb.reentry_gap_s", field<&EstimatorOptions::uwb, &UwbOptions::reentry_gap_s>, "no tag range accepted for this long: hold and cross-check the next ones, 0 = off [s]"},
+    {"zupt.enabled", field<&EstimatorOptions::zupt, &ZuptOptions::enabled>, ""},
+    {"zupt.sigma_vel_m_s", field<&EstimatorOptions::zupt, &ZuptOptions::sigma_vel_m_s>, "sigma of v = 0 [m/s]"},
+    {"zupt.detect_stillness", field<&EstimatorOptions::zupt, &ZuptOptions::detect_stillness>, "without FLIGHT_STATE: ZUPT while the IMU shows rest"},
+    {"zupt.stillness_sigma_vel_m_s", field<&EstimatorOptions::zupt, &ZuptOptions::stillness_sigma_vel_m_s>, "sigma of v = 0 when only IMU stillness says rest (a smooth hover drifts) [m/s]"},
+    {"health.window_s", field<&EstimatorOptions::health, &HealthOptions::window_s>, "innovation statistics window [s]"},
+    {"process_noise.adapt", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::enabled>, "scale the IMU noise densities to the range innovations"},
+    {"recovery.enabled", field<&EstimatorOptions::recovery, &RecoveryOptions::enabled>, "re-initialize from ranges and IMU when lost"},
+    {"flight_volume.enabled", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::enabled>, "use setup flight_volume: against the mirror image of coplanar known anchors on its walls or ceiling, and to drop initial fits outside it"},
+    {"time.max_offset_s", field<&EstimatorOptions::time, &TimeGuardOptions::max_offset_s>, "an input stamped farther than this from the current (newest) time is refused and counted [s]"},
+    {"refine.rerun_on_anchor_join", field<&EstimatorOptions::refine, &RefineOptions::rerun_on_anchor_join>, "on ANCHOR_INIT re-run from the oldest stored input with the calibrated anchors uncertain from there"},
+    {"refine.max_history_s", field<&EstimatorOptions::refine, &RefineOptions::max_history_s>, "inputs kept for re-runs (about 260 B each, S2: 360 inputs/s); older ones are dropped in eighths, counted [s]"},
+    {"refine.rerun_mode", field<&EstimatorOptions::refine, &RefineOptions::rerun_mode>, "auto | sync | async: re-run inline, or on a worker while the node keeps publishing; auto = async in the LCM process"},
+};
+
+/// The model parameters (docs/configuration.md, "Model parameters"): fixed in code with their
+/// reasons in estimator_options.h, set only through the C++ API (tests, tools). A file that still
+/// sets one is refused with this list's key, so an old config fails loudly instead of being ignored.
+const Field kModelParameters[] = {
+    {"joseph_form", field<&EstimatorOptions::joseph_form>, "Joseph covariance update (false: P - K S K^T, symmetrized)"},
     {"imu.extrapolate_max_period_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::extrapolate_max_period_s>, "readings between samples extrapolated when the last two are at most this far apart, else held; 0 = always held [s]"},
     {"imu.gap_sigma_acc_m_s2", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_sigma_acc_m_s2>, "error of the readings a gap is propagated on [m/s^2/sqrt(s)]"},
     {"imu.gap_sigma_gyro_rad_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_sigma_gyro_rad_s>, "error of the readings a gap is propagated on [rad/s/sqrt(s)]"},
-    {"imu.gap_readings", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_readings>, "mean | still | held: in a gap propagate on the low-passed readings, as if the vehicle kept its velocity and attitude, or on the last reading repeated"},
     {"imu.gap_mean_time_constant_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_mean_time_constant_s>, "low-pass of the readings for gap_readings mean [s]"},
-    {"init.duration_s", field<&EstimatorOptions::init, &InitOptions::duration_s>, "landed data before initializing [s]"},
-    {"init.min_ranges", field<&EstimatorOptions::init, &InitOptions::min_ranges>, "tag-anchor ranges needed without initial_pose [-]"},
     {"init.assume_landed_without_flight_state", field<&EstimatorOptions::init, &InitOptions::assume_landed_without_flight_state>, "no FLIGHT_STATE received yet: treat as landed (else IMU stillness decides)"},
     {"init.sigma_v_m_s", field<&EstimatorOptions::init, &InitOptions::sigma_v_m_s>, "[m/s]"},
     {"init.sigma_roll_pitch_deg", field<&EstimatorOptions::init, &InitOptions::sigma_roll_pitch_deg>, "[deg]"},
-    {"init.sigma_bias_gyro_rad_s", field<&EstimatorOptions::init, &InitOptions::sigma_bias_gyro_rad_s>, "[rad/s]"},
-    {"init.sigma_bias_acc_m_s2", field<&EstimatorOptions::init, &InitOptions::sigma_bias_acc_m_s2>, "[m/s^2]"},
     {"init.range_init_min_sigma_p_m", field<&EstimatorOptions::init, &InitOptions::range_init_min_sigma_p_m>, "floor of position sigma from ranges [m]"},
     {"init.range_init_sigma_yaw_deg", field<&EstimatorOptions::init, &InitOptions::range_init_sigma_yaw_deg>, "yaw sigma when initialized from ranges [deg]"},
     {"init.range_init_outlier_m", field<&EstimatorOptions::init, &InitOptions::range_init_outlier_m>, "init range residual treated as outlier [m]"},
     {"init.static_max_sigma_yaw_deg", field<&EstimatorOptions::init, &InitOptions::static_max_sigma_yaw_deg>, "static range fit refused above [deg]"},
     {"init.ambiguity_chi2", field<&EstimatorOptions::init, &InitOptions::ambiguity_chi2>, "second fit minimum within this cost: ambiguous, refused [-]"},
-    {"init.motion_window_s", field<&EstimatorOptions::init, &InitOptions::motion_window_s>, "in-motion alignment window [s]"},
     {"init.gravity_early_check_nis_ratio", field<&EstimatorOptions::init, &InitOptions::gravity_early_check_nis_ratio>, "median range NIS over its expected value that runs the gravity-direction check before its time, once, 0 = never [-]"},
     {"init.motion_max_window_s", field<&EstimatorOptions::init, &InitOptions::motion_max_window_s>, "in-motion alignment: longest window when ranges are sparse (count-based) [s]"},
     {"init.motion_min_span_s", field<&EstimatorOptions::init, &InitOptions::motion_min_span_s>, "in-motion alignment shortest window [s]"},
@@ -65,60 +111,28 @@ const Field kFields[] = {
     {"init.motion_max_sigma_p_m", field<&EstimatorOptions::init, &InitOptions::motion_max_sigma_p_m>, "in-motion alignment refused above [m]"},
     {"init.motion_relinearize_rad", field<&EstimatorOptions::init, &InitOptions::motion_relinearize_rad>, "in-motion alignment: re-integrate at the fitted gyro bias when it turns the attitude more than this over the window, 0 = never [rad]"},
     {"init.motion_use_baro", field<&EstimatorOptions::init, &InitOptions::motion_use_baro>, "baro heights (setup reference pressure given) constrain the in-motion alignment's height"},
-    {"init.resume_max_age_s", field<&EstimatorOptions::init, &InitOptions::resume_max_age_s>, "a restart resumes from a checkpoint at most this old [s]"},
-    {"init.resume_max_outage_s", field<&EstimatorOptions::init, &InitOptions::resume_max_outage_s>, "longer restart outages re-initialize the pose (anchors kept) [s]"},
     {"init.resume_max_acc_m_s2", field<&EstimatorOptions::init, &InitOptions::resume_max_acc_m_s2>, "largest acceleration during a restart's outage [m/s^2]"},
     {"init.resume_max_rate_deg_s", field<&EstimatorOptions::init, &InitOptions::resume_max_rate_deg_s>, "largest rotation rate during a restart's outage [deg/s]"},
-    {"baro.enabled", field<&EstimatorOptions::baro, &BaroOptions::enabled>, ""},
-    {"baro.pressure_sigma_pa", field<&EstimatorOptions::baro, &BaroOptions::pressure_sigma_pa>, "[Pa]"},
-    {"baro.bias_rw_m_per_sqrt_s", field<&EstimatorOptions::baro, &BaroOptions::bias_rw_m_per_sqrt_s>, "height bias random walk [m/sqrt(s)]"},
-    {"baro.init_bias_sigma_m", field<&EstimatorOptions::baro, &BaroOptions::init_bias_sigma_m>, "bias sigma with a given reference pressure [m]"},
     {"baro.gate_probability", field<&EstimatorOptions::baro, &BaroOptions::gate_probability>, "chi^2 gate, 0 = off [-]"},
-    {"height.enabled", field<&EstimatorOptions::height, &HeightOptions::enabled>, "downward rangefinder (height.csv)"},
-    {"height.sigma_m", field<&EstimatorOptions::height, &HeightOptions::sigma_m>, "range noise sigma [m]"},
-    {"height.bias_rw_m_per_sqrt_s", field<&EstimatorOptions::height, &HeightOptions::bias_rw_m_per_sqrt_s>, "bias random walk [m/sqrt(s)]"},
-    {"height.init_bias_sigma_m", field<&EstimatorOptions::height, &HeightOptions::init_bias_sigma_m>, "prior sigma of the bias around 0 [m]"},
     {"height.gate_probability", field<&EstimatorOptions::height, &HeightOptions::gate_probability>, "chi^2 gate, 0 = off [-]"},
-    {"height.min_range_m", field<&EstimatorOptions::height, &HeightOptions::min_range_m>, "shorter readings are not used (clamped at the sensor's minimum) [m]"},
     {"height.tilt_correction", field<&EstimatorOptions::height, &HeightOptions::tilt_correction>, "h = p_z / cos(tilt) (false: h = p_z)"},
     {"height.max_tilt_deg", field<&EstimatorOptions::height, &HeightOptions::max_tilt_deg>, "not used while tilted more [deg]"},
     {"height.align_rate_hz", field<&EstimatorOptions::height, &HeightOptions::align_rate_hz>, "rate fed to the in-motion alignment, 0 = not used there [Hz]"},
-    {"carried_height.enabled", field<&EstimatorOptions::carried_height, &CarriedHeightOptions::enabled>, "used when setup.yaml has carried_height (hand-held rig)"},
     {"carried_height.rate_hz", field<&EstimatorOptions::carried_height, &CarriedHeightOptions::rate_hz>, "pseudo-readings per second of IMU time [Hz]"},
-    {"carried_height.sigma_m", field<&EstimatorOptions::carried_height, &CarriedHeightOptions::sigma_m>, "sigma of one reading (gait bob and sway) [m]"},
-    {"carried_height.bias_rw_m_per_sqrt_s", field<&EstimatorOptions::carried_height, &CarriedHeightOptions::bias_rw_m_per_sqrt_s>, "random walk of the carrying height [m/sqrt(s)]"},
-    {"uwb.enabled", field<&EstimatorOptions::uwb, &UwbOptions::enabled>, ""},
-    {"uwb.sigma_range_m", field<&EstimatorOptions::uwb, &UwbOptions::sigma_range_m>, "fallback range sigma [m]"},
-    {"uwb.gate_probability", field<&EstimatorOptions::uwb, &UwbOptions::gate_probability>, "chi^2 gate, 0 = off [-]"},
-    {"uwb.huber_k", field<&EstimatorOptions::uwb, &UwbOptions::huber_k>, "Huber threshold of the range update in innovation sigmas, 0 = off [-]"},
     {"uwb.huber_max_prior_ratio", field<&EstimatorOptions::uwb, &UwbOptions::huber_max_prior_ratio>, "Huber weighting only while H P H^T / R of the range is at most this [-]"},
-    {"uwb.use_corrected_range", field<&EstimatorOptions::uwb, &UwbOptions::use_corrected_range>, "fuse range_corr instead of range_raw (one more than 1 m from it is bad input)"},
-    {"uwb.max_range_m", field<&EstimatorOptions::uwb, &UwbOptions::max_range_m>, "longer ranges are bad input [m]"},
-    {"uwb.estimate_tag_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_tag_biases>, "estimate tag-anchor gamma (setup anchors, sigma_gamma > 0) as states"},
-    {"uwb.estimate_anchor_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_anchor_biases>, "estimate a calibrated anchor's gamma (ANCHOR_INIT, sigma_gamma > 0) as states of its instance"},
     {"uwb.anchor_bias_joint_covariance", field<&EstimatorOptions::uwb, &UwbOptions::anchor_bias_joint_covariance>, "initialize them with the calibration's joint covariance of position and gamma"},
-    {"uwb.estimate_setup_anchor_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_setup_anchor_biases>, "the same for known-but-uncertain setup anchors (towards exact and smaller-id uncertain anchors)"},
-    {"uwb.fuse_calibrated_anchor_pairs", field<&EstimatorOptions::uwb, &UwbOptions::fuse_calibrated_anchor_pairs>, "fuse ranges between two calibrated anchors (their correlated calibration errors are not known)"},
-    {"uwb.dah_fuse_estimated_anchor_pairs", field<&EstimatorOptions::uwb, &UwbOptions::dah_fuse_estimated_anchor_pairs>, "dah only: fuse ranges between two estimated anchors (overconfident, see docs)"},
-    {"uwb.dah_joint_anchors", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_anchors>, "dah only: anchors updated jointly: none | batch (added together, e.g. by a re-run) | all"},
     {"uwb.dah_joint_tag_biases", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_tag_biases>, "dah only: the tags' gamma instances join the anchors' joint set (merges the batches into one)"},
     {"uwb.dah_joint_imu", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_imu>, "dah only: the IMU (with the baro and height biases) joins that set too (every pose update also corrects its anchors)"},
     {"uwb.dah_joint_max_anchors", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_max_anchors>, "dah only: most estimated anchors in a joint set, the most refined leave first, 0 = no bound [-]"},
-    {"uwb.reentry_gap_s", field<&EstimatorOptions::uwb, &UwbOptions::reentry_gap_s>, "no tag range accepted for this long: hold and cross-check the next ones, 0 = off [s]"},
     {"uwb.reentry_hold_s", field<&EstimatorOptions::uwb, &UwbOptions::reentry_hold_s>, "longest hold after a gap, at most window_s [s]"},
     {"uwb.reentry_min_ranges", field<&EstimatorOptions::uwb, &UwbOptions::reentry_min_ranges>, "held ranges needed to test them against each other [-]"},
     {"uwb.reentry_min_anchors", field<&EstimatorOptions::uwb, &UwbOptions::reentry_min_anchors>, "distinct anchors among them [-]"},
     {"uwb.reentry_gate_probability", field<&EstimatorOptions::uwb, &UwbOptions::reentry_gate_probability>, "leave-one-out chi^2 gate of a held range [-]"},
-    {"zupt.enabled", field<&EstimatorOptions::zupt, &ZuptOptions::enabled>, ""},
     {"zupt.rate_hz", field<&EstimatorOptions::zupt, &ZuptOptions::rate_hz>, "pseudo-measurement rate while landed [Hz]"},
     {"zupt.sigma_acc_m_s2", field<&EstimatorOptions::zupt, &ZuptOptions::sigma_acc_m_s2>, "sigma of a = 0 [m/s^2]"},
     {"zupt.sigma_gyro_rad_s", field<&EstimatorOptions::zupt, &ZuptOptions::sigma_gyro_rad_s>, "rest rotation allowed while landed; the omega row fuses the mean gyro since the last ZUPT with sigma^2 = this^2 + gyro_noise_density^2/T [rad/s]"},
-    {"zupt.sigma_vel_m_s", field<&EstimatorOptions::zupt, &ZuptOptions::sigma_vel_m_s>, "sigma of v = 0 [m/s]"},
-    {"zupt.detect_stillness", field<&EstimatorOptions::zupt, &ZuptOptions::detect_stillness>, "without FLIGHT_STATE: ZUPT while the IMU shows rest"},
     {"zupt.stillness_gate_probability", field<&EstimatorOptions::zupt, &ZuptOptions::stillness_gate_probability>, "chi^2 gate of those ZUPTs [-]"},
-    {"zupt.stillness_sigma_vel_m_s", field<&EstimatorOptions::zupt, &ZuptOptions::stillness_sigma_vel_m_s>, "sigma of v = 0 when only IMU stillness says rest (a smooth hover drifts) [m/s]"},
     {"zupt.stillness_sigma_gyro_rad_s", field<&EstimatorOptions::zupt, &ZuptOptions::stillness_sigma_gyro_rad_s>, "sigma of omega = 0 and of the initial gyro bias on stillness alone [rad/s]"},
-    {"health.window_s", field<&EstimatorOptions::health, &HealthOptions::window_s>, "innovation statistics window [s]"},
     {"health.min_ranges", field<&EstimatorOptions::health, &HealthOptions::min_ranges>, "ranges in the window before gating can mean lost [-]"},
     {"health.min_anchors", field<&EstimatorOptions::health, &HealthOptions::min_anchors>, "anchors gated alike before it means lost [-]"},
     {"health.degraded_gated_fraction", field<&EstimatorOptions::health, &HealthOptions::degraded_gated_fraction>, "[-]"},
@@ -128,7 +142,6 @@ const Field kFields[] = {
     {"health.lost_no_aiding_s", field<&EstimatorOptions::health, &HealthOptions::lost_no_aiding_s>, "no accepted range for this long: lost [s]"},
     {"health.lost_sigma_p_m", field<&EstimatorOptions::health, &HealthOptions::lost_sigma_p_m>, "largest position sigma beyond which the pose is lost [m]"},
     {"health.hold_s", field<&EstimatorOptions::health, &HealthOptions::hold_s>, "a better health must hold this long [s]"},
-    {"process_noise.adapt", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::enabled>, "scale the IMU noise densities to the range innovations"},
     {"process_noise.batch", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::batch>, "tag-anchor ranges per decision [-]"},
     {"process_noise.upper_ratio", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::upper_ratio>, "median NIS ratio above which the scale grows [-]"},
     {"process_noise.lower_ratio", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::lower_ratio>, "median NIS ratio below which the scale shrinks [-]"},
@@ -139,23 +152,17 @@ const Field kFields[] = {
     {"process_noise.confirm_batches", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::confirm_batches>, "consecutive batches above upper_ratio before the scale grows (by the smallest of their ratios) [-]"},
     {"process_noise.grow_at_once_ratio", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::grow_at_once_ratio>, "a batch whose median NIS ratio exceeds this grows the scale without confirmation [-]"},
     {"process_noise.min_accepted_fraction", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::min_accepted_fraction>, "median over the accepted ranges while this share of the batch was accepted, else over all [-]"},
-    {"recovery.enabled", field<&EstimatorOptions::recovery, &RecoveryOptions::enabled>, "re-initialize from ranges and IMU when lost"},
     {"recovery.retry_s", field<&EstimatorOptions::recovery, &RecoveryOptions::retry_s>, "between two attempts while lost or degraded [s]"},
     {"recovery.degraded_disagreement_chi2", field<&EstimatorOptions::recovery, &RecoveryOptions::degraded_disagreement_chi2>, "degraded: re-initialize when the aligned pose disagrees beyond this chi^2 (4 dof), 0 = off [-]"},
     {"recovery.after_gap_check_min_s", field<&EstimatorOptions::recovery, &RecoveryOptions::after_gap_check_min_s>, "after an IMU gap this long, compare the aligned pose with the filter as while degraded, for init.motion_window_s, 0 = off [s]"},
-    {"flight_volume.enabled", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::enabled>, "use setup flight_volume: against the mirror image of coplanar known anchors on its walls or ceiling, and to drop initial fits outside it"},
     {"flight_volume.mirror_margin_m", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::mirror_margin_m>, "an estimate this far outside whose mirror image is inside is reflected [m]"},
     {"flight_volume.side_constraint_rate_hz", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::side_constraint_rate_hz>, "truncate the position to the volume's side of the anchors' plane at most this often, 0 = off [Hz]"},
     {"flight_volume.candidate_margin_m", field<&EstimatorOptions::flight_volume, &FlightVolumeOptions::candidate_margin_m>, "initialization: a fit ending farther outside is no candidate [m]"},
-    {"time.max_offset_s", field<&EstimatorOptions::time, &TimeGuardOptions::max_offset_s>, "an input stamped farther than this from the current (newest) time is refused and counted [s]"},
     {"time.rebase_after", field<&EstimatorOptions::time, &TimeGuardOptions::rebase_after>, "this many consecutive refused inputs agreeing among themselves move the clock (a real jump) [-]"},
-    {"refine.rerun_on_anchor_join", field<&EstimatorOptions::refine, &RefineOptions::rerun_on_anchor_join>, "on ANCHOR_INIT re-run from the oldest stored input with the calibrated anchors uncertain from there"},
-    {"refine.max_history_s", field<&EstimatorOptions::refine, &RefineOptions::max_history_s>, "inputs kept for re-runs (about 260 B each, S2: 360 inputs/s); older ones are dropped in eighths, counted [s]"},
     {"refine.rerun_prior_sigma_m", field<&EstimatorOptions::refine, &RefineOptions::rerun_prior_sigma_m>, "position sigma per axis of a calibrated anchor in a re-run, around its calibration [m]"},
     {"refine.rerun_gamma_sigma_m", field<&EstimatorOptions::refine, &RefineOptions::rerun_gamma_sigma_m>, "sigma of its gamma in a re-run [m]"},
     {"refine.rerun_gamma_from_calibration", field<&EstimatorOptions::refine, &RefineOptions::rerun_gamma_from_calibration>, "gamma means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false)"},
     {"refine.rerun_with_dah", field<&EstimatorOptions::refine, &RefineOptions::rerun_with_dah>, "strategy dah too (with its joint sets, uwb.dah_joint_anchors; see docs)"},
-    {"refine.rerun_mode", field<&EstimatorOptions::refine, &RefineOptions::rerun_mode>, "auto | sync | async: re-run inline, or on a worker while the node keeps publishing; auto = async in the LCM process"},
 };
 
 /// Visits every option as (dotted key, field, unit/comment).
@@ -190,7 +197,37 @@ EstimatorOptions EstimatorOptions::fromYaml(const std::string& path) {
   // The one rule of common/yaml_options.h: unknown keys and bad values are errors naming the file
   // and the key; a missing key keeps its default (the defaults are the shipped file).
   YamlOptions yaml(YamlOptions::loadFile(path), path);
-  return readOptionsList<EstimatorOptions>(yaml, [](auto& o, auto&& v) { forEachField(o, v); });
+  for (const Field& f : kModelParameters) {
+    if (yaml.has(f.key)) {
+      yaml.fail(f.key, "is a model parameter since 2026-12-05, fixed in code with its reason, not an option any "
+                       "more (docs/configuration.md, \"Model parameters\"); remove it from the file");
+    }
+  }
+  // The profile first: its groups are the defaults the rest of the file overrides.
+  std::string profile = EstimatorOptions{}.profile;
+  yaml.read("profile", profile);
+  if (!profileListed(profile)) yaml.fail("profile", "must be auto, drone or handheld, got '" + profile + "'");
+  return readOptionsList<EstimatorOptions>(yaml, [](auto& o, auto&& v) { forEachField(o, v); },
+                                           forProfile(profile));
+}
+
+bool EstimatorOptions::profileListed(const std::string& name) {
+  return name == "auto" || name == "drone" || name == "handheld";
+}
+
+EstimatorOptions EstimatorOptions::forProfile(const std::string& name) {
+  EstimatorOptions o;
+  o.profile = name;
+  if (name == "drone") {
+    // Nobody carries a drone: the carried-height pseudo-readings are off even when a setup file
+    // written for a hand-held rig has `carried_height`.
+    o.carried_height.enabled = false;
+  } else if (name == "handheld") {
+    // A rig carried by a walker: a downward rangefinder on it reads the walker's gait, not a height
+    // above a floor the height model can use (its bias instance would chase the bob), so it is off.
+    o.height.enabled = false;
+  }
+  return o;
 }
 
 void EstimatorOptions::validate() const {
@@ -198,6 +235,7 @@ void EstimatorOptions::validate() const {
     if (!ok) throw std::invalid_argument("invalid option: " + what);
   };
   need(strategyListed(strategy), "strategy must be one of " + strategyNames(", "));
+  need(profileListed(profile), "profile must be auto, drone or handheld");
   need(gravity_m_s2 > 0.0, "gravity_m_s2 > 0");
   need(uwb.dah_joint_anchors == "none" || uwb.dah_joint_anchors == "batch" || uwb.dah_joint_anchors == "all",
        "uwb.dah_joint_anchors must be none, batch or all");
@@ -280,10 +318,13 @@ void EstimatorOptions::applySetupNoise(const NoiseFigures& n) {
   if (n.baro_pressure_sigma_pa) baro.pressure_sigma_pa = *n.baro_pressure_sigma_pa;
 }
 
-std::string EstimatorOptions::toString() const {
+namespace {
+/// "section:\n  key: value  # comment" lines of every field of `table`.
+template <size_t N>
+std::string yamlListing(const EstimatorOptions& o, const Field (&table)[N]) {
   std::ostringstream os;
   std::vector<std::string> open;  // currently open YAML sections
-  forEachField(*this, [&](const std::string& key, const auto& field, const char* unit) {
+  forEachOption(o, table, [&](const std::string& key, const auto& field, const char* unit) {
     auto parts = splitKey(key);
     const std::string section = parts.size() > 1 ? parts[0] : "";
     if (parts.size() > 1 && (open.empty() || open.back() != section)) {
@@ -298,5 +339,10 @@ std::string EstimatorOptions::toString() const {
   });
   return os.str();
 }
+}  // namespace
+
+std::string EstimatorOptions::toString() const { return yamlListing(*this, kFields); }
+
+std::string EstimatorOptions::modelParametersString() const { return yamlListing(*this, kModelParameters); }
 
 }  // namespace meshnav::estimator

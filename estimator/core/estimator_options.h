@@ -282,6 +282,10 @@ struct RefineOptions {
 };
 
 struct EstimatorOptions {
+  /// Which platform models are on (forProfile): `auto` (every model, each used when its input or
+  /// setup entry is there), `drone` (no carried height), `handheld` (no downward rangefinder, no
+  /// landed assumption without FLIGHT_STATE). The other keys of a file override the profile.
+  std::string profile = "auto";
   std::string strategy = "centralized";  ///< a name of kStrategyList (estimator/core/strategy_list.h)
   double gravity_m_s2 = 9.81;            ///< |g|, gravity is −g along z of G [m/s²]
   double window_s = 1.0;                 ///< out-of-sequence window [s]
@@ -307,14 +311,21 @@ struct EstimatorOptions {
 
   /// Loads `path` (missing keys: defaults); throws std::runtime_error naming the file and the key
   /// for an unknown key, a value of the wrong type, a non-finite number or an out-of-range value.
+  /// A key of the model parameters (fixed in code, docs/configuration.md) is refused naming the file
+  /// and the key; `profile` is read first and gives the defaults (forProfile) the other keys override.
   static EstimatorOptions fromYaml(const std::string& path);
+  /// The defaults of a profile (`auto`, `drone`, `handheld`); `profileListed` says which exist.
+  static EstimatorOptions forProfile(const std::string& name);
+  static bool profileListed(const std::string& name);
   /// Throws std::invalid_argument naming the first out-of-range value.
   void validate() const;
   /// Setup noise figures override the IMU and baro defaults (setup.yaml `noise:`). The range σ is
   /// resolved per range by `UwbNetwork` (pair σ, then setup σ, then the range's R, then this file).
   void applySetupNoise(const NoiseFigures& noise);
-  /// Multi-line "key: value  # unit" listing.
+  /// Multi-line "key: value  # unit" listing of the options (the shipped file's form).
   std::string toString() const;
+  /// The same listing of the model parameters (not loadable; docs/configuration.md).
+  std::string modelParametersString() const;
 };
 
 /// χ² quantile (common/chi_square.h, Boost.Math).

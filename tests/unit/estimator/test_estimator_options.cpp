@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <sstream>
 
 #include "estimator/core/estimator_options.h"
 #include "tests/support/test_util.h"
@@ -86,18 +87,79 @@ TEST(EstimatorOptions, UnknownKeysAndBadValuesNameFileAndKey) {
   e = loadError("opts_rerun_mode.yaml", "refine:\n  rerun_mode: threaded\n");
   EXPECT_NE(e.find("refine.rerun_mode must be auto, sync or async"), std::string::npos) << e;
   EXPECT_EQ(loadError("opts_rerun_async.yaml", "refine:\n  rerun_mode: async\n"), "");
-  e = loadError("opts_pn_fraction.yaml", "process_noise:\n  min_accepted_fraction: 0\n");
-  EXPECT_NE(e.find("min_accepted_fraction in (0, 1]"), std::string::npos) << e;
-  e = loadError("opts_pn_confirm.yaml", "process_noise:\n  confirm_batches: 0\n");
-  EXPECT_NE(e.find("confirm_batches >= 1"), std::string::npos) << e;
-  e = loadError("opts_pn_at_once.yaml", "process_noise:\n  grow_at_once_ratio: 2.0\n");  // below upper_ratio
-  EXPECT_NE(e.find("grow_at_once_ratio >= upper_ratio"), std::string::npos) << e;
   e = loadError("opts_huber.yaml", "uwb:\n  huber_k: -1\n");
   EXPECT_NE(e.find("uwb.huber_k >= 0"), std::string::npos) << e;
-  EXPECT_EQ(loadError("opts_huber_on.yaml", "uwb:\n  huber_k: 2\n  huber_max_prior_ratio: 0.5\n"), "");
-  EXPECT_EQ(loadError("opts_pn_no_ratchet.yaml", "process_noise:\n  min_accepted_fraction: 0.5\n  confirm_batches: 2\n"), "");
-  e = loadError("opts_joint_max.yaml", "uwb:\n  dah_joint_max_anchors: -1\n");
-  EXPECT_NE(e.find("uwb.dah_joint_max_anchors >= 0"), std::string::npos) << e;
+  EXPECT_EQ(loadError("opts_huber_on.yaml", "uwb:\n  huber_k: 2\n"), "");
+  e = loadError("opts_profile.yaml", "profile: quadruped\n");
+  EXPECT_NE(e.find("key 'profile' must be auto, drone or handheld, got 'quadruped'"), std::string::npos) << e;
+}
+
+// Issue 33: the models' fixed parameters are not options. A file written before (or by hand) that
+// still sets one fails naming the file and the key, instead of being silently ignored.
+TEST(EstimatorOptions, AModelParameterInAFileIsRefusedNamingFileAndKey) {
+  const std::string path = (tempRoot() / "opts_model_param.yaml").string();
+  std::string e = loadError("opts_model_param.yaml", "process_noise:\n  max_grow: 5.0\n");
+  EXPECT_NE(e.find(path), std::string::npos) << e;
+  EXPECT_NE(e.find("key 'process_noise.max_grow' is a model parameter"), std::string::npos) << e;
+  e = loadError("opts_model_param2.yaml", "joseph_form: false\n");
+  EXPECT_NE(e.find("key 'joseph_form' is a model parameter"), std::string::npos) << e;
+  // Every model parameter is listed by --print-model-parameters, none by --print-config.
+  const std::string options = EstimatorOptions{}.toString(), params = EstimatorOptions{}.modelParametersString();
+  EXPECT_NE(params.find("  max_grow: 10.0"), std::string::npos) << params;
+  EXPECT_EQ(options.find("max_grow"), std::string::npos);
+  EXPECT_EQ(params.find("sigma_range_m"), std::string::npos);
+}
+
+TEST(EstimatorOptions, AtMostSixtyOptions) {
+  // Issue 33, target: a user has at most 60 estimator options to know (one per line with a value).
+  std::istringstream text(EstimatorOptions{}.toString());
+  int options = 0;
+  for (std::string line; std::getline(text, line);) options += line.find(": ") != std::string::npos;  // not "uwb:"
+  EXPECT_GT(options, 40);
+  EXPECT_LE(options, 60);
+}
+
+// The model parameters keep their ranges, checked by validate() for the C++ API (tests, tools).
+TEST(EstimatorOptions, ModelParametersAreValidated) {
+  auto invalid = [](auto&& change) {
+    EstimatorOptions o;
+    change(o);
+    try {
+      o.validate();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(invalid([](EstimatorOptions& o) { o.process_noise.min_accepted_fraction = 0; })
+                .find("min_accepted_fraction in (0, 1]"),
+            std::string::npos);
+  EXPECT_NE(invalid([](EstimatorOptions& o) { o.process_noise.confirm_batches = 0; }).find("confirm_batches >= 1"),
+            std::string::npos);
+  EXPECT_NE(invalid([](EstimatorOptions& o) { o.process_noise.grow_at_once_ratio = 2.0; })
+                .find("grow_at_once_ratio >= upper_ratio"),
+            std::string::npos);
+  EXPECT_NE(invalid([](EstimatorOptions& o) { o.uwb.dah_joint_max_anchors = -1; }).find("uwb.dah_joint_max_anchors >= 0"),
+            std::string::npos);
+  EXPECT_EQ(invalid([](EstimatorOptions& o) { o.uwb.huber_max_prior_ratio = 0.5; }), "");
+}
+
+// The profile gives the defaults of its platform's models; the file's other keys override them.
+TEST(EstimatorOptions, ProfileSetsThePlatformModelsAndKeysOverrideIt) {
+  EXPECT_EQ(EstimatorOptions::fromYaml(tempFile("p_auto.yaml", "profile: auto\n")).toString(),
+            EstimatorOptions{}.toString());
+  const auto drone = EstimatorOptions::fromYaml(tempFile("p_drone.yaml", "profile: drone\n"));
+  EXPECT_FALSE(drone.carried_height.enabled);
+  EXPECT_TRUE(drone.height.enabled);
+  const auto hand = EstimatorOptions::fromYaml(tempFile("p_hand.yaml", "profile: handheld\n"));
+  EXPECT_FALSE(hand.height.enabled);
+  EXPECT_TRUE(hand.carried_height.enabled);
+  const auto over = EstimatorOptions::fromYaml(tempFile("p_over.yaml", "profile: handheld\nheight:\n  enabled: true\n"));
+  EXPECT_TRUE(over.height.enabled);
+  // What is printed loads back as the same options, profile included.
+  const auto back = EstimatorOptions::fromYaml(tempFile("p_back.yaml", hand.toString()));
+  EXPECT_EQ(back.toString(), hand.toString());
+  EXPECT_EQ(back.profile, "handheld");
 }
 
 TEST(EstimatorOptions, InvalidValuesAndFilesAreRejected) {
