@@ -4,7 +4,7 @@
 /// anchor initialization) are in estimator_node_updates.cpp; initialization, health and recovery
 /// in estimator_node_robustness.cpp.
 
-#include "estimator/node/estimator_node_rerun.h"
+#include "estimator/node/estimator_node.h"
 #include "common/plausibility.h"
 
 #include <spdlog/spdlog.h>
@@ -33,21 +33,6 @@ std::vector<EstimatorInput> mergeInTimeOrder(const Dataset& ds) {
   std::stable_sort(all.begin(), all.end(),
                    [](const EstimatorInput& a, const EstimatorInput& b) { return inputOrder(a) < inputOrder(b); });
   return all;
-}
-
-EstimatorNode::Snapshot EstimatorNode::Snapshot::copy() const {
-  Snapshot s;
-  s.filter = filter ? filter->clone() : nullptr;
-  s.network = network;
-  s.last_imu = last_imu;
-  s.prev_imu = prev_imu;
-  s.landed = landed;
-  s.last_zupt = last_zupt;
-  s.rest_rate = rest_rate;
-  s.last_carried_height = last_carried_height;
-  s.noise_adapter = noise_adapter;
-  s.mean_reading = mean_reading;
-  return s;
 }
 
 using node_internal::weakestPositionAxis;
@@ -86,19 +71,21 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       gravity_(options_.init.motion_window_s, options_.init.gravity_early_check_nis_ratio, diag_),
       volume_(options_.flight_volume, setup_, diag_),
       outputs_(options_.pose_output_rate_hz, options_.anchors_output_rate_hz, options_.status_rate_hz),
-      baro_(options_.baro, setup.baro_id, setup.baro_p_IP),
-      height_(options_.height, setup.height_id, heightLever(options_, setup), carriedHeightUsed(options_, setup)),
-      range_(options_.uwb, options_.strategy == "dah"),
-      anchor_join_(options_.uwb, options_.strategy == "dah", setup_, diag_),
-      propagation_(options_.imu),
-      zupt_model_(Eigen::Vector3d(0.0, 0.0, -options.gravity_m_s2)),
+      sensors_{BaroUpdater(options_.baro, setup.baro_id, setup.baro_p_IP),
+               HeightUpdater(options_.height, setup.height_id, heightLever(options_, setup),
+                             carriedHeightUsed(options_, setup)),
+               RangeUpdater(options_.uwb, options_.strategy == "dah"),
+               AnchorJoin(options_.uwb, options_.strategy == "dah", setup_, diag_), ImuPropagation(options_.imu),
+               ZuptModel(Eigen::Vector3d(0.0, 0.0, -options.gravity_m_s2))},
       health_(options_.health),
       recovery_(options_.recovery, options_.init.motion_window_s),
       reentry_(options_.uwb, diag_),
-      resume_(options_, setup_, diag_) {
+      resume_(options_, setup_, diag_),
+      timeline_(options_.window_s, options_.refine,
+                options_.refine.rerun_on_anchor_join && (options_.strategy != "dah" || options_.refine.rerun_with_dah),
+                diag_),
+      rerun_(options_, diag_, timings_) {
   options_.validate();
-  rerun_enabled_ = options_.refine.rerun_on_anchor_join && (options_.strategy != "dah" || options_.refine.rerun_with_dah);
-  rerun_async_ = options_.refine.rerun_mode == "async";
   resetAll();
 }
 
@@ -115,18 +102,17 @@ void EstimatorNode::resetAll() {
   volume_.reset();
   gravity_.reset();
   recovery_.reset();
-  zupt_model_ = ZuptModel(gravityG());
-  cur_ = Snapshot{};
+  sensors_.zupt = ZuptModel(gravityG());
+  cur_ = FilterContext{};
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);
   cur_.network = std::make_shared<const UwbNetwork>(setup_, options_.uwb.sigma_range_m);
-  history_.clear();
-  clearRerunHistory();
-  rerun_anchors_.clear();
-  rerun_pending_ = false;
+  rerun_.abandon();  // its base is gone
+  timeline_.clear();
+  rerun_.reset();
   reentry_.reset();
-  height_.setBiasPrior(std::nullopt);
+  sensors_.height.setBiasPrior(std::nullopt);
   gate_.forgetKeys();
-  baro_.setReference(std::nullopt);
+  sensors_.baro.setReference(std::nullopt);
   instance_stats_.clear();
   outputs_.resetPose();
 }
@@ -147,11 +133,12 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     case InputGate::Verdict::kClockBack: startOverAfterClockBack(); break;
     case InputGate::Verdict::kAdmitted: break;
   }
-  if (!gate_.admitOnce(in_raw, newest_)) return;
+  if (!gate_.admitOnce(in_raw, timeline_.newest())) return;
   // Commands are not measurements: they apply now (at the newest time) unless they are newer.
-  if (newest_ && (std::holds_alternative<AnchorInit>(in) || std::holds_alternative<EstimatorCommand>(in))) {
-    if (auto* a = std::get_if<AnchorInit>(&in)) a->t = std::max(a->t, *newest_);
-    if (auto* c = std::get_if<EstimatorCommand>(&in)) c->t = std::max(c->t, *newest_);
+  const std::optional<Timestamp>& newest = timeline_.newest();
+  if (newest && (std::holds_alternative<AnchorInit>(in) || std::holds_alternative<EstimatorCommand>(in))) {
+    if (auto* a = std::get_if<AnchorInit>(&in)) a->t = std::max(a->t, *newest);
+    if (auto* c = std::get_if<EstimatorCommand>(&in)) c->t = std::max(c->t, *newest);
   }
   if (const auto* c = std::get_if<EstimatorCommand>(&in); c && c->action == EstimatorCommand::Action::Reset) {
     spdlog::info("estimator: reset by command at t={}", formatSeconds(c->t));
@@ -161,14 +148,14 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   }
   const Timestamp t = inputTime(in);
   init_.feed(in, *cur_.network, cur_.filter.get());
-  if (std::holds_alternative<ImuSample>(in)) init_.pruneStillness(oldestReplayUs(t.us));
+  if (std::holds_alternative<ImuSample>(in)) init_.pruneStillness(timeline_.oldestReplayUs(t.us));
   if (!initialized()) {
     // Only measurements drive the clock: a command stamped far ahead before the first measurement
     // would otherwise leave every later measurement too old.
     if (!std::holds_alternative<AnchorInit>(in) && !std::holds_alternative<EstimatorCommand>(in))
-      newest_ = newest_ ? std::max(*newest_, t) : t;
+      timeline_.advance(t);
     if (const auto* s = std::get_if<ImuSample>(&in); s && resume_.offered()) {
-      if (auto b = resume_.at(*s, pending_anchor_inits_)) {
+      if (auto b = resume_.at(*s, sensors_.anchor_join.held())) {
         initialize(*b);
         publishPeriodic();
         return;
@@ -179,47 +166,47 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     return;
   }
   if (std::holds_alternative<ImuSample>(in)) runGravityDirection(t);
-  if (t < init_time_) {
+  if (t < timeline_.start()) {
     diag_.count("before_init");
     return;
   }
-  if (t < *newest_ - Duration::fromSec(options_.window_s)) {
-    diag_.report("rejected_too_old", where("input", t) + " is older than the newest " + formatSeconds(*newest_) +
+  if (timeline_.beforeWindow(t)) {
+    diag_.report("rejected_too_old", where("input", t) + " is older than the newest " + formatSeconds(*newest) +
                                          " minus the window " + std::to_string(options_.window_s) + " s");
     return;
   }
-  pollRerun(false);  // a worker re-run that is done comes in before this input
-  Entry e{inputOrder(in), in, nullptr};
-  auto pos = std::upper_bound(history_.begin(), history_.end(), e.key,
-                              [](const InputOrder& k, const Entry& x) { return k < x.key; });
-  if (pos == history_.end()) {
-    e.before = std::make_shared<const Snapshot>(cur_.copy());
-    history_.push_back(std::move(e));
-    process(history_.back().input, true);
+  rerun_.poll(false, timeline_, *this);  // a worker re-run that is done comes in before this input
+  InputTimeline::Entry e{inputOrder(in), in, nullptr};
+  auto& window = timeline_.window();
+  auto pos = timeline_.placeOf(e.key);
+  if (pos == window.end()) {
+    e.before = std::make_shared<const FilterContext>(cur_.copy());
+    window.push_back(std::move(e));
+    process(window.back().input, true);
   } else {
     // Out of sequence: rewind to the snapshot before its place, re-process in order.
     diag_.count("out_of_sequence");
-    if (rerun_) rerun_->noteInserted(e.key);
+    rerun_.noteInserted(e.key);
     ScopedStepTimer rewind_timer(timings_, "rewind");
     cur_ = pos->before->copy();
     e.before = pos->before;
-    auto it = history_.insert(pos, std::move(e));
+    auto it = window.insert(pos, std::move(e));
     process(it->input, true);
     replayAfter(it);
   }
-  newest_ = std::max(*newest_, t);
+  timeline_.advance(t);
   releaseReentryIfDue();
   // Anchors calibrated together arrive as consecutive ANCHOR_INITs: one re-run for all of them.
-  if (rerun_pending_ && !rerun_ && !std::holds_alternative<AnchorInit>(in)) startRerun();
-  retireHistory(*newest_ - Duration::fromSec(options_.window_s));
-  init_.pruneStillness(oldestReplayUs(newest_->us));
-  updateHealth(*newest_);
+  if (rerun_.pending() && !rerun_.running() && !std::holds_alternative<AnchorInit>(in)) startRerun();
+  timeline_.retire(*newest - Duration::fromSec(options_.window_s));
+  init_.pruneStillness(timeline_.oldestReplayUs(newest->us));
+  updateHealth(*newest);
   publishPeriodic();
 }
 
-void EstimatorNode::replayAfter(std::deque<Entry>::iterator it) {
-  for (++it; it != history_.end(); ++it) {
-    it->before = std::make_shared<const Snapshot>(cur_.copy());
+void EstimatorNode::replayAfter(InputTimeline::Window::iterator it) {
+  for (++it; it != timeline_.window().end(); ++it) {
+    it->before = std::make_shared<const FilterContext>(cur_.copy());
     process(it->input, false);
   }
 }
@@ -239,8 +226,8 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
         }
         if constexpr (std::is_same_v<T, FlightStateSample>) cur_.landed = m.landed;
         if constexpr (std::is_same_v<T, AnchorInit>) {
-          if (!skipReplayedAnchorInit(m, first)) applyAnchorInit(m, first);
-          noteAnchorJoin(m, first);
+          if (!rerun_.skipReplayed(m, first, *cur_.filter)) applyAnchorInit(m, first);
+          rerun_.noteJoin(m, first, *cur_.filter);
         }
         if constexpr (std::is_same_v<T, EstimatorCommand>) applyCommand(m, first);
       },
@@ -250,7 +237,7 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
 void EstimatorNode::propagateTo(Timestamp t) {
   if (!cur_.last_imu || t <= cur_.filter->state().t) return;
   ScopedStepTimer timer(timings_, "propagate");
-  propagation_.toTime(*cur_.filter, t, propagationInputs());
+  sensors_.imu.toTime(*cur_.filter, t, propagationInputs());
 }
 
 ImuPropagation::Inputs EstimatorNode::propagationInputs() const {
@@ -269,12 +256,12 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
   }
   if (s.t > t0) {
     ScopedStepTimer timer(timings_, "propagate");
-    propagation_.toSample(f, s, propagationInputs());
+    sensors_.imu.toSample(f, s, propagationInputs());
   }
   const std::optional<ImuSample> previous = cur_.last_imu;
   cur_.prev_imu = previous;
   cur_.last_imu = s;
-  propagation_.updateMean(cur_.mean_reading, cur_.filter->state().imu, s, previous, gravityG());
+  sensors_.imu.updateMean(cur_.mean_reading, cur_.filter->state().imu, s, previous, gravityG());
   if (!init_.haveFlightState()) cur_.landed = init_.landedAt(s.t, cur_.landed);
   if (cur_.landed && previous && s.t > previous->t)
     cur_.rest_rate.add(s.gyro_rad_s, (s.t - previous->t).sec(), options_.imu.max_dt_s);
@@ -301,7 +288,7 @@ void EstimatorNode::applyCommand(const EstimatorCommand& c, bool first) {
         break;
       }
       bool removed = cur_.filter->removeInstance(c.id);
-      if (first) std::erase_if(rerun_anchors_, [&](const AnchorInit& a) { return a.id == c.id; });
+      if (first) rerun_.forget(c.id);
       if (cur_.network->isTag(c.id) || cur_.network->exactAnchor(c.id) || cur_.network->isCalibrated(c.id)) {
         auto net = std::make_shared<UwbNetwork>(*cur_.network);
         removed = net->removeDevice(c.id) || removed;
@@ -327,7 +314,7 @@ std::vector<AnchorEstimate> EstimatorNode::anchors() const {
 
 EstimatorStatus EstimatorNode::status() const {
   EstimatorStatus s;
-  s.t = newest_.value_or(Timestamp{});
+  s.t = timeline_.newest().value_or(Timestamp{});
   s.wall_utime = std::chrono::duration_cast<std::chrono::microseconds>(
                      std::chrono::system_clock::now().time_since_epoch())
                      .count();
@@ -365,8 +352,8 @@ EstimatorStatus EstimatorNode::status() const {
 }
 
 void EstimatorNode::publishPeriodic() {
-  if (!newest_) return;
-  const Timestamp now = *newest_;
+  if (!timeline_.newest()) return;
+  const Timestamp now = *timeline_.newest();
   if (initialized() && sinks_.anchors && outputs_.anchorsDue(now)) sinks_.anchors(anchors());
   if (sinks_.status && outputs_.statusDue(now)) sinks_.status(status());
 }

@@ -65,6 +65,7 @@
 #include "estimator/height/height_updater.h"
 #include "estimator/core/estimator_options.h"
 #include "estimator/filter/fusion_strategy.h"
+#include "estimator/refine/anchor_rerun.h"
 #include "estimator/restart/resume.h"
 #include "estimator/node/estimator_input.h"
 #include "estimator/health/health_monitor.h"
@@ -75,7 +76,9 @@
 #include "estimator/health/flight_volume_guard.h"
 #include "estimator/init/gravity_direction.h"
 #include "estimator/init/initialization.h"
+#include "estimator/node/filter_context.h"
 #include "estimator/node/input_gate.h"
+#include "estimator/node/input_timeline.h"
 #include "estimator/node/output_schedule.h"
 #include "estimator/zupt/rest_rate_mean.h"
 #include "estimator/node/step_timings.h"
@@ -93,12 +96,12 @@ struct EstimatorSinks {
   std::function<void(const EstimatorStatus&)> status;
 };
 
-class EstimatorNode {
+class EstimatorNode : private RerunReplayer {
  public:
   /// Throws std::invalid_argument for invalid options or a strategy not implemented yet. Reports
   /// what the setup leaves weak (reportSetupGeometry), once.
   EstimatorNode(const EstimatorOptions& options, const SystemSetup& setup, EstimatorSinks sinks = {});
-  ~EstimatorNode();
+  ~EstimatorNode() override;
   EstimatorNode(const EstimatorNode&) = delete;
   EstimatorNode& operator=(const EstimatorNode&) = delete;
 
@@ -123,7 +126,7 @@ class EstimatorNode {
   /// The filter (null before initialization).
   const FusionStrategy* filter() const { return cur_.filter.get(); }
   /// Inputs currently held for out-of-sequence handling.
-  size_t historySize() const { return history_.size(); }
+  size_t historySize() const { return timeline_.window().size(); }
   /// Variance scale of the IMU white noise (ProcessNoiseAdapter), 1 when the densities fit.
   double processNoiseScale() const { return cur_.noise_adapter.scale(); }
   Health health() const { return initialized() ? health_.health() : Health::Initializing; }
@@ -139,14 +142,14 @@ class EstimatorNode {
   /// initialized as usual: in flight by the MotionAligner). Older: counted "resume_refused".
   void resumeFrom(EstimatorCheckpoint c) { resume_.offer(std::move(c)); }
   /// A re-run computed on a worker (`refine.rerun_mode` async) has not been swapped in yet.
-  bool rerunRunning() const { return rerun_ != nullptr; }
+  bool rerunRunning() const { return rerun_.running(); }
   /// Waits for the running re-run, swaps it in and runs (and waits for) a re-run queued behind it:
   /// a deterministic point for tests and the end of a replay or of the process.
   void finishRerun();
   /// Shutdown without waiting: swaps a finished worker re-run in, abandons one still running.
   void stopRerun() {
-    pollRerun(false);
-    abandonRerun();
+    rerun_.poll(false, timeline_, *this);
+    rerun_.abandon();
   }
 
  private:
@@ -161,40 +164,6 @@ class EstimatorNode {
   /// the counter `known_anchors_nearly_collinear`, unless they lie in a wall of the flight volume
   /// (plane_mirror_ then tells the two sides apart).
   void reportSetupGeometry();
-  /// Everything a rewind restores.
-  struct Snapshot {
-    std::unique_ptr<FusionStrategy> filter;
-    std::shared_ptr<const UwbNetwork> network;
-    std::optional<ImuSample> last_imu;
-    std::optional<ImuSample> prev_imu;  ///< the sample before last_imu (propagateTo's slope)
-    bool landed = true;
-    Timestamp last_zupt;
-    RestRateMean rest_rate;  ///< gyro readings since last_zupt while landed (the ZUPT's ω row)
-    Timestamp last_carried_height;  ///< last carried-height pseudo-reading (IMU time)
-    ProcessNoiseAdapter noise_adapter;  ///< IMU noise scale from the range innovations
-    /// Low-passed (time constant imu.gap_mean_time_constant_s) acceleration and angular rate in
-    /// G (`acc_m_s2` = R̂(a_m − b̂_a) + g, `gyro_rad_s` = R̂(ω_m − b̂_ω)): what an IMU gap is
-    /// propagated on with imu.gap_readings "mean" (the rate's vertical part only).
-    std::optional<ImuReading> mean_reading;
-    Snapshot copy() const;
-  };
-  struct Entry {
-    InputOrder key;
-    EstimatorInput input;
-    std::shared_ptr<const Snapshot> before;
-  };
-  struct RerunJob;      ///< estimator_node_rerun_async.cpp
-  struct RerunResult;
-  struct RunningRerun;
-  /// An input older than the out-of-sequence window, kept for re-runs (RefineOptions); every
-  /// eighth of `refine.max_history_s` one keeps the state before it (a checkpoint), and the
-  /// oldest always does: the re-run's starting state.
-  struct Archived {
-    InputOrder key;
-    EstimatorInput input;
-    std::shared_ptr<const Snapshot> checkpoint;
-  };
-
   struct GravityAdapter;  ///< the node as GravityDirection's context (estimator_node_gravity.cpp)
   /// What GravityDirection has due at IMU time `t` (comparison, re-initialization with +z).
   void runGravityDirection(Timestamp t);
@@ -241,52 +210,25 @@ class EstimatorNode {
   /// Replaces the IMU instance (state, covariance, time); every other instance keeps its mean and
   /// marginal covariance (cross-covariances dropped). History before `t` is forgotten.
   void replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu);
-  /// Pops history entries older than `oldest_kept`; with re-runs on they move to archive_, which
-  /// is cut to `refine.max_history_s` at a checkpoint (counted "rerun_history_cut", logged).
-  void retireHistory(Timestamp oldest_kept);
-  /// True when an ANCHOR_INIT replayed by a re-run or rewind must be skipped: its anchor is
-  /// already in the state as a re-run's uncertain anchor.
-  bool skipReplayedAnchorInit(const AnchorInit& a, bool first) const;
-  /// A live ANCHOR_INIT: remembered for re-runs and a re-run scheduled after the next input that is
-  /// not an ANCHOR_INIT (anchors calibrated together share one re-run).
-  void noteAnchorJoin(const AnchorInit& a, bool first);
-  /// The second pass (RefineOptions): restores the oldest stored state, adds every calibrated
-  /// anchor it lacks with the loose prior, re-processes archive_ and history_ (refreshing their
-  /// snapshots) and continues live from there. Counted "rerun", logged with the wall time. Inline
-  /// (sync) or on a worker (async, swapped in by pollRerun).
+  /// Starts the pending re-run (AnchorRerun::start), a worker's replay node made by makeReplayNode.
   void startRerun();
-  /// Immutable copies of what a re-run needs (nullopt: nothing stored, counted "rerun_skipped").
-  std::optional<RerunJob> makeRerunJob() const;
-  /// Runs `job` on this node's cur_ (the live node inline, a replay node on the worker).
-  RerunResult computeRerun(RerunJob job, const std::atomic<bool>& cancel);
-  /// Takes a re-run's result: its snapshots for the stored inputs it processed, the state before
-  /// the first input it did not (`divergence`: the oldest input inserted among its inputs while it
-  /// ran), and re-processes from there.
-  /// Returns the number of inputs re-processed, nullopt when a snapshot is missing (nothing changed).
-  std::optional<int64_t> applyRerun(RerunResult& r, std::optional<InputOrder> divergence);
-  /// Starts `job` on a worker with a replay node of its own (refine.rerun_mode async); `t_job`:
-  /// when the node began taking its copies (logged at the swap).
-  void launchRerun(RerunJob job, std::chrono::steady_clock::time_point t_job);
-  /// The re-run's log line; `how` tells where it ran.
-  void logRerun(const RerunResult& r, const std::string& how) const;
-  /// Swaps a finished worker re-run in (`wait`: blocks until it is finished).
-  void pollRerun(bool wait);
-  /// Drops a running worker re-run (a re-initialization or the destructor), counted "rerun_abandoned".
-  void abandonRerun();
-  /// The replay node's copy of what processing reads besides cur_ (stillness, flight state, baro
-  /// reference, pending height bias, re-run anchors, gravity direction).
-  void copyReplayContext(const EstimatorNode& live);
-  /// The ANCHOR_INIT of a re-run: the calibration's means, position σ and γ σ of RefineOptions.
-  AnchorInit loosePrior(const AnchorInit& a, Timestamp t) const;
+  /// A replay node for a worker re-run: this node's options and setup, without the start-up report,
+  /// with what processing reads besides the context (stillness, baro reference, height bias prior,
+  /// joined anchors, gravity direction, IMU-gap window, ZUPT model, re-entry fates).
+  std::unique_ptr<RerunReplayer> makeReplayNode() const;
   /// The anchors held before initialization (or from a resumed checkpoint), applied at `t` with
   /// their own covariance (no re-run).
-  void applyPendingAnchorInits(Timestamp t);
-  /// Forgets the stored inputs of re-runs (a re-initialization: no re-run may restore the state before it).
-  void clearRerunHistory();
-  /// Oldest IMU time whose stillness a replay may need [µs].
-  int64_t oldestReplayUs(int64_t newest_us) const;
+  void applyHeldAnchors(Timestamp t);
   /// Re-processes the entries after `it` on cur_ (refreshing their snapshots), as replays do.
-  void replayAfter(std::deque<Entry>::iterator it);
+  void replayAfter(InputTimeline::Window::iterator it);
+  /// Every re-initialization of the pose (initialize, replaceImu): the timeline forgets what a
+  /// rewind or a re-run could restore from before `t`, a running re-run is dropped, the health
+  /// window restarts.
+  void onReinitialized(Timestamp t);
+  // RerunReplayer: the node re-processing stored inputs for AnchorRerun.
+  FilterContext& replayContext() override { return cur_; }
+  void replay(const EstimatorInput& in) override { process(in, false); }
+  void replayAnchor(const AnchorInit& a) override { applyAnchorInit(a, false); }
   /// Releases the ranges held after a gap once uwb.reentry_hold_s passed (ReentryGate decides),
   /// then the node rewinds to the first held range and re-processes from there.
   void releaseReentryIfDue();
@@ -304,33 +246,25 @@ class EstimatorNode {
   GravityDirection gravity_;
   FlightVolumeGuard volume_;
   OutputSchedule outputs_;
-  std::vector<AnchorInit> pending_anchor_inits_;
-  BaroUpdater baro_;
-  HeightUpdater height_;
-  RangeUpdater range_;
-  AnchorJoin anchor_join_;
-  ImuPropagation propagation_;
-  ZuptModel zupt_model_;
+  /// One model per sensor: each turns its input into an update of the filter.
+  struct SensorModels {
+    BaroUpdater baro;
+    HeightUpdater height;  ///< downward rangefinder, or a carried rig's height
+    RangeUpdater range;
+    AnchorJoin anchor_join;
+    ImuPropagation imu;
+    ZuptModel zupt;
+  };
+  SensorModels sensors_;
 
   HealthMonitor health_;
   RecoveryPolicy recovery_;
   ReentryGate reentry_;
   Resume resume_;  ///< resumeFrom's checkpoint, until the initialization
 
-  Snapshot cur_;
-  std::deque<Entry> history_;
-  std::deque<Archived> archive_;        ///< inputs before history_, kept for re-runs
-  std::optional<Timestamp> last_checkpoint_;  ///< time of the newest checkpoint in archive_
-  std::vector<AnchorInit> rerun_anchors_;  ///< calibrated anchors joined live, by order of joining
-  bool rerun_pending_ = false;           ///< an anchor joined: re-run after the next other input
-  /// refine.rerun_on_anchor_join for this strategy (dah: and refine.rerun_with_dah).
-  bool rerun_enabled_ = false;
-  bool applying_pending_inits_ = false;  ///< initialize() is applying held anchors (no re-run)
-  bool rerun_async_ = false;             ///< refine.rerun_mode async: re-runs on a worker
-  std::unique_ptr<RunningRerun> rerun_;  ///< the worker re-run not swapped in yet
-  std::function<void()> rerun_worker_hook_;
-  std::optional<Timestamp> newest_;   ///< newest input time seen (also before init)
-  Timestamp init_time_;
+  FilterContext cur_;
+  InputTimeline timeline_;
+  AnchorRerun rerun_;
   std::map<SensorId, InstanceStatus> instance_stats_;
 };
 

@@ -9,7 +9,7 @@ namespace meshnav::estimator {
 
 EstimatorCheckpoint EstimatorNode::checkpoint() const {
   if (!initialized()) throw std::logic_error("EstimatorNode::checkpoint: not initialized");
-  return makeCheckpoint(*cur_.filter, *cur_.network, cur_.landed, baro_.reference(), options_);
+  return makeCheckpoint(*cur_.filter, *cur_.network, cur_.landed, sensors_.baro.reference(), options_);
 }
 
 }  // namespace meshnav::estimator

@@ -20,7 +20,7 @@ struct EstimatorNode::GravityAdapter final : GravityDirection::Context {
   bool hasVerticalSensor() const override { return n.hasVerticalSensor(); }
   void gravityTurned() override {
     n.init_.aligner().setGravityAlongPlusZ(true);
-    n.zupt_model_ = ZuptModel(n.gravityG());
+    n.sensors_.zupt = ZuptModel(n.gravityG());
   }
   bool reinitializeWithGravity(Timestamp t) override { return n.reinitializeWithPlusZ(t); }
   double rangeNisRatio() const override { return n.cur_.noise_adapter.lastRatio(); }

@@ -10,10 +10,10 @@
 namespace meshnav::estimator {
 
 void EstimatorNode::releaseReentryIfDue() {
-  const std::optional<InputOrder> first_key = reentry_.releaseIfDue(*newest_);
+  const std::optional<InputOrder> first_key = reentry_.releaseIfDue(*timeline_.newest());
   if (!first_key) return;
-  const auto it = std::find_if(history_.begin(), history_.end(), [&](const Entry& e) { return e.key == *first_key; });
-  if (it == history_.end()) {
+  const auto it = timeline_.find(*first_key);
+  if (it == timeline_.window().end()) {
     diag_.count("range_reentry_lost");  // cannot happen with reentry_hold_s <= window_s; counted if it does
   } else {
     cur_ = it->before->copy();
@@ -21,8 +21,8 @@ void EstimatorNode::releaseReentryIfDue() {
     replayAfter(it);
   }
   // Fates are needed while a rewind or a re-run may replay their range; rejected ones as long as a re-run.
-  const double keep_s = std::max(options_.window_s, rerun_enabled_ ? options_.refine.max_history_s : 0.0);
-  reentry_.forgetFates(*newest_, options_.window_s, keep_s);
+  const double keep_s = std::max(options_.window_s, rerun_.enabled() ? options_.refine.max_history_s : 0.0);
+  reentry_.forgetFates(*timeline_.newest(), options_.window_s, keep_s);
 }
 
 }  // namespace meshnav::estimator

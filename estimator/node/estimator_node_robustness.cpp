@@ -20,9 +20,9 @@ using node_internal::weakestPositionAxis;
 
 void EstimatorNode::feedInitializer(const EstimatorInput& in) {
   // Anchors that come before the pose are held and applied at the initialization.
-  if (const auto* a = std::get_if<AnchorInit>(&in)) pending_anchor_inits_.push_back(*a);
+  if (const auto* a = std::get_if<AnchorInit>(&in)) sensors_.anchor_join.hold(*a);
   if (const auto* c = std::get_if<EstimatorCommand>(&in); c && c->action == EstimatorCommand::Action::AddAnchor)
-    pending_anchor_inits_.push_back(c->anchorToAdd());
+    sensors_.anchor_join.hold(c->anchorToAdd());
   if (auto belief = init_.tryInitialize(in, cur_.landed)) initialize(*belief);
 }
 
@@ -88,7 +88,7 @@ void EstimatorNode::logInitialization(const InitialBelief& b) const {
   if (b.height_bias)
     spdlog::info("estimator: the alignment used {} heights: rangefinder bias {:.3f} m (σ {:.3f} m)", b.n_heights_used,
                  b.height_bias->first, std::sqrt(b.height_bias->second));
-  if (!baro_.reference() && baro_.enabled())
+  if (!sensors_.baro.reference() && sensors_.baro.enabled())
     spdlog::warn("estimator: no baro reference pressure (none in setup, no landed baro data): baro unused");
 }
 
@@ -97,15 +97,15 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   auto filter = makeStrategy(options_, gravity_.zSign());
   filter->reset(setup_.imu_id, b.imu, b.cov, b.t);
   if (options_.baro.enabled && b.baro_reference_pa) {
-    baro_.setReference(b.baro_reference_pa);
+    sensors_.baro.setReference(b.baro_reference_pa);
     filter->addInstance<BaroBiasKind>(setup_.baro_id, b.baro_bias_m, Eigen::MatrixXd::Constant(1, 1, b.baro_bias_var_m2));
   } else if (options_.baro.enabled && resume_.keptBaroReference()) {
-    baro_.setReference(resume_.keptBaroReference());  // a restart in flight: the predecessor's
+    sensors_.baro.setReference(resume_.keptBaroReference());  // a restart in flight: the predecessor's
   }                                                        // reference (its bias: a kept instance)
-  height_.setBiasPrior(b.height_bias);  // the height instance is added at the first usable height
+  sensors_.height.setBiasPrior(b.height_bias);  // the height instance is added at the first usable height
   addSetupAnchorStates(*filter);
   addTagBiasStates(*filter);
-  resume_.restoreKept(*filter, b.t, baro_.reference());  // replace the priors
+  resume_.restoreKept(*filter, b.t, sensors_.baro.reference());  // replace the priors
   cur_.filter = std::move(filter);
   cur_.mean_reading.reset();
   cur_.last_imu = b.last_imu;
@@ -113,11 +113,10 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   cur_.landed = b.landed;
   cur_.last_zupt = b.t;
   cur_.rest_rate.reset();
-  init_time_ = b.t;
-  health_.reset(b.t);
-  newest_ = newest_ ? std::max(*newest_, b.t) : b.t;
+  onReinitialized(b.t);
+  timeline_.advance(b.t);
   logInitialization(b);
-  applyPendingAnchorInits(b.t);
+  applyHeldAnchors(b.t);
 }
 
 std::string EstimatorNode::waitingFor() const {
@@ -191,33 +190,14 @@ void EstimatorNode::checkFlightVolume(Timestamp t) {
 }
 
 void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu) {
-  cur_.mean_reading.reset();  // low-passed in the attitude and gravity being replaced
-  const FusionStrategy& old = *cur_.filter;
-  const NominalState& s = old.state();
-  auto f = makeStrategy(options_, gravity_.zSign());
-  f->reset(setup_.imu_id, x, P, t);
-  // Every instance keeps its mean; its marginal covariance as its kind says (the baro bias, which
-  // may have absorbed the runaway, is widened to the init σ; tag γ keep their variances).
-  forEachKind([&]<class K>() {
-    if constexpr (!K::kBody)
-      for (const auto& [id, value] : s.values<K>())
-        f->addInstance<K>(id, value, K::keptCovariance(old.covariance(id, id), options_));
-  });
-  // DAH joint sets stay together (their members' cross-covariances restart from zero like all others).
-  forEachKind([&]<class K>() {
-    if constexpr (!K::kBody)
-      for (const auto& [id, value] : s.values<K>())
-        if (const std::vector<SensorId> set = old.jointSetOf(id); !set.empty()) f->joinJointSet(set);
-  });
-  cur_.filter = std::move(f);
-  cur_.last_imu = last_imu;
-  cur_.prev_imu.reset();
-  cur_.last_zupt = t;
-  cur_.rest_rate.reset();
-  history_.clear();  // a rewind must not restore the state before the re-initialization
-  clearRerunHistory();  // nor a re-run (it starts from the new pose, with the anchors it has)
+  cur_.replaceImu(x, P, t, last_imu, options_, setup_.imu_id, gravity_.zSign());
   reentry_.restart(t);  // held ranges were in the history; the new pose comes from ranges
-  init_time_ = t;
+  onReinitialized(t);
+}
+
+void EstimatorNode::onReinitialized(Timestamp t) {
+  rerun_.abandon();  // a re-run may not restore the state before it (it starts from the new pose next time)
+  timeline_.restart(t);  // nor may a rewind
   health_.reset(t);
 }
 

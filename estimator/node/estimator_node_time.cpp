@@ -11,7 +11,7 @@ namespace meshnav::estimator {
 void EstimatorNode::startOverAfterClockBack() {
   spdlog::warn("estimator: the clock was ahead of every input; the node starts over");
   resetAll();
-  newest_.reset();
+  timeline_.forgetNewest();
   outputs_.resetAll();
   recovery_.resetAll();
   init_.forgetStreams();

@@ -17,14 +17,14 @@ namespace meshnav::estimator {
 using node_internal::where;
 
 void EstimatorNode::processBaro(const BaroSample& s, bool first) {
-  if (!baro_.enabled()) return;
-  if (!baro_.reference()) {
+  if (!sensors_.baro.enabled()) return;
+  if (!sensors_.baro.reference()) {
     event(first, "baro_no_reference");
     return;
   }
   propagateTo(s.t);
   ScopedStepTimer timer(timings_, "baro_update");
-  const UpdateResult r = baro_.update(*cur_.filter, s);
+  const UpdateResult r = sensors_.baro.update(*cur_.filter, s);
   if (first) countScalarUpdate(s.t, setup_.baro_id, "baro", r);
 }
 
@@ -40,8 +40,8 @@ void EstimatorNode::countScalarUpdate(Timestamp t, SensorId id, const std::strin
 }
 
 void EstimatorNode::processHeight(const HeightSample& s, bool first) {
-  if (!height_.enabled()) return;
-  if (const std::string why = height_.refusal(*cur_.filter, s); !why.empty()) {
+  if (!sensors_.height.enabled()) return;
+  if (const std::string why = sensors_.height.refusal(*cur_.filter, s); !why.empty()) {
     if (why == "height_id_is_an_anchor")
       event(first, why,
             where("HEIGHT", s.t) + ": height_id " + std::to_string(setup_.height_id) +
@@ -50,17 +50,17 @@ void EstimatorNode::processHeight(const HeightSample& s, bool first) {
       event(first, why);
     return;
   }
-  height_.ensureBiasState(*cur_.filter, s.t, first);
+  sensors_.height.ensureBiasState(*cur_.filter, s.t, first);
   propagateTo(s.t);
   ScopedStepTimer timer(timings_, "height_update");
-  const UpdateResult r = height_.update(*cur_.filter, s);
-  if (first) countScalarUpdate(s.t, setup_.height_id, height_.typeName(), r);
+  const UpdateResult r = sensors_.height.update(*cur_.filter, s);
+  if (first) countScalarUpdate(s.t, setup_.height_id, sensors_.height.typeName(), r);
 }
 
 void EstimatorNode::processRange(const RangeSample& s, bool first) {
-  if (!range_.enabled()) return;
-  const RangeMeasurement z = range_.measurement(s);
-  if (const std::string why = range_.refusal(z, *cur_.filter, *cur_.network); !why.empty()) {
+  if (!sensors_.range.enabled()) return;
+  const RangeMeasurement z = sensors_.range.measurement(s);
+  if (const std::string why = sensors_.range.refusal(z, *cur_.filter, *cur_.network); !why.empty()) {
     if (why == "unknown_id")
       event(first, why,
             where("RANGE", s.t) + ": unknown device in range " + std::to_string(z.a) + "–" + std::to_string(z.b));
@@ -71,7 +71,7 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
   propagateTo(s.t);
   ScopedStepTimer timer(timings_, "range_update");
   std::string why;
-  const std::optional<Linearization> linearized = range_.linearize(z, *cur_.filter, *cur_.network, &why);
+  const std::optional<Linearization> linearized = sensors_.range.linearize(z, *cur_.filter, *cur_.network, &why);
   if (!linearized) {
     event(first, why);
     return;
@@ -80,9 +80,9 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
   const bool tag_range = cur_.network->isTag(z.a) || cur_.network->isTag(z.b);
   bool count = first;
   if (tag_range &&
-      !reentry_.admit(s, cur_.network->isTag(z.a) ? z.b : z.a, lin, *cur_.filter, init_time_, first, &count))
+      !reentry_.admit(s, cur_.network->isTag(z.a) ? z.b : z.a, lin, *cur_.filter, timeline_.start(), first, &count))
     return;
-  const UpdateResult r = range_.update(*cur_.filter, lin);
+  const UpdateResult r = sensors_.range.update(*cur_.filter, lin);
   const double prior_ratio = RangeUpdater::priorRatio(lin, r);
   const long decisions = cur_.noise_adapter.decisions();
   if (tag_range && cur_.noise_adapter.onRangeNis(r.nis, prior_ratio, r.accepted) && first) {
@@ -107,7 +107,7 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
 }
 
 void EstimatorNode::applyAnchorInit(const AnchorInit& a, bool first) {
-  if (const std::string why = anchor_join_.apply(a, *cur_.filter, cur_.network, first); !why.empty())
+  if (const std::string why = sensors_.anchor_join.apply(a, *cur_.filter, cur_.network, first); !why.empty())
     event(first, "bad_command", where("ANCHOR_INIT", a.t) + ": id " + std::to_string(a.id) + why);
 }
 
@@ -133,7 +133,7 @@ void EstimatorNode::processZupt(const ImuSample& s, bool first) {
     z.sigma_gyro_rad_s = std::max(rest_sigma, options_.zupt.stillness_sigma_gyro_rad_s);
   }
   z.sigma_vel_m_s = init_.haveFlightState() ? options_.zupt.sigma_vel_m_s : options_.zupt.stillness_sigma_vel_m_s;
-  const Linearization lin = zupt_model_.linearize(z, f.state());
+  const Linearization lin = sensors_.zupt.linearize(z, f.state());
   const double gate = init_.haveFlightState() ? 0.0 : chi2Quantile(static_cast<int>(lin.residual.size()),
                                                               options_.zupt.stillness_gate_probability);
   if (!f.update(lin, gate).accepted) event(first, "gated_zupt");

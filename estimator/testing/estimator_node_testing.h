@@ -16,7 +16,7 @@ class EstimatorNodeTesting {
   /// Called on the re-run worker before it starts (a test holds the worker there until it releases
   /// it; the hook must return before the node is destroyed or re-initialized).
   static void setRerunWorkerHook(EstimatorNode& node, std::function<void()> hook) {
-    node.rerun_worker_hook_ = std::move(hook);
+    node.rerun_.setWorkerHook(std::move(hook));
   }
   /// Moves the pose estimate by `dp_m` (G) and turns it by `dyaw_rad` about z, keeping its
   /// covariance, as a corrupted state would look to the filter (counted "injected_pose_error").

@@ -19,6 +19,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/diagnostics.h"
@@ -36,6 +37,11 @@ class AnchorJoin {
   /// Adds anchor `a` to `f` and `network` (replaced by a copy that knows it); "" when done (counted
   /// "anchor_init" and logged when `log`), else why not (its id is a tag's or a sensor's instance).
   std::string apply(const AnchorInit& a, FusionStrategy& f, std::shared_ptr<const UwbNetwork>& network, bool log);
+  /// Anchors that come before the pose (ANCHOR_INIT, an add command, a restart's kept anchors) are
+  /// held and applied at the initialization; a reset does not drop them.
+  void hold(const AnchorInit& a) { held_.push_back(a); }
+  std::vector<AnchorInit>& held() { return held_; }
+  std::vector<AnchorInit> takeHeld() { return std::exchange(held_, {}); }
 
  private:
   /// DAH: puts the just added anchor `id` into its joint set.
@@ -47,6 +53,7 @@ class AnchorJoin {
   Diagnostics& diag_;
   std::vector<SensorId> batch_;      ///< the anchors added at the filter time `batch_t_`
   std::optional<Timestamp> batch_t_;
+  std::vector<AnchorInit> held_;
 };
 
 }  // namespace meshnav::estimator
