@@ -149,9 +149,6 @@ const Field kModelParameters[] = {
     {"process_noise.max_shrink", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::max_shrink>, "largest shrink of the scale per decision (factor) [-]"},
     {"process_noise.max_scale", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::max_scale>, "largest variance scale [-]"},
     {"process_noise.max_prior_ratio", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::max_prior_ratio>, "no growth while the median predicted range variance HPH'/R exceeds this [-]"},
-    {"process_noise.confirm_batches", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::confirm_batches>, "consecutive batches above upper_ratio before the scale grows (by the smallest of their ratios) [-]"},
-    {"process_noise.grow_at_once_ratio", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::grow_at_once_ratio>, "a batch whose median NIS ratio exceeds this grows the scale without confirmation [-]"},
-    {"process_noise.min_accepted_fraction", field<&EstimatorOptions::process_noise, &ProcessNoiseAdaptOptions::min_accepted_fraction>, "median over the accepted ranges while this share of the batch was accepted, else over all [-]"},
     {"recovery.retry_s", field<&EstimatorOptions::recovery, &RecoveryOptions::retry_s>, "between two attempts while lost or degraded [s]"},
     {"recovery.degraded_disagreement_chi2", field<&EstimatorOptions::recovery, &RecoveryOptions::degraded_disagreement_chi2>, "degraded: re-initialize when the aligned pose disagrees beyond this chi^2 (4 dof), 0 = off [-]"},
     {"recovery.after_gap_check_min_s", field<&EstimatorOptions::recovery, &RecoveryOptions::after_gap_check_min_s>, "after an IMU gap this long, compare the aligned pose with the filter as while degraded, for init.motion_window_s, 0 = off [s]"},
@@ -293,10 +290,8 @@ void EstimatorOptions::validate() const {
   need(uwb.huber_k >= 0 && uwb.huber_max_prior_ratio >= 0, "uwb.huber_k >= 0, uwb.huber_max_prior_ratio >= 0");
   need(process_noise.batch >= 5 && process_noise.upper_ratio > 1.0 && process_noise.lower_ratio > 0.0 &&
            process_noise.lower_ratio < 1.0 && process_noise.max_grow > 1.0 && process_noise.max_shrink > 1.0 &&
-           process_noise.max_scale >= 1.0 && process_noise.max_prior_ratio > 0.0 &&
-           process_noise.min_accepted_fraction > 0.0 && process_noise.min_accepted_fraction <= 1.0 &&
-           process_noise.confirm_batches >= 1 && process_noise.grow_at_once_ratio >= process_noise.upper_ratio,
-       "process_noise: batch >= 5, lower_ratio in (0, 1), upper_ratio > 1, max_grow > 1, max_shrink > 1, max_scale >= 1, max_prior_ratio > 0, min_accepted_fraction in (0, 1], confirm_batches >= 1, grow_at_once_ratio >= upper_ratio");
+           process_noise.max_scale >= 1.0 && process_noise.max_prior_ratio > 0.0,
+       "process_noise: batch >= 5, lower_ratio in (0, 1), upper_ratio > 1, max_grow > 1, max_shrink > 1, max_scale >= 1, max_prior_ratio > 0");
   need(time.max_offset_s >= window_s && time.max_offset_s <= kMaxTimeSeconds && time.rebase_after >= 1,
        "time.max_offset_s >= window_s, time.rebase_after >= 1");
   need(refine.max_history_s >= window_s && refine.rerun_prior_sigma_m > 0 && refine.rerun_gamma_sigma_m > 0,

@@ -20,19 +20,14 @@
 /// bound 2.2, λ ≤ 100 (densities at most 10×). λ shrinks again at rest, where a MEMS IMU is as
 /// good as its datasheet.
 ///
-/// **λ also grows where the IMU densities are right** (docs/robustness.md, "λ on exact IMU
-/// densities"). Gated outliers count in the median (15 % of them lift a consistent batch's median
-/// to r ≈ 1.5), the median of 40 values spreads by about ±0.4, so single batches cross 2.2; and
-/// where H P Hᵀ ≪ R (the usual case in flight) a growth hardly lowers the NIS, so nothing undoes
-/// it. On the 200-run sweep (seed 4; simulated IMUs with exact densities) λ ends at a median of
-/// 16 and at its bound in one run in ten. Two options remove that ratchet: the median over the
-/// **accepted** ranges while at least `min_accepted_fraction` of the batch was accepted (over all
-/// of them below, so drift still shows), and growth only after `confirm_batches` batches in a
-/// row above the bound (by the smallest of their ratios) unless one exceeds `grow_at_once_ratio`
-/// (4: for consistent ranges about 10⁻⁶ of the batches). With 0.5 / 2 / 4 the sweep's λ stays at
-/// 1 (median and 90th percentile) and its errors shrink a little, but ISAS-Walk1, whose NLOS
-/// ranges the higher λ happens to follow, loses 12 %. Real data decides, so they are off by
-/// default (1.0 / 1: the rule above exactly).
+/// **λ also grows where the IMU densities are right** (docs/robustness.md, "Process noise from
+/// the innovations"). Gated outliers count in the median (15 % of them lift a consistent batch's
+/// median to r ≈ 1.5), the median of 40 values spreads by about ±0.4, so single batches cross 2.2;
+/// and where H P Hᵀ ≪ R (the usual case in flight) a growth hardly lowers the NIS, so nothing
+/// undoes it: on the 200-run sweep (seed 4, exact densities) λ ends at a median of 16. Taking the
+/// median over the accepted ranges and growing only after two batches in a row kept λ at 1 there
+/// but cost ISAS-Walk1 12 %; those two options were off by default and are gone (issue 33). The
+/// ratchet is a limit of this rule, not a model of the IMU's error (issue 34).
 /// Growth only helps while the predicted range variance H P Hᵀ is small against the range noise R:
 /// once the state is already less certain than one range (median H P Hᵀ / R above
 /// `max_prior_ratio`), a NIS that stays high comes from the range model (biases, NLOS, too few
@@ -54,9 +49,6 @@ struct ProcessNoiseAdaptOptions {
   double max_shrink = 1.2;    ///< largest shrink of λ per decision (factor) [-]
   double max_scale = 100.0;   ///< largest λ (densities up to 10×) [-]
   double max_prior_ratio = 1.0;  ///< no growth while median H P Hᵀ / R of the batch exceeds this [-]
-  int confirm_batches = 1;     ///< consecutive batches above upper_ratio before λ grows [-]
-  double grow_at_once_ratio = 4.0;  ///< with confirm_batches > 1: a batch above this grows λ at once [-]
-  double min_accepted_fraction = 1.0;  ///< median over the accepted ranges while this share of the batch was accepted [-]
 };
 
 class ProcessNoiseAdapter {
@@ -64,8 +56,9 @@ class ProcessNoiseAdapter {
   ProcessNoiseAdapter() = default;
   explicit ProcessNoiseAdapter(const ProcessNoiseAdaptOptions& options) : options_(options) {}
 
-  /// NIS of one tag–anchor range, its predicted variance ratio H P Hᵀ / R (the state's share of
-  /// the innovation variance against the range noise's) and whether the gate accepted it.
+  /// NIS of one tag–anchor range and its predicted variance ratio H P Hᵀ / R (the state's share of
+  /// the innovation variance against the range noise's); gated ranges count too (`accepted` is
+  /// not used: a drifted filter shows itself by gating).
   /// Returns true when λ changed.
   bool onRangeNis(double nis, double prior_ratio = 0.0, bool accepted = true);
   /// Variance scale λ ≥ 1 of the IMU white noise.
@@ -80,9 +73,7 @@ class ProcessNoiseAdapter {
   double scale_ = 1.0;
   double last_ratio_ = 0.0;
   long decisions_ = 0;
-  std::vector<double> recent_above_;  ///< ratios of the consecutive decisions above upper_ratio (the last confirm_batches)
   std::vector<double> batch_;
-  std::vector<bool> accepted_;
   std::vector<double> prior_ratios_;
 };
 

@@ -131,13 +131,8 @@ TEST(EstimatorOptions, ModelParametersAreValidated) {
     }
     return std::string();
   };
-  EXPECT_NE(invalid([](EstimatorOptions& o) { o.process_noise.min_accepted_fraction = 0; })
-                .find("min_accepted_fraction in (0, 1]"),
-            std::string::npos);
-  EXPECT_NE(invalid([](EstimatorOptions& o) { o.process_noise.confirm_batches = 0; }).find("confirm_batches >= 1"),
-            std::string::npos);
-  EXPECT_NE(invalid([](EstimatorOptions& o) { o.process_noise.grow_at_once_ratio = 2.0; })
-                .find("grow_at_once_ratio >= upper_ratio"),
+  EXPECT_NE(invalid([](EstimatorOptions& o) { o.process_noise.batch = 4; }).find("batch >= 5"), std::string::npos);
+  EXPECT_NE(invalid([](EstimatorOptions& o) { o.process_noise.max_grow = 1.0; }).find("max_grow > 1"),
             std::string::npos);
   EXPECT_NE(invalid([](EstimatorOptions& o) { o.uwb.dah_joint_max_anchors = -1; }).find("uwb.dah_joint_max_anchors >= 0"),
             std::string::npos);

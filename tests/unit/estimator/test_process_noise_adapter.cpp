@@ -32,14 +32,6 @@ double closedLoop(ProcessNoiseAdapter& a, int n, double q_true, double q_stated,
   return decisions ? sum / decisions : 1.0;
 }
 
-/// The options that remove the ratchet on exact densities (off by default; docs/robustness.md).
-ProcessNoiseAdaptOptions withoutRatchet() {
-  ProcessNoiseAdaptOptions o;
-  o.min_accepted_fraction = 0.5;
-  o.confirm_batches = 2;
-  o.grow_at_once_ratio = 4.0;
-  return o;
-}
 
 /// Feeds `n` NIS values s·χ²(1) (open loop).
 void feed(ProcessNoiseAdapter& a, int n, double s, std::mt19937& rng) {
@@ -109,68 +101,41 @@ TEST(ProcessNoiseAdapter, GatedOutliersAloneDoNotGrowTheScale) {
   EXPECT_LT(mean_scale, 3.0);
 }
 
-TEST(ProcessNoiseAdapter, AModerateExcessMustHoldTwoBatchesInARow) {
-  // With confirmation on: batches whose median NIS is r times that of χ²(1); r = 3 lies above
-  // upper_ratio (2.2) and below grow_at_once_ratio (4). One batch does nothing, a batch back in the band resets the
-  // count, the second in a row grows λ by the smaller of the two ratios.
-  const auto batch = [](ProcessNoiseAdapter& a, double r) {
-    for (int i = 0; i < ProcessNoiseAdaptOptions{}.batch; ++i) a.onRangeNis(r * 0.4549364231195724, 0.1, true);
-  };
-  ProcessNoiseAdapter a(withoutRatchet());
-  batch(a, 3.0);
-  EXPECT_NEAR(a.lastRatio(), 3.0, 1e-9);
-  EXPECT_DOUBLE_EQ(a.scale(), 1.0);
-  batch(a, 1.0);
-  batch(a, 3.0);
-  EXPECT_DOUBLE_EQ(a.scale(), 1.0);
-  batch(a, 2.5);
-  EXPECT_NEAR(a.scale(), 2.5, 1e-9);
-  batch(a, 3.0);  // still above: grows again by min(2.5, 3)
-  EXPECT_NEAR(a.scale(), 6.25, 1e-9);
-  batch(a, 5.0);  // above grow_at_once_ratio: grows by its own ratio, not the smaller one
-  EXPECT_NEAR(a.scale(), 6.25 * 5.0, 1e-9);
-}
-
-TEST(ProcessNoiseAdapter, TheRatchetOnExactDensitiesAndTheOptionsThatRemoveIt) {
-  // The usual case in flight: H P Hᵀ ≪ R, so the NIS hardly depends on λ (open loop: NIS = χ²(1)
-  // for the consistent ranges) and nothing undoes a growth but a batch far below. 15 % of the
-  // ranges are gross outliers, gated. With the defaults the median runs over all ranges and one
-  // batch above 2.2 grows λ: the outliers lift the median to r ≈ 1.5, the sampling spread of 40
-  // ranges crosses the bound in about one batch in twenty, and λ ratchets up to its bound; even
-  // without outliers it drifts up. Over the accepted ranges and with two batches in a row
-  // required (withoutRatchet), λ stays at 1.
+TEST(ProcessNoiseAdapter, TheRatchetOnExactDensities) {
+  // A limit of this rule, measured (issue 34 replaces it by a model of the IMU's error). The usual
+  // case in flight: H P Hᵀ ≪ R, so the NIS hardly depends on λ (open loop: NIS = χ²(1) for the
+  // consistent ranges) and nothing undoes a growth but a batch far below. 15 % of the ranges are
+  // gross outliers, gated: they lift the median to r ≈ 1.5, the sampling spread of 40 ranges
+  // crosses the bound in about one batch in twenty, and λ ratchets up towards its bound; even
+  // without outliers it drifts up. If a change removes the ratchet this test says so.
   std::mt19937 rng(19);
   std::normal_distribution<double> z(0.0, 1.0);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  ProcessNoiseAdapter opt_in(withoutRatchet()), defaults, defaults_without_outliers;
-  double mean_opt_in = 0.0, mean_defaults = 0.0, mean_without_outliers = 0.0;
+  ProcessNoiseAdapter defaults, defaults_without_outliers;
+  double mean_defaults = 0.0, mean_without_outliers = 0.0;
   const int decisions = 1000;
   for (int i = 0; i < 40 * decisions; ++i) {
     const bool outlier = u(rng) < 0.15;
     const double v = z(rng), nis = outlier ? 60.0 + v * v : v * v;
-    opt_in.onRangeNis(nis, 0.1, !outlier);
     defaults.onRangeNis(nis, 0.1, !outlier);
     defaults_without_outliers.onRangeNis(v * v, 0.1, true);
     if ((i + 1) % 40 == 0) {
-      mean_opt_in += opt_in.scale() / decisions;
       mean_defaults += defaults.scale() / decisions;
       mean_without_outliers += defaults_without_outliers.scale() / decisions;
     }
   }
-  std::cout << "mean scale: without the ratchet " << mean_opt_in << ", defaults " << mean_defaults
-            << ", defaults without outliers " << mean_without_outliers << std::endl;
-  EXPECT_LT(mean_opt_in, 1.5);
+  std::cout << "mean scale: with 15 % gated outliers " << mean_defaults << ", without outliers "
+            << mean_without_outliers << std::endl;
   EXPECT_GT(mean_defaults, 10.0);
   EXPECT_GT(mean_without_outliers, 2.0);
 }
 
-TEST(ProcessNoiseAdapter, MostlyGatedBatchesStillGrowTheScale) {
-  // With the median over accepted ranges: a drifted filter gates most ranges; below
-  // `min_accepted_fraction` accepted, the median runs over all of them (far above the bound,
-  // and above grow_at_once_ratio) and λ grows by max_grow at once.
+TEST(ProcessNoiseAdapter, MostlyGatedBatchesGrowTheScaleAtOnce) {
+  // A drifted filter gates most ranges: their NIS is in the median, far above the bound, and λ
+  // grows by max_grow at once.
   std::mt19937 rng(23);
   std::normal_distribution<double> z(0.0, 1.0);
-  ProcessNoiseAdapter a(withoutRatchet());
+  ProcessNoiseAdapter a;
   for (int i = 0; i < 40; ++i) {
     const double v = z(rng);
     const bool accepted = i % 4 == 0;  // 25 % accepted
