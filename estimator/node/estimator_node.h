@@ -172,11 +172,6 @@ class EstimatorNode : private RerunReplayer {
   /// Before initialization: the input to the initializers (anchors held for later).
   void feedInitializer(const EstimatorInput& in);
   void initialize(const InitialBelief& b);
-  /// Known-but-uncertain setup anchors (abs_anchor_sigmas) as estimated instances, with their
-  /// a-priori γ as states when `uwb.estimate_setup_anchor_biases`.
-  void addSetupAnchorStates(FusionStrategy& f) const;
-  /// The tags' γ towards setup anchors whose a-priori bias is uncertain, as states of the tags.
-  void addTagBiasStates(FusionStrategy& f) const;
   /// The initialization's log lines (pose, σ, source, heights, a missing baro reference).
   void logInitialization(const InitialBelief& b) const;
   /// Processes one input on `cur_`; `first` = first time (count events, publish).

@@ -11,6 +11,7 @@
 
 #include "common/atmosphere.h"
 #include "estimator/filter/strategy_factory.h"
+#include "estimator/init/initial_states.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/node/node_internals.h"
 
@@ -24,54 +25,6 @@ void EstimatorNode::feedInitializer(const EstimatorInput& in) {
   if (const auto* c = std::get_if<EstimatorCommand>(&in); c && c->action == EstimatorCommand::Action::AddAnchor)
     sensors_.anchor_join.hold(c->anchorToAdd());
   if (auto belief = init_.tryInitialize(in, cur_.landed)) initialize(*belief);
-}
-
-/// Known-but-uncertain setup anchors (abs_anchor_sigmas) as estimated anchor instances.
-void EstimatorNode::addSetupAnchorStates(FusionStrategy& f) const {
-  for (const auto& [id, p] : setup_.abs_anchor_positions) {
-    auto sig = setup_.abs_anchor_sigmas_m.find(id);
-    if (sig == setup_.abs_anchor_sigmas_m.end()) continue;
-    // Known-but-uncertain: its a-priori γ towards exactly known anchors and towards uncertain
-    // anchors of smaller id (one owner per pair) become states too (independent a priori).
-    BiasState biases;
-    std::vector<double> gamma, var = {1.0, 1.0, 1.0};
-    if (options_.uwb.estimate_setup_anchor_biases) {
-      for (const auto& [peer, q] : setup_.abs_anchor_positions) {
-        if (peer == id || (setup_.abs_anchor_sigmas_m.count(peer) && peer > id)) continue;
-        const auto pb = setup_.findPairBias(id, peer);
-        if (!pb || pb->sigma_gamma_m <= 0.0) continue;
-        biases.peers.push_back(peer);
-        gamma.push_back(pb->gamma_m);
-        var.push_back(pb->sigma_gamma_m * pb->sigma_gamma_m);
-      }
-    }
-    biases.gamma_m = Eigen::Map<const Eigen::VectorXd>(gamma.data(), static_cast<Eigen::Index>(gamma.size()));
-    Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(var.data(), static_cast<Eigen::Index>(var.size()));
-    v.head<3>() *= sig->second * sig->second;
-    f.addInstance<AnchorKind>(id, AnchorState{p, biases}, v.asDiagonal().toDenseMatrix());
-  }
-}
-
-void EstimatorNode::addTagBiasStates(FusionStrategy& f) const {
-  if (options_.uwb.estimate_tag_biases) {
-    // Tag instances with state: γ towards the setup's anchors (exact or known-but-uncertain) whose
-    // a-priori bias is uncertain. Constant per pair, so a state rather than white noise.
-    for (const auto& [tag, lever] : setup_.rel_tag_positions) {
-      std::vector<SensorId> peers;
-      std::vector<double> gamma, var;
-      for (const auto& [anchor, p] : setup_.abs_anchor_positions) {
-        const auto pb = setup_.findPairBias(tag, anchor);
-        if (!pb || pb->sigma_gamma_m <= 0.0) continue;
-        peers.push_back(anchor);
-        gamma.push_back(pb->gamma_m);
-        var.push_back(pb->sigma_gamma_m * pb->sigma_gamma_m);
-      }
-      if (!peers.empty())
-        f.addInstance<TagBiasKind>(
-            tag, BiasState{peers, Eigen::Map<Eigen::VectorXd>(gamma.data(), static_cast<long>(gamma.size()))},
-            Eigen::Map<Eigen::VectorXd>(var.data(), static_cast<long>(var.size())).asDiagonal().toDenseMatrix());
-    }
-  }
 }
 
 void EstimatorNode::logInitialization(const InitialBelief& b) const {
@@ -103,8 +56,8 @@ void EstimatorNode::initialize(const InitialBelief& b) {
     sensors_.baro.setReference(resume_.keptBaroReference());  // a restart in flight: the predecessor's
   }                                                        // reference (its bias: a kept instance)
   sensors_.height.setBiasPrior(b.height_bias);  // the height instance is added at the first usable height
-  addSetupAnchorStates(*filter);
-  addTagBiasStates(*filter);
+  addSetupAnchorStates(*filter, setup_, options_.uwb);
+  addTagBiasStates(*filter, setup_, options_.uwb);
   resume_.restoreKept(*filter, b.t, sensors_.baro.reference());  // replace the priors
   cur_.filter = std::move(filter);
   cur_.mean_reading.reset();

@@ -11,6 +11,7 @@
 #include "common/atmosphere.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/node/node_internals.h"
+#include "estimator/zupt/rest_measurement.h"
 
 namespace meshnav::estimator {
 
@@ -111,32 +112,16 @@ void EstimatorNode::applyAnchorInit(const AnchorInit& a, bool first) {
     event(first, "bad_command", where("ANCHOR_INIT", a.t) + ": id " + std::to_string(a.id) + why);
 }
 
-/// Zero-velocity update at the IMU reading `s` while landed (rate `zupt.rate_hz`): v = 0, the
-/// specific force of gravity alone, and ω = 0 on the mean gyro reading since the last ZUPT.
+/// Zero-velocity update at the IMU reading `s` while landed (rate `zupt.rate_hz`; restMeasurement).
 void EstimatorNode::processZupt(const ImuSample& s, bool first) {
   FusionStrategy& f = *cur_.filter;
   ScopedStepTimer timer(timings_, "zupt");
-  ZuptMeasurement z;
-  z.t = s.t;
-  z.acc_m_s2 = s.acc_m_s2;
-  // Only a flight state says v = 0 and ω = 0 exactly; IMU stillness allows a slow drift and turn.
-  z.sigma_acc_m_s2 = options_.zupt.sigma_acc_m_s2;
-  // ω row: the mean reading since the last ZUPT, σ² = (rest rotation allowed)² + σ_ω² λ / T
-  // (RestRateMean; λ the IMU noise scale); the latest reading with the loosest σ before any interval.
-  const double rest_sigma = init_.haveFlightState() ? options_.zupt.sigma_gyro_rad_s : options_.zupt.stillness_sigma_gyro_rad_s;
-  if (cur_.rest_rate.span() > 0.0) {
-    const double mean_sigma = cur_.rest_rate.sigma(options_.imu.gyro_noise_density * std::sqrt(cur_.noise_adapter.scale()));
-    z.gyro_rad_s = cur_.rest_rate.mean();
-    z.sigma_gyro_rad_s = std::hypot(rest_sigma, mean_sigma);
-  } else {
-    z.gyro_rad_s = s.gyro_rad_s;
-    z.sigma_gyro_rad_s = std::max(rest_sigma, options_.zupt.stillness_sigma_gyro_rad_s);
-  }
-  z.sigma_vel_m_s = init_.haveFlightState() ? options_.zupt.sigma_vel_m_s : options_.zupt.stillness_sigma_vel_m_s;
+  const bool flight_state = init_.haveFlightState();
+  const ZuptMeasurement z = restMeasurement(s, cur_.rest_rate, options_.zupt, options_.imu.gyro_noise_density,
+                                            cur_.noise_adapter.scale(), flight_state);
   const Linearization lin = sensors_.zupt.linearize(z, f.state());
-  const double gate = init_.haveFlightState() ? 0.0 : chi2Quantile(static_cast<int>(lin.residual.size()),
-                                                              options_.zupt.stillness_gate_probability);
-  if (!f.update(lin, gate).accepted) event(first, "gated_zupt");
+  if (!f.update(lin, restGate(static_cast<int>(lin.residual.size()), options_.zupt, flight_state)).accepted)
+    event(first, "gated_zupt");
   cur_.last_zupt = s.t;
   cur_.rest_rate.reset();
   if (first) ++instance_stats_[setup_.imu_id].n_updates;
