@@ -27,14 +27,14 @@
 ///   samples (propagateTo). While landed a
 ///   zero-velocity update runs at `zupt.rate_hz` with the latest IMU reading.
 /// - ANCHOR_INIT and ESTIMATOR_CMD apply at max(their time, newest time).
-/// - Re-run on an anchor join (RefineOptions, estimator_node_rerun.cpp): inputs that leave the
+/// - Re-run on an anchor join (AnchorRerun, estimator/refine/anchor_rerun.h): inputs that leave the
 ///   window are archived up to `refine.max_history_s`; after a live ANCHOR_INIT the node restores
 ///   the oldest stored state, adds the calibrated anchors there with a loose prior and
 ///   re-processes every stored input ("rerun", "rerun_inputs"; centralized and dp by default).
 ///   With `refine.rerun_mode` async (the LCM process) the re-run is computed on a worker thread
 ///   from immutable copies while the node keeps processing and publishing; its result is swapped
 ///   in at the first input after the worker is done and the inputs that came meanwhile are
-///   re-processed from it (estimator_node_rerun_async.cpp).
+///   re-processed from it. The stored inputs and their contexts: InputTimeline, FilterContext.
 /// - Initialization: while at rest (flight state, else IMU stillness) from the landed data
 ///   (StaticInitializer); in motion, or when the landed data cannot fix the pose (one tag,
 ///   coplanar anchors), from ranges and strapdown increments over a window (MotionAligner).
