@@ -18,9 +18,10 @@
 /// A fix is rejected (counted) when Jᵀ W J is near-singular (anchor geometry) or the RMS of the
 /// residuals after convergence exceeds `max_rms_residual_m`.
 ///
-/// The tag lever arm is ignored: the fix is the tag's position, reported as the body position
-/// (an error of at most the lever-arm length, 0.1 m on ISAS-Walk1, 0.2 m on MILUV). Using the
-/// estimator's orientation to move it would mix the baseline with the estimate under test.
+/// A fix is the tag's position. `solve` can also return which tag each fix belongs to, so that the
+/// evaluation compares it with the truth's tag position (the truth's pose and the lever arm,
+/// evaluateBaseline); the estimator's orientation is never used for it (that would mix the baseline
+/// with the estimate under test).
 
 #include <map>
 #include <vector>
@@ -57,8 +58,9 @@ class Multilateration {
   /// Fixes of every tag in time order, as pose estimates (position only: identity orientation,
   /// zero covariance, so that NEES is not computed for them). Counters also go to `diag`
   /// ("multilateration:*").
+  /// `fix_tags`: when given, the tag of each fix (same order).
   std::vector<PoseEstimate> solve(const std::vector<RangeSample>& ranges, const SystemSetup& setup,
-                                  Diagnostics& diag);
+                                  Diagnostics& diag, std::vector<SensorId>* fix_tags = nullptr);
 
   /// One epoch: anchor positions a_i [m] and ranges z_i [m] (same length, ≥ 3), start `x0`.
   /// Returns the position, or nullopt (and sets `reason`) when degenerate or the residual is large.

@@ -51,7 +51,7 @@ std::string formatAlignmentAndBaseline(const RunEvaluation& ev) {
   if (ev.baseline) {
     const auto& st = ev.baseline->stats;
     os << "  (multilateration: per tag, epochs of " << formatNumber(ev.baseline->window_s, 2) << " s, ≥ 4 known anchors, "
-       << "Huber Gauss–Newton, tag lever arm ignored; " << st.epochs << " epochs, " << st.fixes << " fixes, "
+       << "Huber Gauss–Newton, compared as tag positions (truth pose + lever arm); " << st.epochs << " epochs, " << st.fixes << " fixes, "
        << st.too_few_anchors << " with too few anchors, " << st.degenerate << " degenerate, " << st.large_residual
        << " large residual)\n";
   }
@@ -71,7 +71,7 @@ void addAlignmentAndBaseline(YAML::Node& root, const RunEvaluation& ev) {
   }
   const auto& b = *ev.baseline;
   YAML::Node n;
-  n["method"] = "per-epoch multilateration, Huber IRLS Gauss-Newton, >= 4 known anchors, lever arm ignored";
+  n["method"] = "per-epoch multilateration, Huber IRLS Gauss-Newton, >= 4 known anchors, compared as tag positions (truth pose + lever arm)";
   n["window_s"] = number(b.window_s);
   n["epochs"] = b.stats.epochs;
   n["fixes"] = b.stats.fixes;

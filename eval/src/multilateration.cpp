@@ -71,9 +71,9 @@ std::optional<Eigen::Vector3d> Multilateration::solveEpoch(const std::vector<Eig
 }
 
 std::vector<PoseEstimate> Multilateration::solve(const std::vector<RangeSample>& ranges, const SystemSetup& setup,
-                                                 Diagnostics& diag) {
+                                                 Diagnostics& diag, std::vector<SensorId>* fix_tags) {
   stats_ = Stats{};
-  std::vector<PoseEstimate> fixes;
+  std::vector<std::pair<PoseEstimate, SensorId>> fixes;
   for (const auto& tag_entry : setup.rel_tag_positions) {
     const SensorId tag = tag_entry.first;
     // This tag's ranges to known anchors, in time order: (t, anchor id, range).
@@ -123,13 +123,20 @@ std::vector<PoseEstimate> Multilateration::solve(const std::vector<RangeSample>&
       PoseEstimate fix;
       fix.t = t;
       fix.p_IinG = *x;
-      fixes.push_back(fix);
+      fixes.emplace_back(fix, tag);
       last = fix;
       ++stats_.fixes;
     }
   }
-  std::stable_sort(fixes.begin(), fixes.end(), [](const PoseEstimate& x, const PoseEstimate& y) { return x.t < y.t; });
-  return fixes;
+  std::stable_sort(fixes.begin(), fixes.end(), [](const auto& x, const auto& y) { return x.first.t < y.first.t; });
+  std::vector<PoseEstimate> out;
+  out.reserve(fixes.size());
+  if (fix_tags) fix_tags->clear();
+  for (const auto& [fix, tag] : fixes) {
+    out.push_back(fix);
+    if (fix_tags) fix_tags->push_back(tag);
+  }
+  return out;
 }
 
 }  // namespace meshnav::eval

@@ -131,3 +131,26 @@ TEST(Multilateration, BaselineInARotatedTruthFrameIsExactAfterSe3Alignment) {
   EXPECT_LT(se3.trajectory.position.rmse, 1e-9);
   EXPECT_GT(none.trajectory.position.rmse, 1.0);
 }
+
+// Issue 34 item 7: the baseline is scored as tag positions (the truth's pose with the lever arm),
+// so a lever arm costs it nothing: a rig turning about z with its tag 0.5 m off the body. Scored
+// as the body's position (before), every fix would be 0.5 m off.
+TEST(Multilateration, BaselineIsScoredAsTheTruthsTagPositionSoTheLeverArmCostsNothing) {
+  auto s = fiveAnchors();
+  s.rel_tag_positions[1000] = {0.5, 0.0, 0.0};
+  std::vector<RangeSample> ranges;
+  std::vector<PoseSample> truth;
+  for (int k = 0; k <= 200; ++k) {
+    const double tk = 0.01 * k;
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(1.5 * tk, Eigen::Vector3d::UnitZ()));
+    truth.push_back({Timestamp::fromSec(tk), walk(tk), q});
+    if (k % 5 == 0 && k > 0 && k < 200) addEpoch(ranges, s, walk(tk) + q * s.rel_tag_positions.at(1000), tk);
+  }
+  Diagnostics diag;
+  const auto b = evaluateBaseline(ranges, s, truth, {}, AlignmentMode::None, EvalOptions{}, diag);
+  ASSERT_EQ(b.trajectory.n_selected, 39);
+  EXPECT_LT(b.trajectory.position.rmse, 1e-9);
+  // SE(3) alignment fitted on the tag positions: exact too.
+  const auto se3 = evaluateBaseline(ranges, s, truth, {}, AlignmentMode::Se3, EvalOptions{}, diag);
+  EXPECT_LT(se3.trajectory.position.rmse, 1e-9);
+}
