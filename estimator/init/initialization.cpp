@@ -7,7 +7,6 @@
 #include <cmath>
 
 #include "common/atmosphere.h"
-#include "estimator/node/node_internals.h"
 
 namespace meshnav::estimator {
 
@@ -25,11 +24,34 @@ Eigen::Vector3d heightLever(const EstimatorOptions& o, const SystemSetup& setup)
 
 namespace {
 
+/// The in-motion alignment's options from the estimator's (init.motion_*, the bias priors, the
+/// height model), `p_IH` the lever of its vertical sensor.
+MotionAlignerOptions alignerOptions(const EstimatorOptions& o, const Eigen::Vector3d& p_IH) {
+  MotionAlignerOptions a;
+  a.p_IH = p_IH;
+  a.window_s = o.init.motion_window_s;
+  a.min_span_s = o.init.motion_min_span_s;
+  a.min_ranges = o.init.motion_min_ranges;
+  a.max_sigma_yaw_deg = o.init.motion_max_sigma_yaw_deg;
+  a.max_sigma_p_m = o.init.motion_max_sigma_p_m;
+  a.relinearize_rad = o.init.motion_relinearize_rad;
+  a.sigma_bias_acc_m_s2 = o.init.sigma_bias_acc_m_s2;
+  a.sigma_bias_gyro_rad_s = o.init.sigma_bias_gyro_rad_s;
+  a.outlier_m = o.init.range_init_outlier_m;
+  a.ambiguity_chi2 = o.init.ambiguity_chi2;
+  a.gravity_m_s2 = o.gravity_m_s2;
+  a.max_imu_gap_s = o.imu.max_dt_s;
+  a.max_window_s = o.init.motion_max_window_s;
+  a.height_tilt_correction = o.height.tilt_correction;
+  a.sigma_bias_height_m = o.height.init_bias_sigma_m;
+  return a;
+}
+
 /// The alignment's options; its height model is the baro's (lever p_IP, no tilt correction, bias
 /// prior baro.init_bias_sigma_m) when the baro aligns, else the height model's.
 MotionAlignerOptions alignerOptionsFor(const EstimatorOptions& o, const SystemSetup& setup) {
   MotionAlignerOptions a =
-      node_internal::alignerOptions(o, baroAligns(o, setup) ? setup.baro_p_IP : heightLever(o, setup));
+      alignerOptions(o, baroAligns(o, setup) ? setup.baro_p_IP : heightLever(o, setup));
   if (baroAligns(o, setup)) {
     a.height_tilt_correction = false;
     a.sigma_bias_height_m = o.baro.init_bias_sigma_m;
@@ -162,7 +184,10 @@ std::optional<InitialBelief> Initialization::tryInitialize(const EstimatorInput&
   const auto r = align(Eigen::Vector3d::Zero());
   if (aligner_.relinearizations() > relinearized_before) diag_.count("init_motion_relinearized");
   if (!r) {
-    diag_.count("init_motion_refused");
+    // Why, with its figures (the first few of a run; all are counted): a user whose recording
+    // never initializes sees what the data lacks (ambiguous rival pose, heading, too few ranges).
+    diag_.report("init_motion_refused", "estimator: in-motion alignment at t=" + formatSeconds(t) +
+                                            " refused: " + aligner_.reason());
     return std::nullopt;
   }
   return beliefFrom(*r, landedAt(r->t, landed));
