@@ -257,6 +257,11 @@ class Supervisor:
     def __init__(self, launch, out=sys.stdout):
         self.launch = launch
         self.out = out
+        self.output_lost = False
+        try:
+            self.out_fd = out.fileno()
+        except (AttributeError, OSError, ValueError):
+            self.out_fd = None
         self.cv = threading.Condition(threading.RLock())
         self.events = []  # (name, exit code) reported by the reader threads
         self.running = {}  # name -> Popen of the current incarnation
@@ -270,9 +275,29 @@ class Supervisor:
         self.failed = []
 
     def say(self, name, line):
+        """Writes one prefixed line. Its own output never stops the supervision (issue 36): when
+        stdout is gone (a reader like `head` closed the pipe, the disk is full) the lines are
+        dropped from then on, said once on stderr, and the processes are still watched, their
+        exits handled and the run's exit code kept."""
         with self.cv:
-            self.out.write('[%s] %s\n' % (name, line))
-            self.out.flush()
+            if self.out is None:
+                return
+            try:
+                self.out.write('[%s] %s\n' % (name, line))
+                self.out.flush()
+            except (OSError, ValueError) as e:  # BrokenPipeError, ENOSPC, a closed stream
+                self.out = None
+                self.output_lost = True
+                try:
+                    # Python would fail flushing the broken stdout again at exit: point it at /dev/null.
+                    if self.out_fd is not None:
+                        devnull = os.open(os.devnull, os.O_WRONLY)
+                        os.dup2(devnull, self.out_fd)
+                        os.close(devnull)
+                    sys.stderr.write('supervisor: output lost (%s); still supervising\n' % e)
+                    sys.stderr.flush()
+                except OSError:
+                    pass
 
     def start(self, spec):
         env = dict(os.environ)

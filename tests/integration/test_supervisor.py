@@ -208,6 +208,31 @@ processes:
         self.assertEqual(rc, 0, out)
         self.assertIn('required process core exited', out)
 
+    def test_a_closed_stdout_does_not_stop_the_supervision(self):
+        # Issue 36: `./meshnav up ... | head -1` used to raise BrokenPipeError in say(): the run
+        # aborted, or an output thread died and its process's exit was never seen. Now the lines are
+        # dropped, stderr says so once, and the required process's exit still ends the run with 0.
+        with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
+            f.write('''
+processes:
+  - {name: chatty, command: "sh -c 'i=0; while [ $i -lt 2000 ]; do echo line $i; i=$((i+1)); done; sleep 60'"}
+  - {name: core, command: "sh -c 'sleep 1; exit 0'", required: true}
+''')
+        try:
+            p = subprocess.Popen([sys.executable, SUPERVISOR, f.name], stdout=subprocess.PIPE,
+                                 stderr=subprocess.PIPE, text=True)
+            first = p.stdout.readline()  # the reader takes one line and goes away, as `head -1`
+            p.stdout.close()
+            rc = p.wait(timeout=30)
+            err = p.stderr.read()
+            p.stderr.close()
+        finally:
+            os.unlink(f.name)
+        self.assertIn('[supervisor]', first)
+        self.assertEqual(rc, 0, err)
+        self.assertIn('supervisor: output lost', err)
+        self.assertNotIn('Traceback', err)
+
     def test_sigkill_after_stop_timeout(self):
         rc, out, _ = run_launch('''
 stop_timeout: 0.5
