@@ -81,9 +81,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       recovery_(options_.recovery, options_.init.motion_window_s),
       reentry_(options_.uwb, diag_),
       resume_(options_, setup_, diag_),
-      timeline_(options_.window_s, options_.refine,
-                options_.refine.rerun_on_anchor_join && (options_.strategy != "dah" || options_.refine.rerun_with_dah),
-                diag_),
+      timeline_(options_.window_s, options_.refine, AnchorRerun::enabledBy(options_), diag_),
       rerun_(options_, diag_, timings_) {
   options_.validate();
   resetAll();

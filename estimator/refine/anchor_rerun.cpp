@@ -22,10 +22,14 @@ AnchorRerun::AnchorRerun(const EstimatorOptions& options, Diagnostics& diag, Ste
     : refine_(options.refine),
       diag_(diag),
       timings_(timings),
-      enabled_(options.refine.rerun_on_anchor_join && (options.strategy != "dah" || options.refine.rerun_with_dah)),
+      enabled_(enabledBy(options)),
       async_(options.refine.rerun_mode == "async") {}
 
 AnchorRerun::~AnchorRerun() { abandon(); }
+
+bool AnchorRerun::enabledBy(const EstimatorOptions& options) {
+  return options.refine.rerun_on_anchor_join && (options.strategy != "dah" || options.refine.rerun_with_dah);
+}
 
 void AnchorRerun::reset() {
   joined_.clear();

@@ -68,6 +68,7 @@ class AnchorRerun {
   AnchorRerun& operator=(const AnchorRerun&) = delete;
 
   /// `refine.rerun_on_anchor_join` for this strategy (dah: and `refine.rerun_with_dah`).
+  static bool enabledBy(const EstimatorOptions& options);
   bool enabled() const { return enabled_; }
   /// A worker re-run has not been swapped in yet.
   bool running() const { return running_ != nullptr; }
