@@ -41,6 +41,13 @@ struct FlightVolume {
 /// Optional noise figures overriding the tuning defaults.
 struct NoiseFigures {
   std::optional<double> sigma_range_m;
+  /// 1σ of the constant bias γ of a tag–anchor pair that `pair_biases` does not list, around its
+  /// hardware's common offset [m] (overrides uwb.uncalibrated_gamma_sigma_m). 0: ranges whose
+  /// antenna delays and biases were calibrated before they reached the file (γ = 0 exact).
+  std::optional<double> sigma_gamma_m;
+  /// Correlation time of a pair's range error (γ removed) [s] (overrides
+  /// uwb.range_error_correlation_s). 0: independent errors, as a simulator that draws them so.
+  std::optional<double> range_correlation_time_s;
   std::optional<double> imu_acc_noise_density;   ///< [m/s²/√Hz]
   std::optional<double> imu_gyro_noise_density;  ///< [rad/s/√Hz]
   std::optional<double> imu_acc_bias_rw;         ///< [m/s³/√Hz]

@@ -238,6 +238,8 @@ void readAnchorSigmas(const YAML::Node& sig, const std::string& path, SystemSetu
 NoiseFigures readNoise(YamlOptions& y) {
   NoiseFigures n;
   y.read("noise.sigma_range", n.sigma_range_m);
+  y.read("noise.sigma_gamma", n.sigma_gamma_m);
+  y.read("noise.range_correlation_time", n.range_correlation_time_s);
   y.read("noise.imu_acc_noise_density", n.imu_acc_noise_density);
   y.read("noise.imu_gyro_noise_density", n.imu_gyro_noise_density);
   y.read("noise.imu_acc_bias_rw", n.imu_acc_bias_rw);
@@ -252,6 +254,10 @@ NoiseFigures readNoise(YamlOptions& y) {
                                {"noise.imu_gyro_noise_density", n.imu_gyro_noise_density},
                                {"noise.baro_pressure_sigma", n.baro_pressure_sigma_pa}})
     if (v && !(*v > 0.0)) y.fail(key, "must be > 0");
+  if (n.sigma_gamma_m && !(*n.sigma_gamma_m >= 0.0 && *n.sigma_gamma_m <= 10.0))
+    y.fail("noise.sigma_gamma", "must be in [0, 10] [m]");
+  if (n.range_correlation_time_s && !(*n.range_correlation_time_s >= 0.0 && *n.range_correlation_time_s <= 60.0))
+    y.fail("noise.range_correlation_time", "must be in [0, 60] [s]");
   for (const auto& [key, v] : {std::pair{"noise.imu_acc_bias_rw", n.imu_acc_bias_rw},
                                {"noise.imu_gyro_bias_rw", n.imu_gyro_bias_rw}})
     if (v && !(*v >= 0.0)) y.fail(key, "must be >= 0");
@@ -381,13 +387,15 @@ void saveSetup(const SystemSetup& s, const std::string& path) {
     e << YAML::EndMap;
   }
   const auto& n = s.noise;
-  if (n.sigma_range_m || n.imu_acc_noise_density || n.imu_gyro_noise_density || n.imu_acc_bias_rw ||
+  if (n.sigma_range_m || n.sigma_gamma_m || n.range_correlation_time_s || n.imu_acc_noise_density || n.imu_gyro_noise_density || n.imu_acc_bias_rw ||
       n.imu_gyro_bias_rw || n.imu_acc_bias_sigma || n.imu_gyro_bias_sigma || n.baro_pressure_sigma_pa) {
     e << YAML::Key << "noise" << YAML::Value << YAML::BeginMap;
     auto put = [&](const char* k, const std::optional<double>& v, const char* unit) {
       if (v) e << YAML::Key << k << YAML::Value << *v << YAML::Comment(unit);
     };
     put("sigma_range", n.sigma_range_m, "m");
+    put("sigma_gamma", n.sigma_gamma_m, "m, constant bias of a pair not in pair_biases (1 sigma); 0 = calibrated ranges");
+    put("range_correlation_time", n.range_correlation_time_s, "s, of a pair's range error; 0 = independent errors");
     put("imu_acc_noise_density", n.imu_acc_noise_density, "m/s^2/sqrt(Hz)");
     put("imu_gyro_noise_density", n.imu_gyro_noise_density, "rad/s/sqrt(Hz)");
     put("imu_acc_bias_rw", n.imu_acc_bias_rw, "m/s^3/sqrt(Hz)");

@@ -66,6 +66,7 @@ const Field kFields[] = {
     {"uwb.use_corrected_range", field<&EstimatorOptions::uwb, &UwbOptions::use_corrected_range>, "fuse range_corr instead of range_raw (one more than 1 m from it is bad input)"},
     {"uwb.max_range_m", field<&EstimatorOptions::uwb, &UwbOptions::max_range_m>, "longer ranges are bad input [m]"},
     {"uwb.estimate_tag_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_tag_biases>, "estimate tag-anchor gamma (setup anchors, sigma_gamma > 0) as states"},
+    {"uwb.uncalibrated_gamma_sigma_m", field<&EstimatorOptions::uwb, &UwbOptions::uncalibrated_gamma_sigma_m>, "1 sigma of a tag-anchor pair's own constant bias when setup.yaml does not list the pair (around the tag's common offset; setup noise.sigma_gamma overrides); 0 = such a pair is exact [m]"},
     {"uwb.estimate_anchor_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_anchor_biases>, "estimate a calibrated anchor's gamma (ANCHOR_INIT, sigma_gamma > 0) as states of its instance"},
     {"uwb.estimate_setup_anchor_biases", field<&EstimatorOptions::uwb, &UwbOptions::estimate_setup_anchor_biases>, "the same for known-but-uncertain setup anchors (towards exact and smaller-id uncertain anchors)"},
     {"uwb.fuse_calibrated_anchor_pairs", field<&EstimatorOptions::uwb, &UwbOptions::fuse_calibrated_anchor_pairs>, "fuse ranges between two calibrated anchors (their correlated calibration errors are not known)"},
@@ -124,6 +125,8 @@ const Field kModelParameters[] = {
     {"uwb.dah_joint_tag_biases", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_tag_biases>, "dah only: the tags' gamma instances join the anchors' joint set (merges the batches into one)"},
     {"uwb.dah_joint_imu", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_imu>, "dah only: the IMU (with the baro and height biases) joins that set too (every pose update also corrects its anchors)"},
     {"uwb.dah_joint_max_anchors", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_max_anchors>, "dah only: most estimated anchors in a joint set, the most refined leave first, 0 = no bound [-]"},
+    {"uwb.uncalibrated_common_gamma_sigma_m", field<&EstimatorOptions::uwb, &UwbOptions::uncalibrated_common_gamma_sigma_m>, "1 sigma of the offset common to an unlisted tag's pairs [m]"},
+    {"uwb.range_error_correlation_s", field<&EstimatorOptions::uwb, &UwbOptions::range_error_correlation_s>, "correlation time of a pair's range error: R x (1 + rho)/(1 - rho), rho = exp(-dt/tau), dt since the pair's previous range; 0 = white [s]"},
     {"uwb.reentry_hold_s", field<&EstimatorOptions::uwb, &UwbOptions::reentry_hold_s>, "longest hold after a gap, at most window_s [s]"},
     {"uwb.reentry_min_ranges", field<&EstimatorOptions::uwb, &UwbOptions::reentry_min_ranges>, "held ranges needed to test them against each other [-]"},
     {"uwb.reentry_min_anchors", field<&EstimatorOptions::uwb, &UwbOptions::reentry_min_anchors>, "distinct anchors among them [-]"},
@@ -288,6 +291,11 @@ void EstimatorOptions::validate() const {
   need(uwb.sigma_range_m > 0 && uwb.max_range_m > 0, "uwb.sigma_range_m > 0, uwb.max_range_m > 0");
   need(uwb.gate_probability >= 0 && uwb.gate_probability < 1, "uwb.gate_probability in [0, 1)");
   need(uwb.huber_k >= 0 && uwb.huber_max_prior_ratio >= 0, "uwb.huber_k >= 0, uwb.huber_max_prior_ratio >= 0");
+  need(uwb.uncalibrated_gamma_sigma_m >= 0 && uwb.uncalibrated_gamma_sigma_m <= 10 &&
+           uwb.uncalibrated_common_gamma_sigma_m >= 0 && uwb.uncalibrated_common_gamma_sigma_m <= 10,
+       "uwb.uncalibrated_gamma_sigma_m and uwb.uncalibrated_common_gamma_sigma_m in [0, 10] [m]");
+  need(uwb.range_error_correlation_s >= 0 && uwb.range_error_correlation_s <= 60,
+       "uwb.range_error_correlation_s in [0, 60] [s]");
   need(process_noise.batch >= 5 && process_noise.upper_ratio > 1.0 && process_noise.lower_ratio > 0.0 &&
            process_noise.lower_ratio < 1.0 && process_noise.max_grow > 1.0 && process_noise.max_shrink > 1.0 &&
            process_noise.max_scale >= 1.0 && process_noise.max_prior_ratio > 0.0,
@@ -304,6 +312,8 @@ void EstimatorOptions::validate() const {
 }
 
 void EstimatorOptions::applySetupNoise(const NoiseFigures& n) {
+  if (n.sigma_gamma_m) uwb.uncalibrated_gamma_sigma_m = *n.sigma_gamma_m;
+  if (n.range_correlation_time_s) uwb.range_error_correlation_s = *n.range_correlation_time_s;
   if (n.imu_acc_noise_density) imu.acc_noise_density = *n.imu_acc_noise_density;
   if (n.imu_gyro_noise_density) imu.gyro_noise_density = *n.imu_gyro_noise_density;
   if (n.imu_acc_bias_rw) imu.acc_bias_rw = *n.imu_acc_bias_rw;

@@ -5,6 +5,7 @@
 /// missing key keeps its default; the defaults here equal the shipped file. Setup noise figures (setup.yaml `noise:`)
 /// override the matching defaults at construction of the node (see `applySetupNoise`).
 
+#include <cmath>
 #include <string>
 
 #include "common/chi_square.h"
@@ -141,6 +142,29 @@ struct UwbOptions {
   /// Estimate γ of tag–setup-anchor pairs whose a-priori bias has sigma_gamma > 0 as states of the
   /// tag instances (else their σ_γ inflates the range noise).
   bool estimate_tag_biases = true;
+  /// The constant bias of a tag–setup-anchor pair that setup.yaml `pair_biases` does not list
+  /// (docs/uwb_bias_model.md). Every UWB pair has one (antenna delays, the received-power bias;
+  /// STAR-loc's raw ranges +0.09 to +0.39 m): γ(tag, a) = c_tag + e(tag, a), c_tag the offset
+  /// common to the tag's pairs (N(0, uncalibrated_common_gamma_sigma_m²)), e the pair's own part
+  /// (N(0, σ²), σ this value [m]). With `estimate_tag_biases` the γ are states of the tag's
+  /// instance with that prior (covariance σ_c² 11ᵀ + σ² I); else σ_c² + σ² inflates the pair's
+  /// range noise. 0: an unlisted pair is exact (γ = 0; calibrated ranges, setup `noise.sigma_gamma: 0`).
+  double uncalibrated_gamma_sigma_m = 0.1;
+  /// σ_c of the common part above [m]. Model parameter: the STAR-loc run is the same to 1 mm for
+  /// 0.2–1.0 m (the data fix c), so it is a wide prior, not a tuning.
+  double uncalibrated_common_gamma_sigma_m = 0.5;
+  /// Correlation time τ of a pair's range error once its γ is removed [s] (RangeErrorCorrelation:
+  /// a range Δt after its pair's previous one is fused with R (1 + ρ)/(1 − ρ), ρ = e^(−Δt/τ)).
+  /// Model parameter: STAR-loc's errors against its truth have autocorrelation 0.52 at 0.1 s (one
+  /// pair's ranges 0.072 s apart), which a first-order process has at τ ≈ 0.1 s; ranges of a pair
+  /// seconds apart (MILUV's) are unchanged. 0: white errors. setup.yaml `noise.range_correlation_time`
+  /// overrides it: the simulator, whose errors are drawn independently, writes 0.
+  double range_error_correlation_s = 0.1;
+  /// Whole a-priori σ of an unlisted pair's γ, √(σ_c² + σ²) (0 when such a pair is exact) [m].
+  double uncalibratedPairSigma() const {
+    return uncalibrated_gamma_sigma_m > 0.0 ? std::hypot(uncalibrated_common_gamma_sigma_m, uncalibrated_gamma_sigma_m)
+                                            : 0.0;
+  }
   /// Estimate the γ of an anchor added at run time (ANCHOR_INIT: its calibrated biases with
   /// sigma_gamma > 0) as states of the anchor's instance (issue 10). Else they are fixed
   /// dictionary values whose σ_γ inflates the range noise.

@@ -103,7 +103,9 @@ void EstimatorNode::resetAll() {
   sensors_.zupt = ZuptModel(gravityG());
   cur_ = FilterContext{};
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);
-  cur_.network = std::make_shared<const UwbNetwork>(setup_, options_.uwb.sigma_range_m);
+  cur_.range_errors = RangeErrorCorrelation(options_.uwb.range_error_correlation_s);
+  cur_.network = std::make_shared<const UwbNetwork>(setup_, options_.uwb.sigma_range_m,
+                                                    options_.uwb.uncalibratedPairSigma());
   rerun_.abandon();  // its base is gone
   timeline_.clear();
   rerun_.reset();

@@ -77,13 +77,16 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
     event(first, why);
     return;
   }
-  const Linearization& lin = *linearized;
+  Linearization lin = *linearized;
+  // Correlated errors: a range soon after its pair's previous one carries less new information.
+  lin.R *= cur_.range_errors.inflation(z.a, z.b, s.t);
   const bool tag_range = cur_.network->isTag(z.a) || cur_.network->isTag(z.b);
   bool count = first;
   if (tag_range &&
       !reentry_.admit(s, cur_.network->isTag(z.a) ? z.b : z.a, lin, *cur_.filter, timeline_.start(), first, &count))
     return;
   const UpdateResult r = sensors_.range.update(*cur_.filter, lin);
+  cur_.range_errors.noteRange(z.a, z.b, s.t);  // fused or gated: the error process went on
   const double prior_ratio = RangeUpdater::priorRatio(lin, r);
   const long decisions = cur_.noise_adapter.decisions();
   if (tag_range && cur_.noise_adapter.onRangeNis(r.nis, prior_ratio, r.accepted) && first) {

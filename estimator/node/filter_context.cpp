@@ -17,6 +17,7 @@ FilterContext FilterContext::copy() const {
   s.rest_rate = rest_rate;
   s.last_carried_height = last_carried_height;
   s.noise_adapter = noise_adapter;
+  s.range_errors = range_errors;
   s.mean_reading = mean_reading;
   return s;
 }

@@ -20,6 +20,7 @@
 #include "estimator/filter/fusion_strategy.h"
 #include "estimator/imu/imu_readings.h"
 #include "estimator/imu/process_noise_adapter.h"
+#include "estimator/uwb/range_error_correlation.h"
 #include "estimator/uwb/uwb_network.h"
 #include "estimator/zupt/rest_rate_mean.h"
 
@@ -35,6 +36,7 @@ struct FilterContext {
   RestRateMean rest_rate;  ///< gyro readings since last_zupt while landed (the ZUPT's ω row)
   Timestamp last_carried_height;  ///< last carried-height pseudo-reading (IMU time)
   ProcessNoiseAdapter noise_adapter;  ///< IMU noise scale from the range innovations
+  RangeErrorCorrelation range_errors;  ///< each pair's newest range (the R inflation of the next)
   /// Low-passed (time constant imu.gap_mean_time_constant_s) acceleration and angular rate in
   /// G (`acc_m_s2` = R̂(a_m − b̂_a) + g, `gyro_rad_s` = R̂(ω_m − b̂_ω)): what an IMU gap is
   /// propagated on with imu.gap_readings "mean" (the rate's vertical part only).

@@ -89,6 +89,8 @@ SystemSetup syntheticSetup(const SyntheticOptions& o) {
     s.initial_pose = ip;
   }
   s.noise.sigma_range_m = o.sigma_range_m;
+  s.noise.sigma_gamma_m = 0.0;  // the ranges below have γ = 0 for every unlisted pair: calibrated
+  s.noise.range_correlation_time_s = 0.0;  // and independent errors
   s.noise.imu_acc_noise_density = o.acc_noise_density;
   s.noise.imu_gyro_noise_density = o.gyro_noise_density;
   s.noise.baro_pressure_sigma_pa = o.baro_sigma_pa;

@@ -4,13 +4,24 @@
 
 namespace meshnav::estimator {
 
-UwbNetwork::UwbNetwork(const SystemSetup& setup, double fallback_sigma_m)
+UwbNetwork::UwbNetwork(const SystemSetup& setup, double fallback_sigma_m, double uncalibrated_gamma_sigma_m)
     : tags_p_TinI_(setup.rel_tag_positions),
       setup_sigma_m_(setup.noise.sigma_range_m),
       fallback_sigma_m_(fallback_sigma_m) {
   for (const auto& [id, p] : setup.abs_anchor_positions)
     if (!setup.abs_anchor_sigmas_m.count(id)) exact_anchors_p_AinG_[id] = p;
   for (const PairBias& b : setup.pair_biases) setPairBias(b);
+  if (uncalibrated_gamma_sigma_m > 0.0)
+    for (const auto& [tag, lever] : tags_p_TinI_)
+      for (const auto& [anchor, p] : exact_anchors_p_AinG_) {
+        if (hasPairBias(tag, anchor)) continue;
+        PairBias b;
+        b.a = tag;
+        b.b = anchor;
+        b.sigma_m = 0.0;  // the range σ from rangeSigma's fallbacks, as for any unlisted pair
+        b.sigma_gamma_m = uncalibrated_gamma_sigma_m;
+        setPairBias(b);
+      }
 }
 
 const Eigen::Vector3d* UwbNetwork::tagLeverArm(SensorId id) const {

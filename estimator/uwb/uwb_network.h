@@ -20,8 +20,11 @@ class UwbNetwork {
  public:
   UwbNetwork() = default;
   /// Tags and biases from `setup`; anchors in setup.abs_anchor_positions without a σ in
-  /// setup.abs_anchor_sigmas_m are exact. `fallback_sigma_m` is the config range σ.
-  UwbNetwork(const SystemSetup& setup, double fallback_sigma_m);
+  /// setup.abs_anchor_sigmas_m are exact. `fallback_sigma_m` is the config range σ. A pair of a
+  /// tag and an exact anchor that setup.pair_biases does not list gets γ = 0 with σ_γ =
+  /// `uncalibrated_gamma_sigma_m` when that is > 0 (uwb.uncalibrated_gamma_sigma_m: its γ is
+  /// unknown, not zero), so that a fixed γ inflates the range noise by it.
+  UwbNetwork(const SystemSetup& setup, double fallback_sigma_m, double uncalibrated_gamma_sigma_m = 0.0);
 
   bool isTag(SensorId id) const { return tags_p_TinI_.count(id) > 0; }
   const Eigen::Vector3d* tagLeverArm(SensorId id) const;

@@ -85,6 +85,8 @@ class MiluvRobot(unittest.TestCase):
         self.assertEqual(sorted(setup["abs_anchor_positions"]), [100, 101, 102, 103, 104, 105])
         self.assertEqual(setup["imu_id"], 1)
         self.assertNotIn("baro", setup)
+        # MILUV's `range` column is calibrated (its raw range is `range_raw`): unlisted pairs exact.
+        self.assertEqual(setup["noise"], {"sigma_gamma": 0.0})
         truth = rs.read_yaml(os.path.join(self.out["ifo002"], "truth.yaml"))
         self.assertIs(truth["align_required"], False)
         self.assertEqual(truth["anchor_positions"], setup["abs_anchor_positions"])

@@ -170,8 +170,14 @@ def run(args):
     dw.write_csv(os.path.join(out, "groundtruth.csv"), dw.TUM_HEADER, dw.sort_by_time(mocap, report, "groundtruth.csv"))
     if height:
         dw.write_csv(os.path.join(out, "height.csv"), dw.HEIGHT_HEADER, dw.sort_by_time(height, report, "height.csv"))
-    note = "no noise figures: the PX4 IMU's are not published with the data; the estimator's defaults apply"
-    dw.write_setup_yaml(os.path.join(out, "setup.yaml"), own, mapped, IMU_ID, None, comments=(
+    note = "no IMU noise figures: the PX4 IMU's are not published with the data; the estimator's defaults apply"
+    # MILUV's `range` is its processed range, antenna delays and the received-power bias removed
+    # (the file keeps `range_raw` and `bias_raw` beside it): the pairs are calibrated, so their
+    # constant biases are not states (docs/uwb_bias_model.md). `range_raw` keeps the default model.
+    noise = {"sigma_gamma": 0.0} if args.range_column == "range" else None
+    if noise:
+        note += "; noise.sigma_gamma 0: column 'range' is calibrated (antenna delays and power bias removed by MILUV)"
+    dw.write_setup_yaml(os.path.join(out, "setup.yaml"), own, mapped, IMU_ID, noise, comments=(
         f"imported from MILUV {os.path.basename(os.path.normpath(args.dir))}/{args.robot} by ./meshnav import miluv",
         f"anchor ids = MILUV anchor id + {off}; tag ids as in MILUV; ranges column '{args.range_column}'", note))
     dw.write_truth_yaml(os.path.join(out, "truth.yaml"), mapped, "vicon world (the anchors' frame)", False, comments=(

@@ -86,6 +86,17 @@ TEST(Setup, RoundTrip) {
   ASSERT_TRUE(rb.noise.imu_acc_bias_sigma && rb.noise.imu_gyro_bias_sigma);
   EXPECT_DOUBLE_EQ(*rb.noise.imu_acc_bias_sigma, 0.01);
   EXPECT_DOUBLE_EQ(*rb.noise.imu_gyro_bias_sigma, 5e-4);
+  // The unlisted pairs' bias σ, 0 included (calibrated ranges), written only when given.
+  EXPECT_FALSE(rb.noise.sigma_gamma_m);
+  auto g = s;
+  g.noise.sigma_gamma_m = 0.0;
+  g.noise.range_correlation_time_s = 0.0;
+  saveSetup(g, (d / "gamma.yaml").string());
+  const auto rg = loadSetup((d / "gamma.yaml").string());
+  ASSERT_TRUE(rg.noise.sigma_gamma_m);
+  EXPECT_DOUBLE_EQ(*rg.noise.sigma_gamma_m, 0.0);
+  ASSERT_TRUE(rg.noise.range_correlation_time_s);
+  EXPECT_DOUBLE_EQ(*rg.noise.range_correlation_time_s, 0.0);
 }
 
 TEST(Setup, ReadsThePublishedToolboxConfig) {
@@ -163,6 +174,10 @@ TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
   EXPECT_NE(error(base + "height: {p_IH: [0, 0]}\n").find("height.p_IH"), std::string::npos);
   EXPECT_NE(error(base + "noise: {sigma_range: -0.1}\n").find("key 'noise.sigma_range' must be > 0"), std::string::npos);
   EXPECT_NE(error(base + "noise: {imu_acc_bias_sigma: 0}\n").find("key 'noise.imu_acc_bias_sigma' must be > 0"),
+            std::string::npos);
+  EXPECT_NE(error(base + "noise: {sigma_gamma: -0.1}\n").find("key 'noise.sigma_gamma' must be in [0, 10]"),
+            std::string::npos);
+  EXPECT_NE(error(base + "noise: {range_correlation_time: 100}\n").find("key 'noise.range_correlation_time' must be in [0, 60]"),
             std::string::npos);
   EXPECT_NE(error(base + "noise: {sigma_rnage: 0.1}\n").find("unknown key 'noise.sigma_rnage'"), std::string::npos);
   EXPECT_NE(error(base + "carried_height: {sigma_m: 0.3}\n").find("carried_height.height_m"), std::string::npos);

@@ -62,6 +62,19 @@ TEST(FilterContext, ACopyDoesNotChangeWithItsOriginal) {
   EXPECT_DOUBLE_EQ(before.rest_rate.span(), 0.1);
 }
 
+TEST(FilterContext, ARewindRestoresEachPairsPreviousRange) {
+  // The R inflation of correlated range errors depends on the pair's previous range: a rewind to
+  // a copy must see the history as it was then, not the ranges processed after it.
+  const EstimatorOptions o;
+  FilterContext c = smallContext(o);
+  c.range_errors = RangeErrorCorrelation(0.1);
+  c.range_errors.noteRange(1001, 4, at(1.0));
+  const FilterContext before = c.copy();
+  c.range_errors.noteRange(1001, 4, at(1.05));
+  EXPECT_NEAR(before.range_errors.inflation(1001, 4, at(1.1)), c.range_errors.inflation(1001, 4, at(1.15)), 1e-12);
+  EXPECT_GT(c.range_errors.inflation(1001, 4, at(1.1)), before.range_errors.inflation(1001, 4, at(1.1)));
+}
+
 TEST(FilterContext, ReplaceImuKeepsTheOtherInstancesAndRestartsTheReadings) {
   EstimatorOptions o;
   o.baro.init_bias_sigma_m = 1.0;

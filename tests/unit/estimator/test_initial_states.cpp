@@ -68,6 +68,7 @@ TEST(InitialStates, WithSetupAnchorBiasesEachPairHasOneOwner) {
 
 TEST(InitialStates, TagBiasesTowardsAnchorsWithAnUncertainGamma) {
   UwbOptions o;
+  o.uncalibrated_gamma_sigma_m = 0.0;  // unlisted pairs exact: only the listed uncertain γ
   auto f = filter();
   addTagBiasStates(*f, setup(), o);
   const auto& tags = f->state().values<TagBiasKind>();
@@ -79,4 +80,44 @@ TEST(InitialStates, TagBiasesTowardsAnchorsWithAnUncertainGamma) {
   auto g = filter();
   addTagBiasStates(*g, setup(), o);
   EXPECT_TRUE(g->state().values<TagBiasKind>().empty());
+}
+
+TEST(InitialStates, UnlistedPairsShareTheirTagsCommonOffsetAndKeepTheirOwnPart) {
+  // γ(tag, a) = c_tag + e(tag, a): the unlisted pairs of one tag have prior covariance
+  // σ_c² 11ᵀ + σ² I, a listed uncertain pair keeps its own σ_γ² and is uncorrelated with them, a
+  // listed exact pair is no state.
+  UwbOptions o;
+  o.uncalibrated_gamma_sigma_m = 0.1;
+  o.uncalibrated_common_gamma_sigma_m = 0.5;
+  auto f = filter();
+  addTagBiasStates(*f, setup(), o);
+  const auto& tags = f->state().values<TagBiasKind>();
+  ASSERT_EQ(tags.size(), 2u);
+  // Tag 11: 101 listed (0.1 ± 0.05), 102 unlisted, 103 listed (−0.2 ± 0.1), 104 unlisted.
+  EXPECT_EQ(tags.at(11).peers, (std::vector<SensorId>{101, 102, 103, 104}));
+  EXPECT_DOUBLE_EQ(tags.at(11).gamma_m(0), 0.1);
+  EXPECT_DOUBLE_EQ(tags.at(11).gamma_m(1), 0.0);
+  const Eigen::MatrixXd P11 = f->covariance(11, 11);
+  EXPECT_DOUBLE_EQ(P11(1, 1), 0.5 * 0.5 + 0.1 * 0.1);
+  EXPECT_DOUBLE_EQ(P11(3, 3), 0.5 * 0.5 + 0.1 * 0.1);
+  EXPECT_DOUBLE_EQ(P11(1, 3), 0.5 * 0.5) << "two unlisted pairs of one tag share c_tag";
+  EXPECT_DOUBLE_EQ(P11(0, 0), 0.05 * 0.05);
+  EXPECT_DOUBLE_EQ(P11(0, 1), 0.0) << "a listed pair has its own calibration";
+  // Tag 12: 102 listed exact (no state); 101, 103, 104 unlisted.
+  EXPECT_EQ(tags.at(12).peers, (std::vector<SensorId>{101, 103, 104}));
+  EXPECT_TRUE(f->covariance(12, 12).isApprox(Eigen::Matrix3d::Constant(0.25) + 0.01 * Eigen::Matrix3d::Identity()));
+  // Calibrated ranges (setup noise.sigma_gamma: 0): unlisted pairs are exact again.
+  EstimatorOptions e;
+  NoiseFigures n;
+  n.sigma_gamma_m = 0.0;
+  e.applySetupNoise(n);
+  auto g = filter();
+  addTagBiasStates(*g, setup(), e.uwb);
+  EXPECT_EQ(g->state().values<TagBiasKind>().at(11).peers, (std::vector<SensorId>{101, 103}));
+  EXPECT_EQ(g->state().values<TagBiasKind>().count(12), 0u);
+  // The range errors' correlation time comes from the setup too (a simulator's: 0, independent).
+  EXPECT_DOUBLE_EQ(e.uwb.range_error_correlation_s, 0.1);
+  n.range_correlation_time_s = 0.0;
+  e.applySetupNoise(n);
+  EXPECT_DOUBLE_EQ(e.uwb.range_error_correlation_s, 0.0);
 }

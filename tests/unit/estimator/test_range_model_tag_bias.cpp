@@ -88,3 +88,21 @@ TEST(RangeModelTagBias, EkfLearnsAConstantBiasFromRepeatedRanges) {
   EXPECT_NEAR(ekf.state().values<TagBiasKind>().at(100).gamma_m(0), 0.25, 0.005);
   EXPECT_LT(ekf.covariance(100, 100)(0, 0), 0.2 * 0.02 * 0.02);
 }
+
+TEST(RangeModelTagBias, AnUnlistedPairIsUnknownNotZero) {
+  // Without a γ state (uwb.estimate_tag_biases off) an unlisted tag–anchor pair's a-priori σ_γ
+  // (given to the network) inflates its range noise; a listed pair keeps its own.
+  SystemSetup setup = setupWithUncertainBias();
+  setup.abs_anchor_positions[102] = {3.0, 1.0, 1.5};  // not in pair_biases
+  const UwbNetwork net(setup, 0.15, 0.3);
+  NominalState x = stateWithGamma(0.0);
+  x.values<TagBiasKind>().clear();
+  Linearization lin;
+  ASSERT_EQ(RangeModel::linearize({Timestamp{}, 100, 102, 3.0, 0.0}, x, net, &lin), RangeModel::Status::Ok);
+  EXPECT_NEAR(lin.R(0, 0), 0.15 * 0.15 + 0.3 * 0.3, 1e-12) << "fallback σ, then σ_γ of the unknown pair";
+  ASSERT_EQ(RangeModel::linearize({Timestamp{}, 100, 101, 5.0, 0.0}, x, net, &lin), RangeModel::Status::Ok);
+  EXPECT_NEAR(lin.R(0, 0), 0.1 * 0.1 + 0.02 * 0.02, 1e-12) << "the listed pair is unchanged";
+  const UwbNetwork exact(setup, 0.15);  // 0: unlisted pairs exact
+  ASSERT_EQ(RangeModel::linearize({Timestamp{}, 100, 102, 3.0, 0.0}, x, exact, &lin), RangeModel::Status::Ok);
+  EXPECT_NEAR(lin.R(0, 0), 0.15 * 0.15, 1e-12);
+}
