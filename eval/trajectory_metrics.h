@@ -37,6 +37,8 @@ struct EvalOptions {
   /// align_required, else none.
   std::optional<AlignmentMode> align;
   bool baseline = true;            ///< also evaluate the multilateration baseline
+  /// Leave out the stretches where groundtruth.csv contradicts imu.csv's gyro (truth_consistency.h).
+  bool check_truth_with_gyro = true;
   double baseline_window_s = 0.03;  ///< its epoch length [s]: one RTLS message of ISAS-Walk1 (51 ms apart)
 };
 

@@ -31,7 +31,7 @@ constexpr char kDescription[] =
 /// The command line of meshnav_eval (EvalOptions holds the defaults of the metric options).
 struct EvalCli {
   EvalOptions eval;
-  bool no_baseline = false;
+  bool no_baseline = false, no_truth_check = false;
   std::string align;
   std::string dataset, run, out, json, calibration, batch, table_md;
   std::string dataset_subdir = "dataset", run_subdir = "run";
@@ -50,6 +50,9 @@ void declareOptions(Cli& cli, EvalCli& c) {
   cli.option("skip", c.eval.skip_first_s, "ignore the first S seconds after the first estimate [s]")
       ->type_name("S")->check(cli::nonNegative());
   cli.flag("only-flying", c.eval.only_flying, "evaluate only while not landed (flight_state.csv); default: all samples");
+  cli.flag("no-truth-check", c.no_truth_check,
+           "keep the ground truth where it contradicts imu.csv's gyro (by default those windows are left out and "
+           "listed: a motion-capture dropout; eval/truth_consistency.h)");
   cli.option("max-gt-gap", c.eval.max_gt_gap_s, "largest ground-truth gap that is interpolated [s]")
       ->type_name("S")->check(cli::positive());
   cli.optional("align", c.align,
@@ -85,6 +88,7 @@ void declareOptions(Cli& cli, EvalCli& c) {
 EvalOptions optionsFrom(const EvalCli& c) {
   EvalOptions o = c.eval;
   o.baseline = !c.no_baseline;
+  o.check_truth_with_gyro = !c.no_truth_check;
   if (!c.align.empty()) o.align = parseAlignmentMode(c.align);
   return o;
 }

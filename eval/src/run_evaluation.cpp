@@ -8,6 +8,7 @@
 #include "common/dataset.h"
 #include "common/estimate_io.h"
 #include "common/setup.h"
+#include "eval/truth_consistency.h"
 
 namespace fs = std::filesystem;
 
@@ -34,6 +35,34 @@ void readGroundTruth(RunEvaluation& ev, const fs::path& ds, Diagnostics& diag) {
       note(ev, std::string("cannot read ground truth: ") + ex.what());
     }
   }
+}
+
+/// Drops the truth where it contradicts the gyro of imu.csv (a motion-capture dropout): each such
+/// window is noted and counted ("eval:truth_gyro_mismatch"), its estimates are then not scored.
+void checkTruthWithGyro(RunEvaluation& ev, const fs::path& ds, Diagnostics& diag) {
+  const fs::path imu_path = ds / "imu.csv";
+  if (!ev.options.check_truth_with_gyro || !ev.has_ground_truth || !fs::exists(imu_path)) return;
+  std::vector<ImuSample> imu;
+  try {
+    Diagnostics imu_diag;  // the estimator reports imu.csv's rows; here they only serve the check
+    imu = readImuCsv(imu_path.string(), imu_diag);
+  } catch (const std::exception& ex) {
+    note(ev, std::string("truth check against the gyro skipped: ") + ex.what());
+    return;
+  }
+  const std::vector<TruthFault> faults = truthGyroFaults(ev.ground_truth, imu);
+  if (faults.empty()) return;
+  diag.count("eval:truth_gyro_mismatch", static_cast<int64_t>(faults.size()));
+  std::string where;
+  for (size_t k = 0; k < faults.size() && k < 5; ++k)
+    where += (k ? ", " : "") + formatSeconds(faults[k].t0) + "–" + formatSeconds(faults[k].t1) + " s (truth " +
+             std::to_string(faults[k].truth_angle_rad).substr(0, 5) + ", gyro " +
+             std::to_string(faults[k].gyro_angle_rad).substr(0, 5) + " rad)";
+  const size_t dropped = dropTruthInFaults(ev.ground_truth, faults);
+  note(ev, "ground truth contradicts the gyro of imu.csv in " + std::to_string(faults.size()) + " stretch(es): " + where +
+               (faults.size() > 5 ? ", ..." : "") + "; its " + std::to_string(dropped) +
+               " poses there are left out (--no-truth-check keeps them; eval/truth_consistency.h)");
+  ev.has_ground_truth = ev.ground_truth.size() >= 2;
 }
 
 /// The alignment of the estimate: --align if given, else se3 when truth.yaml says the ground truth
@@ -132,6 +161,7 @@ RunEvaluation evaluateRun(const std::string& dataset_dir, const std::string& run
   const fs::path ds(dataset_dir), run(run_dir);
 
   readGroundTruth(ev, ds, diag);
+  checkTruthWithGyro(ev, ds, diag);
 
   // Setup (known anchors) and truth.
   std::map<SensorId, Eigen::Vector3d> known;

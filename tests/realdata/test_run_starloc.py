@@ -1,9 +1,12 @@
-"""End to end on STAR-loc loop2d-s1 (issue 34, item 7): the folder is already in the dataset
-format; `meshnav_run` with its defaults and `meshnav_eval` with no alignment (Vicon is the anchors'
-frame). Asserted: the figures measured on 2026-12-05 (position ATE 0.542 m, ANEES 88, orientation
-12.85 deg; plain multilateration scored as tag positions 1.256 m) within a margin, and that the
-estimate beats multilateration. The issue's targets (<= 0.25 m, ANEES <= 6, <= 5 deg) are NOT
-reached; docs/results.md says so. When a model moves these figures, update MEASURED and the doc."""
+"""End to end on STAR-loc loop2d-s1 (issue 34): the folder is already in the dataset format;
+`meshnav_run` with its defaults and `meshnav_eval` with no alignment (Vicon is the anchors' frame).
+The evaluation leaves out 6.34-7.32 s, where the Vicon truth contradicts the IMU's gyro (the
+dataset README's dropout; eval/truth_consistency.h); the test asserts that it finds that stretch.
+Asserted: the issue's targets (ATE <= 0.25 m, orientation <= 5 deg, position ANEES <= 6 with 10 %
+for toolchain differences; measured 2026-12-05: 0.163 m, 3.70 deg, 5.95) and, against
+regressions, the measured ATE within 0.05 m; plain multilateration scored as tag positions
+(1.257 m) is the baseline the estimate must beat. When a model moves these figures, update
+MEASURED and docs/results.md."""
 
 import os
 import re
@@ -14,9 +17,11 @@ import unittest
 import realdata_support as rs
 
 STARLOC_DIR = os.path.join(rs.SHARED, "data", "real-starloc-loop2d-s1")
-# ATE [m], position ANEES, orientation RMSE [deg], multilateration ATE [m] (2026-12-05, main at 5954736).
-MEASURED = {"ate": 0.542, "anees": 88.14, "ori": 12.85, "multilateration": 1.256}
-ATE_MARGIN_M = 0.1  # deterministic run; the margin absorbs compiler/libm differences
+# ATE [m], position ANEES, orientation RMSE [deg], multilateration ATE [m] (2026-12-05, the pair-bias
+# and correlated-error models, the truth check; before them 0.542 m, 88, 12.85 deg).
+MEASURED = {"ate": 0.163, "anees": 5.95, "ori": 3.70, "multilateration": 1.257}
+TARGET = {"ate": 0.25, "anees": 6.0, "ori": 5.0}  # issue 34
+ATE_MARGIN_M = 0.05  # deterministic run; the margin absorbs compiler/libm differences
 
 
 class StarlocEndToEnd(unittest.TestCase):
@@ -41,12 +46,16 @@ class StarlocEndToEnd(unittest.TestCase):
         ori = re.search(r"^orientation \[deg\]\s+([0-9.]+)", e.stdout, re.M)
         for m in (ate, ml, pos, ori):
             self.assertIsNotNone(m, e.stdout)
-        self.assertLess(float(ate.group(1)), MEASURED["ate"] + ATE_MARGIN_M, e.stdout)
+        self.assertLess(float(ate.group(1)), min(TARGET["ate"], MEASURED["ate"] + ATE_MARGIN_M), e.stdout)
         self.assertLess(float(ate.group(1)), float(ml.group(1)), "the estimate should beat plain multilateration")
         self.assertLess(abs(float(ml.group(1)) - MEASURED["multilateration"]), 0.05, e.stdout)
-        # Overconfident today (issue 34): the ANEES is reported, and a model that fixes it moves it down.
-        self.assertLess(float(pos.group(2)), 2.0 * MEASURED["anees"], e.stdout)
-        self.assertLess(float(ori.group(1)), MEASURED["ori"] + 3.0, e.stdout)
+        self.assertLess(float(pos.group(2)), 1.1 * TARGET["anees"], e.stdout)
+        self.assertLess(float(ori.group(1)), TARGET["ori"], e.stdout)
+        # The Vicon dropout is found from the data, not from a list of times.
+        fault = re.search(r"ground truth contradicts the gyro of imu.csv in 1 stretch\(es\): ([0-9.]+)–([0-9.]+) s",
+                          e.stdout + e.stderr)
+        self.assertIsNotNone(fault, e.stdout + e.stderr)
+        self.assertTrue(6.2 <= float(fault.group(1)) <= 6.5 and 7.2 <= float(fault.group(2)) <= 7.4, fault.group(0))
 
 
 if __name__ == "__main__":
