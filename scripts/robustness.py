@@ -42,7 +42,7 @@ SKIP_S = 10.0           # initial transient left out of the max error [s]
 BAD_ANCHOR_M = 0.5      # final error of a calibrated anchor that counts as a bad anchor [m]
 ANCHOR_NEES_BOUND = 13.93  # chi^2(3) at 99.7 %: a final anchor NEES above it is overconfident
 SCENARIO_KEYS = {"name", "seed", "trajectory", "hall", "anchor_layout", "tags", "known", "unknown",
-                 "sigma_range", "outliers", "drop", "imu_grade", "duration", "bias_max"}
+                 "sigma_range", "outliers", "drop", "imu_grade", "duration", "bias_max", "nlos", "range_correlation"}
 
 
 def pick(rng, items):
@@ -54,9 +54,12 @@ def uniform(rng, lo, hi, digits):
     return round(lo + (hi - lo) * rng.random(), digits)
 
 
-def draw_scenarios(runs, seed, duration_s):
-    """`runs` scenarios drawn deterministically from `seed` over the sweep's space."""
+def draw_scenarios(runs, seed, duration_s, widened=False):
+    """`runs` scenarios drawn deterministically from `seed` over the sweep's space. `widened`: the
+    range errors of real hardware too (issue 34): NLOS excess 0.2 m + Exp(0.3 m) instead of
+    U(0.5, 3) m, and a pair's error correlated over U(0, 0.3) s; the other draws are the same."""
     rng = random.Random(seed)
+    wide_rng = random.Random("widened-%d" % seed)  # its own stream: the other draws stay the plain sweep's
     out = []
     for i in range(runs):
         layout = pick(rng, LAYOUTS)
@@ -76,6 +79,9 @@ def draw_scenarios(runs, seed, duration_s):
             "imu_grade": pick(rng, IMU_GRADES),
             "duration": duration_s,
         }
+        if widened:
+            sc["nlos"] = "exponential"
+            sc["range_correlation"] = uniform(wide_rng, 0.0, 0.3, 3)
         out.append(sc)
     return out
 
@@ -108,7 +114,8 @@ def sim_args(sc):
     """meshnav_sim options of a scenario."""
     flags = [("seed", "seed"), ("trajectory", "trajectory"), ("anchor_layout", "anchor-layout"), ("tags", "tags"),
              ("known", "known"), ("unknown", "unknown"), ("sigma_range", "sigma-range"), ("outliers", "outliers"),
-             ("drop", "drop"), ("imu_grade", "imu-grade"), ("duration", "duration"), ("bias_max", "bias-max")]
+             ("drop", "drop"), ("imu_grade", "imu-grade"), ("duration", "duration"), ("bias_max", "bias-max"),
+             ("nlos", "nlos"), ("range_correlation", "range-correlation")]
     args = []
     for key, flag in flags:
         if key in sc and sc[key] is not None:
@@ -359,6 +366,9 @@ def parse_args(argv):
     p.add_argument("--out", default=os.path.join(ROOT, "out", "robustness"), help="output folder (default out/robustness)")
     p.add_argument("--strategy", help="meshnav_run --strategy, checked by meshnav_run (default: its own)")
     p.add_argument("--config", help="estimator options YAML for meshnav_run --config (default: its built-in defaults)")
+    p.add_argument("--widened", action="store_true",
+                   help="with --runs: draw real hardware's range errors too (NLOS excess 0.2 m + Exp(0.3 m), "
+                        "errors correlated over U(0, 0.3) s; docs/robustness.md)")
     p.add_argument("--duration", type=float, default=90.0, help="sequence length of drawn scenarios [s] (default 90)")
     p.add_argument("--calibration", choices=["off", "auto"], default="off",
                    help="off: known anchors only (default); auto: the unknown anchors are calibrated fly-by and "
@@ -429,7 +439,7 @@ def collinear_lines(results):
 def main(argv):
     a = parse_args(argv)
     try:
-        scenarios = load_scenarios(a.scenarios) if a.scenarios else draw_scenarios(a.runs, a.seed, a.duration)
+        scenarios = load_scenarios(a.scenarios) if a.scenarios else draw_scenarios(a.runs, a.seed, a.duration, a.widened)
     except (OSError, ValueError) as e:
         print("robustness: %s" % e, file=sys.stderr)
         return 2

@@ -87,7 +87,7 @@ SystemSetup makeSetup(const SimulationOptions& o, const PaperScenario& scenario,
   // they always were (its anchors are not coplanar, so the estimator would not use it).
   if (!o.isPaperScenario()) setup.flight_volume = FlightVolume{o.hall().min_m, o.hall().max_m};
   setup.noise.sigma_range_m = o.uwb.sigma_range_m;
-  setup.noise.range_correlation_time_s = 0.0;  // every range error is drawn on its own
+  setup.noise.range_correlation_time_s = o.uwb.correlation_time_s;  // what the ranges were drawn with
   setup.noise.imu_acc_noise_density = o.imu.acc_noise_density;
   setup.noise.imu_gyro_noise_density = o.imu.gyro_noise_density;
   setup.noise.imu_acc_bias_rw = o.imu.acc_bias_rw;

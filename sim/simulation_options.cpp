@@ -14,6 +14,9 @@ void SimulationOptions::validate() const {
   require(uwb.outlier_fraction >= 0.0 && uwb.outlier_fraction <= 1.0, "outlier_fraction must be in [0, 1]");
   require(uwb.drop_fraction >= 0.0 && uwb.drop_fraction < 1.0, "drop_fraction must be in [0, 1)");
   require(uwb.outlier_min_m >= 0.0 && uwb.outlier_max_m >= uwb.outlier_min_m, "outlier range must be 0 <= min <= max");
+  require(uwb.nlos_excess == "uniform" || uwb.nlos_excess == "exponential", "nlos excess must be uniform or exponential");
+  require(uwb.outlier_mean_m > 0.0, "outlier mean excess must be > 0 [m]");
+  require(uwb.correlation_time_s >= 0.0 && uwb.correlation_time_s <= 60.0, "range correlation time must be in [0, 60] s");
   require(uwb.slot_s > 0.0, "slot_s must be > 0");
   require(imu.rate_hz > 0.0 && baro.rate_hz > 0.0, "sensor rates must be > 0");
   require(ground_truth_rate_hz > 0.0 && flight_state_rate_hz > 0.0, "output rates must be > 0");

@@ -1,5 +1,6 @@
 #include "sim/uwb_range_simulator.h"
 
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -9,8 +10,14 @@ namespace meshnav::sim {
 
 std::string UwbRangeOptions::toString() const {
   std::ostringstream s;
-  s << "uwb ranges: slot " << slot_s << " s, sigma " << sigma_range_m << " m, outliers " << outlier_fraction
-    << " (+U(" << outlier_min_m << ", " << outlier_max_m << ") m), drops " << drop_fraction;
+  s << "uwb ranges: slot " << slot_s << " s, sigma " << sigma_range_m << " m";
+  if (correlation_time_s > 0.0) s << " (correlation time " << correlation_time_s << " s)";
+  s << ", outliers " << outlier_fraction;
+  if (nlos_excess == "exponential")
+    s << " (+" << outlier_min_m << " m + Exp(mean " << outlier_mean_m << " m))";
+  else
+    s << " (+U(" << outlier_min_m << ", " << outlier_max_m << ") m)";
+  s << ", drops " << drop_fraction;
   return s.str();
 }
 
@@ -29,14 +36,29 @@ std::vector<SimulatedRange> UwbRangeSimulator::simulate(const Trajectory& trajec
                                                         const TdmaSchedule& schedule, double t_end_s) {
   RandomStream rng(RandomStream::deriveSeed(seed_, "uwb_ranges"));
   n_slots_ = n_dropped_ = n_outliers_ = 0;
+  pair_error_.clear();
   std::vector<SimulatedRange> out;
   for (const TdmaSlot& slot : schedule.slotsUntil(t_end_s)) {
     ++n_slots_;
     // Fixed number of draws per slot (see file comment).
     const double u_drop = rng.uniform();
     const double u_outlier = rng.uniform();
-    const double noise = rng.gaussian();
-    const double excess = rng.uniform(options_.outlier_min_m, options_.outlier_max_m);
+    const double n = rng.gaussian();
+    const double u_excess = rng.uniform();
+    const double excess = options_.nlos_excess == "exponential"
+                              ? options_.outlier_min_m - options_.outlier_mean_m * std::log1p(-u_excess)
+                              : options_.outlier_min_m + (options_.outlier_max_m - options_.outlier_min_m) * u_excess;
+    // The pair's unit error: independent, or a first-order process over its slots (dropped ones too).
+    double noise = n;
+    if (options_.correlation_time_s > 0.0) {
+      const auto key = pairKey(slot.initiator, slot.responder);
+      auto it = pair_error_.find(key);
+      if (it != pair_error_.end()) {
+        const double rho = std::exp(-(slot.t_s - it->second.first) / options_.correlation_time_s);
+        noise = rho * it->second.second + std::sqrt(1.0 - rho * rho) * n;
+      }
+      pair_error_[key] = {slot.t_s, noise};
+    }
     if (u_drop < options_.drop_fraction) {
       ++n_dropped_;
       continue;

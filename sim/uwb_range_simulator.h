@@ -4,14 +4,20 @@
 ///
 /// At slot time t between devices a (initiator) and b:
 ///   p_TinG = p_IinG(t) + R_ItoG(t) p_TinI for a tag, p_AinG for an anchor,  d = ‖p_a − p_b‖,
-///   z = β_ab d + γ_ab + ν,  ν ~ N(0, σ_d²),
-/// and with probability ε an NLOS-like outlier adds a positive error U(o_min, o_max); with
-/// probability δ the message is dropped. Every slot consumes the same random draws whatever the
-/// options, so e.g. disabling noise leaves the outlier pattern unchanged.
+///   z = β_ab d + γ_ab + σ_d e,  e ~ N(0, 1),
+/// and with probability ε an NLOS-like outlier adds a positive error, U(o_min, o_max) (`uniform`,
+/// the paper's) or o_min + Exp(mean o_mean) (`exponential`: most of its mass within a few tenths of
+/// a metre, as on real hardware, where a χ² gate does not see it); with probability δ the message
+/// is dropped. With a correlation time τ > 0 the unit error of a pair (either direction) is a
+/// first-order process, e_k = ρ e_{k−1} + √(1 − ρ²) n_k, ρ = exp(−Δt/τ), Δt since the pair's
+/// previous slot (real multipath changes with the geometry, slowly: STAR-loc, docs/uwb_bias_model.md);
+/// τ = 0: independent. Every slot consumes the same random draws whatever the options, so e.g.
+/// disabling noise leaves the outlier pattern unchanged, and the defaults draw the paper's ranges.
 /// The written `R` is σ_d², `range_corr` equals the raw range, `LOS` is always 1 (as in real data,
 /// where the flag carries no information; outliers are marked only in `SimulatedRange`).
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -28,7 +34,10 @@ struct UwbRangeOptions {
   double sigma_range_m = 0.1;      ///< σ_d [m]
   double outlier_fraction = 0.05;  ///< ε [-]
   double outlier_min_m = 0.5;      ///< smallest NLOS excess [m]
-  double outlier_max_m = 3.0;      ///< largest NLOS excess [m]
+  double outlier_max_m = 3.0;      ///< largest NLOS excess [m] (uniform)
+  std::string nlos_excess = "uniform";  ///< uniform | exponential
+  double outlier_mean_m = 0.3;     ///< mean excess beyond outlier_min_m (exponential) [m]
+  double correlation_time_s = 0.0;  ///< τ of a pair's range error, 0 = independent [s]
   double drop_fraction = 0.02;     ///< δ [-]
   std::string toString() const;
 };
@@ -56,6 +65,7 @@ class UwbRangeSimulator {
   int64_t outlierCount() const { return n_outliers_; }
 
  private:
+  std::map<std::pair<SensorId, SensorId>, std::pair<double, double>> pair_error_;  ///< pair → (t [s], e)
   PaperScenario scenario_;
   const UwbHardwareBiases& biases_;
   UwbRangeOptions options_;

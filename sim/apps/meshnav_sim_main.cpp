@@ -30,7 +30,7 @@ constexpr char kDescription[] =
 struct SimCli {
   meshnav::sim::SimulationOptions sim;
   int64_t seed = 1;
-  std::string out, trajectory, hall, anchor_layout, imu_grade;
+  std::string out, trajectory, hall, anchor_layout, imu_grade, nlos = "uniform";
   double duration_s = 0.0;
   double bias_max_m = 0.0;
   double uncertain_sigma_m = 0.0;
@@ -83,8 +83,17 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
       ->type_name("S")->check(cli_checks::positive())->group("Scenario (default: the paper's)");
   cli.option("sigma-range", o.uwb.sigma_range_m, "UWB range noise sigma_d [m]")
       ->type_name("M")->check(cli_checks::nonNegative())->group("Sensors");
-  cli.option("outliers,--outlier-fraction", o.uwb.outlier_fraction, "fraction of NLOS outlier ranges, +U(0.5, 3) m")
+  cli.option("outliers,--outlier-fraction", o.uwb.outlier_fraction, "fraction of NLOS outlier ranges (their excess: --nlos)")
       ->type_name("F")->check(cli_checks::nonNegative())->group("Sensors");
+  cli.optional("nlos", c.nlos,
+               "NLOS excess of an outlier: uniform = U(0.5, 3) m (the paper's, which a chi^2 gate removes), "
+               "exponential = 0.2 m + Exp(mean 0.3 m) (real hardware's: most of it passes a gate)")
+      ->type_name("uniform|exponential")->check(cli_checks::oneOf([](const std::string& v) {
+        return v == "uniform" || v == "exponential"; }, "uniform|exponential"))->group("Sensors");
+  cli.option("range-correlation", o.uwb.correlation_time_s,
+             "correlation time of a pair's range error, a first-order process (real multipath: about 0.1 s at a "
+             "walk), written to setup.yaml noise.range_correlation_time; 0 = independent [s]")
+      ->type_name("S")->check(cli_checks::nonNegative())->group("Sensors");
   cli.option("drop,--drop-fraction", o.uwb.drop_fraction, "fraction of dropped range messages")
       ->type_name("F")->check(cli_checks::nonNegative())->group("Sensors");
   c.bias_max_m = o.hardware.gamma_max_m;
@@ -134,6 +143,11 @@ void applyScenarioOptions(const meshnav::Cli& cli, SimCli& c) {
     o.anchor_layout = *layout;
   }
   if (cli.given("hall")) o.hall_size_m = parseHall(c.hall);
+  if (c.nlos == "exponential") {
+    o.uwb.nlos_excess = "exponential";
+    o.uwb.outlier_min_m = 0.2;
+    o.uwb.outlier_mean_m = 0.3;
+  }
   if (cli.given("duration")) o.duration_s = c.duration_s;
   if (cli.given("imu-grade")) {
     try {

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 #include "sim/paper_scenario.h"
 #include "sim/spiral_trajectory.h"
@@ -123,4 +124,71 @@ TEST(SimUwbRangeSimulator, NoiseLevelDoesNotChangeWhichRangesAreOutliersOrDroppe
     EXPECT_EQ(ra[k].sample.t, rb[k].sample.t);
     EXPECT_EQ(ra[k].outlier, rb[k].outlier);
   }
+}
+
+TEST(SimUwbRangeSimulator, ExponentialNlosExcessStartsAtTwentyCentimetresWithItsMean) {
+  // Real hardware's NLOS: 0.2 m + Exp(mean 0.3 m), most of it below 1 m; the same slots are
+  // outliers as with the paper's U(0.5, 3) m (the same draws).
+  Fixture f;
+  UwbRangeOptions uni, ex;
+  uni.sigma_range_m = ex.sigma_range_m = 0.0;
+  uni.outlier_fraction = ex.outlier_fraction = 0.10;
+  ex.nlos_excess = "exponential";
+  ex.outlier_min_m = 0.2;
+  ex.outlier_mean_m = 0.3;
+  UwbRangeSimulator a(f.scenario, f.biases, uni, 8), b(f.scenario, f.biases, ex, 8);
+  const auto ra = a.simulate(f.trajectory, f.schedule, f.trajectory.duration());
+  const auto rb = b.simulate(f.trajectory, f.schedule, f.trajectory.duration());
+  ASSERT_EQ(ra.size(), rb.size());
+  double sum = 0;
+  int n = 0, below_1m = 0;
+  for (size_t k = 0; k < rb.size(); ++k) {
+    ASSERT_EQ(ra[k].outlier, rb[k].outlier);
+    if (!rb[k].outlier) continue;
+    const auto& bias = f.biases.truth(rb[k].sample.id_initiator, rb[k].sample.id_responder);
+    const double e = rb[k].sample.range_m - (bias.beta * rb[k].true_distance_m + bias.gamma_m);
+    EXPECT_GE(e, 0.2 - 1e-9);
+    sum += e;
+    ++n;
+    below_1m += e < 1.0;
+  }
+  ASSERT_GT(n, 1000);
+  EXPECT_NEAR(sum / n, 0.5, 0.03);                          // 0.2 + 0.3
+  EXPECT_NEAR(static_cast<double>(below_1m) / n, 1.0 - std::exp(-0.8 / 0.3), 0.03);  // P(Exp < 0.8 m)
+}
+
+TEST(SimUwbRangeSimulator, CorrelatedErrorsFollowAFirstOrderProcessPerPair) {
+  // Lag-one correlation of a pair's consecutive errors = exp(−Δt/τ) at the pair's interval; the
+  // marginal σ stays σ_d; τ = 0 leaves every range as the paper's.
+  Fixture f;
+  UwbRangeOptions white, corr;
+  white.outlier_fraction = corr.outlier_fraction = 0.0;
+  white.drop_fraction = corr.drop_fraction = 0.0;
+  corr.correlation_time_s = 2.0;
+  UwbRangeSimulator a(f.scenario, f.biases, white, 5), b(f.scenario, f.biases, corr, 5);
+  const auto ra = a.simulate(f.trajectory, f.schedule, f.trajectory.duration());
+  const auto rb = b.simulate(f.trajectory, f.schedule, f.trajectory.duration());
+  ASSERT_EQ(ra.size(), rb.size());
+  std::map<std::pair<meshnav::SensorId, meshnav::SensorId>, std::pair<double, double>> last;  // t, e
+  double sxy = 0, sxx = 0, s2 = 0, dt_sum = 0;
+  int n = 0;
+  for (const auto& r : rb) {
+    const auto& bias = f.biases.truth(r.sample.id_initiator, r.sample.id_responder);
+    const double e = (r.sample.range_m - (bias.beta * r.true_distance_m + bias.gamma_m)) / corr.sigma_range_m;
+    const auto key = meshnav::pairKey(r.sample.id_initiator, r.sample.id_responder);
+    if (auto it = last.find(key); it != last.end()) {
+      sxy += it->second.second * e;
+      sxx += it->second.second * it->second.second;
+      dt_sum += r.sample.t.sec() - it->second.first;
+      ++n;
+    }
+    s2 += e * e;
+    last[key] = {r.sample.t.sec(), e};
+  }
+  ASSERT_GT(n, 5000);
+  // The pair's slots are unevenly spaced (both directions of a pair); compare with the mean of ρ
+  // loosely: for Δt ≪ τ, ρ ≈ 1 − Δt/τ is linear, so the mean interval gives the mean ρ.
+  EXPECT_NEAR(sxy / sxx, std::exp(-(dt_sum / n) / 2.0), 0.03);
+  EXPECT_NEAR(std::sqrt(s2 / rb.size()), 1.0, 0.1);
+  for (size_t k = 0; k < ra.size(); k += 97) EXPECT_EQ(ra[k].outlier, rb[k].outlier);
 }
