@@ -72,6 +72,7 @@ const Field kFields[] = {
     {"uwb.fuse_calibrated_anchor_pairs", field<&EstimatorOptions::uwb, &UwbOptions::fuse_calibrated_anchor_pairs>, "fuse ranges between two calibrated anchors (their correlated calibration errors are not known)"},
     {"uwb.dah_fuse_estimated_anchor_pairs", field<&EstimatorOptions::uwb, &UwbOptions::dah_fuse_estimated_anchor_pairs>, "dah only: fuse ranges between two estimated anchors (overconfident, see docs)"},
     {"uwb.dah_joint_anchors", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_anchors>, "dah only: anchors updated jointly: none | batch (added together, e.g. by a re-run) | all"},
+    {"uwb.nlos_fraction", field<&EstimatorOptions::uwb, &UwbOptions::nlos_fraction>, "prior probability that a range carries an NLOS excess (posterior line-of-sight weight after the gate), 0 = Gaussian only (default: off) [-]"},
     {"uwb.reentry_gap_s", field<&EstimatorOptions::uwb, &UwbOptions::reentry_gap_s>, "no tag range accepted for this long: hold and cross-check the next ones, 0 = off [s]"},
     {"zupt.enabled", field<&EstimatorOptions::zupt, &ZuptOptions::enabled>, ""},
     {"zupt.sigma_vel_m_s", field<&EstimatorOptions::zupt, &ZuptOptions::sigma_vel_m_s>, "sigma of v = 0 [m/s]"},
@@ -127,6 +128,8 @@ const Field kModelParameters[] = {
     {"uwb.dah_joint_max_anchors", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_max_anchors>, "dah only: most estimated anchors in a joint set, the most refined leave first, 0 = no bound [-]"},
     {"uwb.uncalibrated_common_gamma_sigma_m", field<&EstimatorOptions::uwb, &UwbOptions::uncalibrated_common_gamma_sigma_m>, "1 sigma of the offset common to an unlisted tag's pairs [m]"},
     {"uwb.range_error_correlation_s", field<&EstimatorOptions::uwb, &UwbOptions::range_error_correlation_s>, "correlation time of a pair's range error: R x (1 + rho)/(1 - rho), rho = exp(-dt/tau), dt since the pair's previous range; 0 = white [s]"},
+    {"uwb.nlos_min_excess_m", field<&EstimatorOptions::uwb, &UwbOptions::nlos_min_excess_m>, "smallest NLOS excess b0 [m]"},
+    {"uwb.nlos_mean_excess_m", field<&EstimatorOptions::uwb, &UwbOptions::nlos_mean_excess_m>, "mean NLOS excess beyond b0 [m]"},
     {"uwb.reentry_hold_s", field<&EstimatorOptions::uwb, &UwbOptions::reentry_hold_s>, "longest hold after a gap, at most window_s [s]"},
     {"uwb.reentry_min_ranges", field<&EstimatorOptions::uwb, &UwbOptions::reentry_min_ranges>, "held ranges needed to test them against each other [-]"},
     {"uwb.reentry_min_anchors", field<&EstimatorOptions::uwb, &UwbOptions::reentry_min_anchors>, "distinct anchors among them [-]"},
@@ -296,6 +299,8 @@ void EstimatorOptions::validate() const {
        "uwb.uncalibrated_gamma_sigma_m and uwb.uncalibrated_common_gamma_sigma_m in [0, 10] [m]");
   need(uwb.range_error_correlation_s >= 0 && uwb.range_error_correlation_s <= 60,
        "uwb.range_error_correlation_s in [0, 60] [s]");
+  need(uwb.nlos_fraction >= 0 && uwb.nlos_fraction < 1 && uwb.nlos_min_excess_m >= 0 && uwb.nlos_mean_excess_m > 0,
+       "uwb.nlos_fraction in [0, 1), uwb.nlos_min_excess_m >= 0, uwb.nlos_mean_excess_m > 0");
   need(process_noise.batch >= 5 && process_noise.upper_ratio > 1.0 && process_noise.lower_ratio > 0.0 &&
            process_noise.lower_ratio < 1.0 && process_noise.max_grow > 1.0 && process_noise.max_shrink > 1.0 &&
            process_noise.max_scale >= 1.0 && process_noise.max_prior_ratio > 0.0,

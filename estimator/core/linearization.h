@@ -9,6 +9,7 @@
 
 #include "common/types.h"
 #include "estimator/core/huber.h"
+#include "estimator/core/nlos_mixture.h"
 
 namespace meshnav::estimator {
 
@@ -32,7 +33,22 @@ struct Linearization {
   /// innovation is the measurement's; beyond, it is more likely the state's own error, which the
   /// update must correct in full (a filter that has drifted would otherwise never catch up).
   double huber_max_prior_ratio = 1.0;
+  /// > 0: a scalar range whose error is a line-of-sight / NLOS mixture (nlos_mixture.h) with this
+  /// prior NLOS probability ε and excess nlos_min_m + Exp(nlos_mean_m); 0: Gaussian only.
+  double nlos_fraction = 0.0;
+  double nlos_min_m = 0.2;
+  double nlos_mean_m = 0.3;
   int dim() const { return static_cast<int>(residual.size()); }
+  /// The factor on s = H P Hᵀ + R of this (scalar) measurement after the gate: the Huber weight
+  /// times the NLOS mixture's 1/w (both 1 when off or not scalar).
+  double robustInflation(double nis, double s) const {
+    if (dim() != 1) return 1.0;
+    const bool measurement_dominated = (s - R(0, 0)) / R(0, 0) <= huber_max_prior_ratio;
+    const double nlos = nlos_fraction > 0.0 && measurement_dominated
+                            ? nlos::innovationInflation(residual(0), s, nlos_fraction, nlos_min_m, nlos_mean_m)
+                            : 1.0;
+    return huberInflation(nis, s) * nlos;
+  }
   /// The factor on the innovation covariance s = H P Hᵀ + R of this (scalar) measurement after
   /// the gate passed it at `nis` (huber::innovationInflation); 1 when off or not scalar.
   double huberInflation(double nis, double s) const {

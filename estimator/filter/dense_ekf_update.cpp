@@ -28,7 +28,7 @@ DenseUpdateOutput denseEkfUpdate(Eigen::MatrixXd& P, const StateLayout& layout, 
   DenseUpdateOutput out;
   out.nis = lin.residual.dot(ldlt.solve(lin.residual));
   if (!std::isfinite(out.nis) || (nis_gate > 0.0 && out.nis > nis_gate)) return out;
-  if (const double inflate = lin.huberInflation(out.nis, S(0, 0)); inflate > 1.0) {
+  if (const double inflate = lin.robustInflation(out.nis, S(0, 0)); inflate > 1.0) {
     S *= inflate;  // R_eff = R + S (inflate − 1): the Joseph form below uses S = H P Hᵀ + R_eff
     ldlt.compute(S);
   }

@@ -256,7 +256,7 @@ class DahUpdate {
     const double r = lin_.residual(0);
     res->nis = r * (invertible_ ? r / s_ : 0.0);
     if (!std::isfinite(res->nis) || (nis_gate > 0.0 && res->nis > nis_gate)) return false;
-    s_ *= lin_.huberInflation(res->nis, s_);  // Huber weight (Linearization::huber_k), after the gate
+    s_ *= lin_.robustInflation(res->nis, s_);  // Huber and NLOS weights (Linearization), after the gate
     Kv_.resize(n_);
     for (int i = 0; i < n_; ++i) Kv_(i) = invertible_ ? U_(i) / s_ : 0.0;
     // Element (i, j) and (j, i) in one pass over the upper triangle, then symmetrized.

@@ -45,6 +45,9 @@ std::optional<Linearization> RangeUpdater::linearize(const RangeMeasurement& z, 
     return std::nullopt;
   }
   lin.huber_k = options_.huber_k;
+  lin.nlos_fraction = options_.nlos_fraction;
+  lin.nlos_min_m = options_.nlos_min_excess_m;
+  lin.nlos_mean_m = options_.nlos_mean_excess_m;
   lin.huber_max_prior_ratio = options_.huber_max_prior_ratio;
   return lin;
 }
