@@ -34,7 +34,7 @@ struct TruthFault {
 struct TruthCheckOptions {
   double window_s = 0.25;      ///< T [s]
   double tolerance_rad = 0.125;  ///< largest |θ_truth − θ_gyro| on a correct truth [rad]
-  double max_truth_dt_s = 0.05;  ///< a window end without a truth sample this close is not checked [s]
+  double max_truth_dt_s = 0.05;  ///< a window end whose truth samples are more than 2× this apart is not checked [s]
   double step_fraction = 0.25;   ///< windows start every step_fraction · T (they overlap) [-]
 };
 

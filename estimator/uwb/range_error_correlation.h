@@ -48,6 +48,7 @@ class RangeErrorCorrelation {
   }
   /// A range of (a, b) at `t` went through the update (fused or gated).
   void noteRange(SensorId a, SensorId b, Timestamp t) {
+    if (tau_s_ <= 0.0) return;  // white errors: no history to keep
     auto [it, inserted] = last_fused_.try_emplace(pairKey(a, b), t);
     if (!inserted) it->second = std::max(it->second, t);
   }

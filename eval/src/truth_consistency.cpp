@@ -1,5 +1,7 @@
 #include "eval/truth_consistency.h"
 
+#include "common/pose_interpolation.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -12,22 +14,13 @@ double angleOf(const Eigen::Quaterniond& q) {
   return 2.0 * std::acos(std::min(1.0, std::abs(q.normalized().w())));
 }
 
-/// The truth sample nearest to t (truth sorted, not empty).
-const PoseSample& nearest(const std::vector<PoseSample>& truth, Timestamp t) {
-  auto it = std::lower_bound(truth.begin(), truth.end(), t, [](const PoseSample& s, Timestamp x) { return s.t < x; });
-  if (it == truth.end()) return truth.back();
-  if (it == truth.begin()) return *it;
-  auto prev = std::prev(it);
-  return (t - prev->t) < (it->t - t) ? *prev : *it;
-}
-
 }  // namespace
 
 std::vector<TruthFault> truthGyroFaults(const std::vector<PoseSample>& truth, const std::vector<ImuSample>& imu,
                                         const TruthCheckOptions& options) {
   std::vector<TruthFault> faults;
   if (truth.size() < 2 || imu.size() < 2) return faults;
-  const double max_dt = options.max_truth_dt_s;
+  const Duration max_gap = Duration::fromSec(2.0 * options.max_truth_dt_s);
   size_t i = 0;
   while (i + 1 < imu.size()) {
     // One window: the gyro integrated from sample i to the last sample within window_s of it.
@@ -44,10 +37,9 @@ std::vector<TruthFault> truthGyroFaults(const std::vector<PoseSample>& truth, co
       ++i;
       continue;
     }
-    const PoseSample& a = nearest(truth, imu[i].t);
-    const PoseSample& b = nearest(truth, imu[j].t);
-    if (std::abs((a.t - imu[i].t).sec()) <= max_dt && std::abs((b.t - imu[j].t).sec()) <= max_dt && b.t > a.t) {
-      const double th_truth = angleOf(a.q_ItoG.conjugate() * b.q_ItoG), th_gyro = angleOf(q);
+    const auto a = interpolatePose(truth, imu[i].t, max_gap), b = interpolatePose(truth, imu[j].t, max_gap);
+    if (a && b) {
+      const double th_truth = angleOf(a->q_ItoG.conjugate() * b->q_ItoG), th_gyro = angleOf(q);
       if (std::isfinite(th_truth) && std::abs(th_truth - th_gyro) > options.tolerance_rad) {
         // Overlapping windows that disagree are one fault (its angles: the largest disagreement).
         if (!faults.empty() && imu[i].t <= faults.back().t1) {
