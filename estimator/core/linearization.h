@@ -38,9 +38,24 @@ struct Linearization {
   double nlos_fraction = 0.0;
   double nlos_min_m = 0.2;
   double nlos_mean_m = 0.3;
+  /// ≥ 1: the step weights the measurement as if its noise were R·this (an error correlated with
+  /// the previous one of its pair brings less new information: (1+ρ)/(1−ρ),
+  /// estimator/uwb/range_error_correlation.h). The gate, the NIS and every statistic built on it
+  /// judge the measurement by R, the marginal distribution of its own error (docs/uwb_bias_model.md,
+  /// "Correlated errors"); 1: white errors.
+  double step_noise_factor = 1.0;
   int dim() const { return static_cast<int>(residual.size()); }
   /// The factor on s = H P Hᵀ + R of this (scalar) measurement after the gate: the Huber weight
   /// times the NLOS mixture's 1/w (both 1 when off or not scalar).
+  /// The innovation covariance of the step for s = H P Hᵀ + R that passed the gate at `nis`:
+  /// (s + (step_noise_factor − 1) R) times the robust weights (robustInflation, judged on s).
+  template <class Mat>
+  Mat stepCovariance(const Mat& s, double nis) const {
+    Mat out = s;
+    if (step_noise_factor > 1.0) out += (step_noise_factor - 1.0) * R;
+    if (dim() == 1) out *= robustInflation(nis, s(0, 0));
+    return out;
+  }
   double robustInflation(double nis, double s) const {
     if (dim() != 1) return 1.0;
     const bool measurement_dominated = (s - R(0, 0)) / R(0, 0) <= huber_max_prior_ratio;

@@ -28,8 +28,10 @@ DenseUpdateOutput denseEkfUpdate(Eigen::MatrixXd& P, const StateLayout& layout, 
   DenseUpdateOutput out;
   out.nis = lin.residual.dot(ldlt.solve(lin.residual));
   if (!std::isfinite(out.nis) || (nis_gate > 0.0 && out.nis > nis_gate)) return out;
-  if (const double inflate = lin.robustInflation(out.nis, S(0, 0)); inflate > 1.0) {
-    S *= inflate;  // R_eff = R + S (inflate − 1): the Joseph form below uses S = H P Hᵀ + R_eff
+  // Correlated errors and robust weights, after the gate: R_eff = R·f + S'(inflate − 1); the Joseph
+  // form below uses S = H P Hᵀ + R_eff.
+  if (lin.step_noise_factor > 1.0 || (m == 1 && lin.robustInflation(out.nis, S(0, 0)) > 1.0)) {
+    S = lin.stepCovariance(S, out.nis);
     ldlt.compute(S);
   }
   out.K = ldlt.solve(U.transpose()).transpose();  // n × m

@@ -231,7 +231,7 @@ class DahUpdate {
   }
 
   /// The EKF update of Σ_PP. Scalar (the arithmetic of denseEkfUpdate with m = 1): u = Σ_PP hᵀ,
-  /// s = h u + R, NIS = r² / s (gated), then s scaled by Linearization::huberInflation (R_eff),
+  /// s = h u + R, NIS = r² / s (gated), then s taken as Linearization::stepCovariance (R_eff),
   /// K = u / s, Joseph form P ← P − K uᵀ − u Kᵀ + K s Kᵀ (or P ← P − K uᵀ), symmetrized. Vector: denseEkfUpdate. Fills `res`; false when gated (or the NIS
   /// is not finite).
   bool ekfUpdate(double nis_gate, bool joseph, FactorizedCovariance::Result* res) {
@@ -256,7 +256,9 @@ class DahUpdate {
     const double r = lin_.residual(0);
     res->nis = r * (invertible_ ? r / s_ : 0.0);
     if (!std::isfinite(res->nis) || (nis_gate > 0.0 && res->nis > nis_gate)) return false;
-    s_ *= lin_.robustInflation(res->nis, s_);  // Huber and NLOS weights (Linearization), after the gate
+    // Correlated errors, Huber and NLOS weights (Linearization::stepCovariance), after the gate.
+    if (lin_.step_noise_factor > 1.0) s_ += (lin_.step_noise_factor - 1.0) * lin_.R(0, 0);
+    s_ *= lin_.robustInflation(res->nis, S(0, 0));
     Kv_.resize(n_);
     for (int i = 0; i < n_; ++i) Kv_(i) = invertible_ ? U_(i) / s_ : 0.0;
     // Element (i, j) and (j, i) in one pass over the upper triangle, then symmetrized.

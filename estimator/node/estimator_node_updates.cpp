@@ -78,8 +78,9 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
     return;
   }
   Linearization lin = *linearized;
-  // Correlated errors: a range soon after its pair's previous one carries less new information.
-  lin.R *= cur_.range_errors.inflation(z.a, z.b, s.t);
+  // Correlated errors: a range soon after its pair's previous one carries less new information;
+  // the step weights it so, the gate and the NIS judge it by its own error (Linearization).
+  lin.step_noise_factor = cur_.range_errors.inflation(z.a, z.b, s.t);
   const bool tag_range = cur_.network->isTag(z.a) || cur_.network->isTag(z.b);
   bool count = first;
   if (tag_range &&

@@ -1,6 +1,7 @@
 /// The Huber-weighted update (Linearization::huber_k): in every strategy it equals the plain
 /// update with R_eff = R + S (√NIS / k − 1), reports the NIS of the stated R, and is the plain
-/// update where it must be (within k, above the prior-ratio bound, gated, switched off).
+/// update where it must be (within k, above the prior-ratio bound, gated, switched off); the
+/// correlated-error factor on R (Linearization::step_noise_factor) weighs the step only.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -141,5 +142,55 @@ TEST(HuberUpdate, IsThePlainUpdateWithinKAboveThePriorRatioOrWhenGated) {
     EXPECT_NEAR(r.nis, nis, 1e-9);
     EXPECT_EQ(test::relativeDifference(*robust, *before), 0.0);
     EXPECT_EQ(crossDifference(*robust, *before), 0.0);
+  }
+}
+
+// Correlated errors (Linearization::step_noise_factor f): the step is the plain update's with R·f,
+// the NIS and the gate are those of the stated R, in every strategy; combined with the Huber weight
+// the step covariance is (H P Hᵀ + f R)·(√NIS / k).
+TEST(StepNoiseFactor, TheStepWeighsRTimesTheFactorTheGateAndTheNisJudgeR) {
+  for (const std::string name : {"centralized", "dp", "dah"}) {
+    SCOPED_TRACE(name);
+    auto weighted = makeStrategy(name, 0.05);
+    auto plain = weighted->clone();
+    Linearization lin = test::imuAnchorRange(weighted->state(), 106, 3.7);
+    const double S = innovationVariance(*weighted, lin), r = lin.residual(0);
+    lin.step_noise_factor = 2.5;
+    Linearization lin_eff = test::imuAnchorRange(plain->state(), 106, 3.7);
+    lin_eff.R(0, 0) *= 2.5;
+    const UpdateResult rw = weighted->update(lin, 0.0), rp = plain->update(lin_eff, 0.0);
+    ASSERT_TRUE(rw.accepted && rp.accepted);
+    EXPECT_NEAR(rw.nis, r * r / S, 1e-12) << "the NIS of the stated R";
+    EXPECT_LT(test::relativeDifference(*weighted, *plain), 1e-12);
+    EXPECT_LT(crossDifference(*weighted, *plain), 1e-15);
+
+    // Gated on the stated R: a gate between the NIS of R and that of R·f rejects the range.
+    auto gated = makeStrategy(name, 0.05);
+    auto before = gated->clone();
+    Linearization far = test::imuAnchorRange(gated->state(), 106, 4.0);
+    const double S_far = innovationVariance(*gated, far), nis = far.residual(0) * far.residual(0) / S_far;
+    const double nis_inflated = far.residual(0) * far.residual(0) / (S_far + 1.5 * far.R(0, 0));
+    const double gate = 0.5 * (nis + nis_inflated);
+    ASSERT_LT(nis_inflated, gate);
+    far.step_noise_factor = 2.5;
+    const UpdateResult rg = gated->update(far, gate);
+    EXPECT_FALSE(rg.accepted);
+    EXPECT_NEAR(rg.nis, nis, 1e-9);
+    EXPECT_EQ(test::relativeDifference(*gated, *before), 0.0);
+
+    // With a Huber weight on top: R_eff = f R + (H P Hᵀ + f R)(e/k − 1), e on the stated S.
+    auto both = makeStrategy(name, 0.05);
+    auto ref = both->clone();
+    Linearization l2 = test::imuAnchorRange(both->state(), 106, 4.0);
+    const double S2 = innovationVariance(*both, l2), e = std::abs(l2.residual(0)) / std::sqrt(S2);
+    ASSERT_GT(e, 2.0);
+    l2.step_noise_factor = 2.5;
+    l2.huber_k = 2.0;
+    l2.huber_max_prior_ratio = 1.0;
+    Linearization l2_eff = test::imuAnchorRange(ref->state(), 106, 4.0);
+    const double R = l2_eff.R(0, 0);
+    l2_eff.R(0, 0) = 2.5 * R + (S2 + 1.5 * R) * (e / 2.0 - 1.0);
+    ASSERT_TRUE(both->update(l2, 0.0).accepted && ref->update(l2_eff, 0.0).accepted);
+    EXPECT_LT(test::relativeDifference(*both, *ref), 1e-12);
   }
 }
