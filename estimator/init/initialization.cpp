@@ -193,9 +193,10 @@ std::optional<InitialBelief> Initialization::tryInitialize(const EstimatorInput&
   return beliefFrom(*r, landedAt(r->t, landed));
 }
 
-std::optional<AlignmentResult> Initialization::align(const Eigen::Vector3d& bias_gyro_rad_s) {
+std::optional<AlignmentResult> Initialization::align(const Eigen::Vector3d& bias_gyro_rad_s,
+                                                     const std::optional<MotionAligner::HeadingPrior>& heading) {
   ScopedStepTimer timer(timings_, "align");
-  return aligner_.solve(bias_gyro_rad_s);
+  return aligner_.solve(bias_gyro_rad_s, heading);
 }
 
 bool Initialization::landedAt(Timestamp t, bool current) const {

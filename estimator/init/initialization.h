@@ -66,7 +66,8 @@ class Initialization {
   std::optional<InitialBelief> tryInitialize(const EstimatorInput& in, bool landed);
 
   /// The aligner's fit of its window (timed as the step "align"), nullopt with `reason()`.
-  std::optional<AlignmentResult> align(const Eigen::Vector3d& bias_gyro_rad_s);
+  std::optional<AlignmentResult> align(const Eigen::Vector3d& bias_gyro_rad_s,
+                                       const std::optional<MotionAligner::HeadingPrior>& heading = std::nullopt);
   /// An alignment as an initial belief: the pose, the height bias it estimated, the baro's
   /// reference and bias. `landed`: the rest state at r.t.
   InitialBelief beliefFrom(const AlignmentResult& r, bool landed) const;

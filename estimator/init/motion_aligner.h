@@ -116,8 +116,19 @@ class MotionAligner {
   void addRange(const AlignRange& r);
   void addHeight(const AlignHeight& h);
   void clear();
+  /// A heading the caller still knows at the window's end: a lost filter's yaw, which the gyro
+  /// keeps through a range outage while the position drifts (docs/robustness.md, "Rival poses").
+  struct HeadingPrior {
+    double yaw_rad = 0.0;       ///< ψ of q_ItoG at the newest IMU sample [rad]
+    double var_rad2 = 0.0;      ///< its variance σ_ψ² [rad²] (> 0)
+  };
   /// Fits the current window; nullopt (see `reason()`) while the pose is not determined.
-  std::optional<AlignmentResult> solve(const Eigen::Vector3d& bias_gyro_rad_s);
+  /// Distinct minima that fit within the ambiguity margin are rivals. Without `heading` the window
+  /// is then refused. With it each minimum k scores its negative log-posterior in the cost's units,
+  /// J_k = c_k + v (ψ_k − ψ_prior)² / σ_ψ² (v the robust variance factor: the costs are v-scaled
+  /// χ²), and the lowest is taken when every other scores beyond the margin; else refused.
+  std::optional<AlignmentResult> solve(const Eigen::Vector3d& bias_gyro_rad_s,
+                                       const std::optional<HeadingPrior>& heading = std::nullopt);
   /// Which way gravity points in G, by the data. The estimator assumes −z (z up); an anchor
   /// frame whose z axis points down (ISAS-Walk1's RTLS frame, docs/real_data.md) fits the ranges
   /// and accelerations of a window better with gravity along +z. Both are fitted from the same
@@ -140,6 +151,8 @@ class MotionAligner {
   void setGravityAlongPlusZ(bool plus_z) { gravity_z_sign_ = assumed_gravity_z_sign_ = plus_z ? 1.0 : -1.0; }
   /// How often `solve` integrated the increments again at a corrected gyro bias (all calls).
   int relinearizations() const { return relinearizations_; }
+  /// Solves in which the heading prior chose a rival over the best fit by cost (all calls).
+  int headingDecisions() const { return heading_decisions_; }
   /// Why the last `solve` refused.
   const std::string& reason() const { return reason_; }
   /// Data span currently held [s].
@@ -224,10 +237,14 @@ class MotionAligner {
                                   const Eigen::Matrix3d& C);
   ImuState endState(const Unknowns& x, const Increments& end, const Eigen::Vector3d& bias_gyro) const;
   std::vector<Unknowns> starts(const std::vector<Obs>& obs) const;
-  /// Covariance, end state and the acceptance checks of the best fit.
+  /// Covariance, end state and the acceptance checks of the best fit. With `heading`, the end
+  /// state is first combined with the prior heading (a Kalman update of the yaw, H = [0 0 nᵀ 0 0],
+  /// n = R_ItoGᵀ e_z, so that the fit's heading and the prior's weigh by their variances); the
+  /// checks then judge the combined pose.
   std::optional<AlignmentResult> finish(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights,
                                         const Unknowns& x, const Info& info, const Increments& end,
-                                        const Eigen::Vector3d& bias_gyro);
+                                        const Eigen::Vector3d& bias_gyro,
+                                        const std::optional<HeadingPrior>& heading = std::nullopt);
 
   /// g = (0, 0, sign·|g|) in G: the assumed sign everywhere but inside `checkGravityDirection`.
   Eigen::Vector3d gravityG() const { return {0.0, 0.0, gravity_z_sign_ * options_.gravity_m_s2}; }
@@ -235,6 +252,7 @@ class MotionAligner {
   MotionAlignerOptions options_;
   double gravity_z_sign_ = -1.0, assumed_gravity_z_sign_ = -1.0;
   int relinearizations_ = 0;  ///< re-integrations over this aligner's life
+  int heading_decisions_ = 0;  ///< solves whose heading prior chose a rival (headingDecisions)
   /// The caller's gyro bias (the prior's centre) and the bias the best fit of the last solve found
   /// about it; the next solve with the same prior integrates at the latter [rad/s]
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> last_fit_;

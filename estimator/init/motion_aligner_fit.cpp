@@ -5,6 +5,7 @@
 /// motion_aligner.cpp.
 
 #include <Eigen/Dense>
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -252,7 +253,8 @@ bool MotionAligner::fitStarts(const Eigen::Vector3d& bias_gyro_rad_s, Window* w)
   }
 }
 
-std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_gyro_rad_s) {
+std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_gyro_rad_s,
+                                                    const std::optional<HeadingPrior>& heading) {
   if (spanSeconds() < options_.min_span_s) {
     reason_ = "motion alignment: " + std::to_string(spanSeconds()) + " s of IMU data, need " +
               std::to_string(options_.min_span_s) + " s";
@@ -284,7 +286,28 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
   // Distinct rivals are refitted on the same inliers, in rivalOrder, up to 6 in all.
   // Costs are compared in units of the residuals' own scatter: ranges that fit worse than their σ
   // (unmodelled drift over the window, heavier noise) make a cost difference mean less.
-  const double margin = options_.ambiguity_chi2 * robustVarianceFactor(obs, best);
+  const double v = robustVarianceFactor(obs, best);
+  const double margin = options_.ambiguity_chi2 * v;
+  // The heading term of a minimum's score, in the cost's units (solve's contract); 0 without a prior.
+  auto headingTerm = [&](const ImuState& e) {
+    if (!heading) return 0.0;
+    const double d = std::remainder(so3::yawOf(e.q_ItoG) - heading->yaw_rad, 2.0 * M_PI);
+    return v * d * d / heading->var_rad2;
+  };
+  auto ambiguity = [&](const ImuState& a, const ImuState& b, double dcost) {
+    const double dyaw = std::remainder(so3::yawOf(a.q_ItoG) - so3::yawOf(b.q_ItoG), 2.0 * M_PI) / kDeg;
+    return "motion alignment: ambiguous (two poses " + fmt::format("{:.2f} m and {:.1f} deg", (a.p_IinG - b.p_IinG).norm(),
+                                                                   std::abs(dyaw)) +
+           " apart score within " + fmt::format("{:.1f} (margin {:.1f}{})", dcost, margin,
+                                                heading ? ", with the heading prior" : ", ranges only") +
+           "): anchor geometry or motion cannot fix the pose yet";
+  };
+  struct Minimum {
+    Unknowns x;
+    ImuState e;
+    double score;
+  };
+  std::vector<Minimum> minima{{best, best_end, best_cost + headingTerm(best_end)}};
   std::vector<ImuState> checked;
   for (const size_t k : rivalOrder(cands, best_end.p_IinG)) {
     if (checked.size() >= 6) break;
@@ -295,14 +318,28 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
     Unknowns rival = cands[k].x;
     const double c = fit(obs, heights, w.dbg_prior_mean, rival, nullptr);
     const ImuState rival_end = endState(rival, end, b_lin);
-    if (c - best_cost < margin && distinctPoses(rival_end, best_end)) {
-      reason_ = "motion alignment: ambiguous (two poses " + std::to_string((rival_end.p_IinG - best_end.p_IinG).norm()) +
-                " m apart fit the ranges within " + std::to_string(c - best_cost) +
-                "): anchor geometry or motion cannot fix the pose yet";
+    if (!distinctPoses(rival_end, best_end)) continue;
+    if (!heading && c - best_cost < margin) {
+      reason_ = ambiguity(rival_end, best_end, c - best_cost);
       return std::nullopt;
     }
+    minima.push_back({rival, rival_end, c + headingTerm(rival_end)});
   }
-  return finish(obs, heights, best, info, end, b_lin);
+  if (heading) {
+    // The lowest score, unless another distinct minimum scores within the margin of it.
+    std::sort(minima.begin(), minima.end(), [](const Minimum& a, const Minimum& b) { return a.score < b.score; });
+    for (size_t k = 1; k < minima.size(); ++k)
+      if (minima[k].score - minima[0].score < margin && distinctPoses(minima[k].e, minima[0].e)) {
+        reason_ = ambiguity(minima[k].e, minima[0].e, minima[k].score - minima[0].score);
+        return std::nullopt;
+      }
+    if (distinctPoses(minima[0].e, best_end)) {  // a rival won: its covariance from its own fit
+      best = minima[0].x;
+      fit(obs, heights, w.dbg_prior_mean, best, &info);
+      ++heading_decisions_;
+    }
+  }
+  return finish(obs, heights, best, info, end, b_lin, heading);
 }
 
 std::optional<MotionAligner::GravityCheck> MotionAligner::checkGravityDirection(const Eigen::Vector3d& bias_gyro_rad_s) {
@@ -354,7 +391,8 @@ double MotionAligner::robustVarianceFactor(const std::vector<Obs>& obs, const Un
 
 std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights,
                                                      const Unknowns& x, const MatU& info, const Increments& end,
-                                                     const Eigen::Vector3d& bias_gyro) {
+                                                     const Eigen::Vector3d& bias_gyro,
+                                                     const std::optional<HeadingPrior>& heading) {
   const MatU Sigma = options_.cov_inflation * info.ldlt().solve(MatU::Identity());
   const ImuState e0 = endState(x, end, bias_gyro);
   Eigen::Matrix<double, 15, kDim> J;
@@ -371,6 +409,16 @@ std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs
     res.cov(ImuErr::kP + i, ImuErr::kP + i) += 0.02 * 0.02;
     res.cov(ImuErr::kV + i, ImuErr::kV + i) += 0.05 * 0.05;
     res.cov(ImuErr::kTheta + i, ImuErr::kTheta + i) += std::pow(0.5 * kDeg, 2);
+  }
+  if (heading) {
+    Eigen::Matrix<double, 15, 1> h = Eigen::Matrix<double, 15, 1>::Zero();
+    h.segment<3>(ImuErr::kTheta) = res.imu.q_ItoG.conjugate() * Eigen::Vector3d::UnitZ();  // δψ = nᵀ δθ
+    const Eigen::Matrix<double, 15, 1> Ph = res.cov * h;
+    const double s = h.dot(Ph) + heading->var_rad2;
+    const Eigen::Matrix<double, 15, 1> K = Ph / s;
+    res.imu.boxplus(K * std::remainder(heading->yaw_rad - so3::yawOf(res.imu.q_ItoG), 2.0 * M_PI));
+    res.cov -= K * Ph.transpose();
+    res.cov = (0.5 * (res.cov + res.cov.transpose())).eval();
   }
   res.t = imu_.back().t;
   res.last_imu = imu_.back();
@@ -389,7 +437,7 @@ std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs
   }
   res.n_anchors = static_cast<int>(used_anchors.size());
   res.rms_m = res.n_ranges ? std::sqrt(sq / res.n_ranges) : 0.0;
-  res.sigma_yaw_deg = std::sqrt(so3::yawVariance(e0.q_ItoG, res.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta))) / kDeg;
+  res.sigma_yaw_deg = std::sqrt(so3::yawVariance(res.imu.q_ItoG, res.cov.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta))) / kDeg;
   res.sigma_p_m = std::sqrt(res.cov.block<3, 3>(ImuErr::kP, ImuErr::kP).diagonal().maxCoeff());
   if (!res.cov.allFinite() || res.sigma_yaw_deg > options_.max_sigma_yaw_deg || res.sigma_p_m > options_.max_sigma_p_m) {
     reason_ = "motion alignment: pose not determined yet (σ_yaw " + std::to_string(res.sigma_yaw_deg) + " deg, σ_p " +

@@ -10,12 +10,19 @@
 #include <stdexcept>
 
 #include "common/atmosphere.h"
+#include "estimator/core/so3.h"
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/init/initial_states.h"
 #include "estimator/node/estimator_node.h"
 #include "estimator/node/node_internals.h"
 
 namespace meshnav::estimator {
+
+namespace {
+/// Added to a lost filter's heading variance before it judges rival poses: the aligner's own
+/// attitude floor is 0.5° per axis; a filter that was lost carries at least that much more [rad²].
+constexpr double kHeadingPriorFloorRad2 = (1.0 * M_PI / 180.0) * (1.0 * M_PI / 180.0);
+}  // namespace
 
 using node_internal::weakestPositionAxis;
 
@@ -101,7 +108,18 @@ void EstimatorNode::updateHealth(Timestamp t) {
 
 void EstimatorNode::tryRecover(Timestamp t) {
   const bool lost = health_.health() == Health::Lost;
-  const auto r = init_.align(cur_.filter->state().imu.bias_gyro_rad_s);
+  // Lost after a range outage, the position has drifted but the gyro kept the heading: rival poses
+  // that fit the ranges alike are told apart by it (MotionAligner::solve; docs/robustness.md).
+  std::optional<MotionAligner::HeadingPrior> heading;
+  if (lost) {
+    const ImuState& x = cur_.filter->state().imu;
+    const Eigen::Matrix3d P_tt =
+        cur_.filter->covariance(setup_.imu_id, setup_.imu_id).block<3, 3>(ImuErr::kTheta, ImuErr::kTheta);
+    heading = MotionAligner::HeadingPrior{so3::yawOf(x.q_ItoG), so3::yawVariance(x.q_ItoG, P_tt) + kHeadingPriorFloorRad2};
+  }
+  const int decided = init_.aligner().headingDecisions();
+  const auto r = init_.align(cur_.filter->state().imu.bias_gyro_rad_s, heading);
+  if (r && init_.aligner().headingDecisions() != decided) diag_.count("recovery_heading_prior_decided");
   if (!r) {
     if (!lost) return;  // degraded: nothing to compare with
     diag_.count("recovery_refused");

@@ -119,6 +119,30 @@ TEST(MotionAligner, RefusesWhileLandedWithOneTag) {
       << a.reason();
 }
 
+TEST(MotionAligner, AHeadingPriorFixesTheHeadingTheRangesLeaveOpen) {
+  // On the pad one tag's ranges fix position and tilt, never the heading: refused without a prior.
+  // A lost filter's heading (the gyro kept it through a range outage) decides among the rivals and
+  // is combined with the fit: the pose is taken, its heading within the prior's σ of the truth, the
+  // position the ranges' own.
+  const Flight f(2e-3, 2e-4);
+  const sim::TrajectoryState st = f.trajectory.evaluate(4.5);
+  const double yaw_true = std::atan2(st.R_ItoG(1, 0), st.R_ItoG(0, 0));
+  for (const double offset_deg : {0.0, 4.0}) {
+    MotionAligner a(MotionAlignerOptions{}, {{100, sim::PaperScenario::paper().tags_p_TinI.at(100)}});
+    std::mt19937_64 rng(1);
+    feed(a, f, 0.0, 4.5, {101, 102, 103, 104}, 0.1, &rng);
+    ASSERT_FALSE(a.solve(Eigen::Vector3d::Zero()));
+    const double sigma_rad = 3.0 * M_PI / 180.0;
+    const auto r = a.solve(Eigen::Vector3d::Zero(),
+                           MotionAligner::HeadingPrior{yaw_true + offset_deg * M_PI / 180.0, sigma_rad * sigma_rad});
+    ASSERT_TRUE(r) << a.reason();
+    const sim::TrajectoryState s_end = f.trajectory.evaluate(r->t.sec());
+    EXPECT_LT(std::abs(yawError(r->imu, s_end)) * 180.0 / M_PI, offset_deg + 3.0 * r->sigma_yaw_deg) << offset_deg;
+    EXPECT_LE(r->sigma_yaw_deg, 3.0 + 1e-9);  // the prior's σ, or less where the data add to it
+    EXPECT_LT((r->imu.p_IinG - s_end.p_IinG).norm(), 0.3);
+  }
+}
+
 TEST(MotionAligner, RefusesWithTwoAnchorsOrAShortWindow) {
   const Flight f(0.0, 0.0);
   MotionAligner a(MotionAlignerOptions{}, {{100, sim::PaperScenario::paper().tags_p_TinI.at(100)}});
