@@ -22,6 +22,9 @@
 #include "common/diagnostics.h"
 #include "common/types.h"
 #include "eval/chi_square.h"
+#include <utility>
+#include <vector>
+
 #include "eval/pose_error.h"
 #include "eval/trajectory_alignment.h"
 
@@ -40,6 +43,10 @@ struct EvalOptions {
   /// Leave out the stretches where groundtruth.csv contradicts imu.csv's gyro (truth_consistency.h).
   bool check_truth_with_gyro = true;
   double baseline_window_s = 0.03;  ///< its epoch length [s]: one RTLS message of ISAS-Walk1 (51 ms apart)
+  /// Windows [t0, t1] of dataset time [s] (the files' stamps) whose ground truth is left out, so
+  /// their estimates enter neither the alignment nor the figures (--exclude; a sensor outage the
+  /// figures should not mix with the rest of the run).
+  std::vector<std::pair<double, double>> exclude_windows_s;
 };
 
 /// Associates estimates with interpolated ground truth. `flight_states` may be empty (then every

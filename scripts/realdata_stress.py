@@ -9,6 +9,7 @@ Cases (times relative to the first sample of the dataset):
   late_start      every file starts 20 s later: the run begins in motion, mid-recording
   imu_gap         IMU rows of 30-33 s removed (a driver that stalled; ranges keep coming)
   range_gap       every range of 30-38 s removed (the UWB link down for 8 s)
+  range_gap_late  the same at 40-48 s
   outliers        10 % of the ranges (seeded) made 0.5-3 m longer (NLOS, multipath)
   anchor_out      every range of one anchor removed (the anchor of --anchor, default the
                   one with the most ranges), the anchor kept in setup.yaml (a dead anchor)
@@ -16,11 +17,15 @@ Cases (times relative to the first sample of the dataset):
   repeated_ranges every range row written twice (a bridge that publishes twice)
 
 A case **holds** when `meshnav_run` exits 0, the run initialized and its ATE is at most
-max(2 × clean, clean + 0.25 m) (see HOLD_FACTOR, HOLD_SLACK_M). The exit status is 1 when a
+max(2 × clean, clean + 0.25 m) (see HOLD_FACTOR, HOLD_SLACK_M). A range gap is scored without the
+outage and the SETTLE_S after it (`meshnav_eval --exclude`): what no estimator controls there is how
+far the IMU alone drifts in 8 s (on ISAS-Walk1 the same defaults drift 0.24-5.7 m RMSE for gaps
+placed 5 s apart, the filter's own σ reaching 3 m: docs/robustness.md); what it must do is come back
+after it. The whole-run ATE, outage included, is reported beside it. The exit status is 1 when a
 case does not hold, so the command can gate a test; `--expect-fail NAME` lists cases known not to
 hold (reported, not failed). Usage:
 
-  realdata_stress.py --dataset DIR [--out DIR] [--bin DIR] [--cases a,b,...] [--seed N]
+  realdata_stress.py --dataset DIR [--out DIR] [--bin DIR] [--cases a,b,...] [--seed N] [--config FILE]
 """
 
 import argparse
@@ -36,8 +41,10 @@ import robustness  # noqa: E402  (read_counter, run_command, read_refusal, metri
 
 HOLD_FACTOR = 2.0
 HOLD_SLACK_M = 0.25
-CASES = ["clean", "late_start", "imu_gap", "range_gap", "outliers", "anchor_out", "half_rate_imu",
-         "repeated_ranges"]
+CASES = ["clean", "late_start", "imu_gap", "range_gap", "range_gap_late", "outliers", "anchor_out",
+         "half_rate_imu", "repeated_ranges"]
+RANGE_GAPS_S = {"range_gap": (30.0, 38.0), "range_gap_late": (40.0, 48.0)}  # relative to the first sample
+SETTLE_S = 3.0  # after a range gap, left out of its score with the gap (the re-entry check and convergence)
 SENSOR_FILES = ["imu.csv", "ranges.csv", "groundtruth.csv", "height.csv", "baro.csv", "flight_state.csv"]
 
 
@@ -102,8 +109,9 @@ def perturb(case, src, dst, t0, seed, anchor):
             edit(name, lambda h, rows: [r for r in rows if rel(r) >= 20.0])
     elif case == "imu_gap":
         edit("imu.csv", lambda h, rows: [r for r in rows if not 30.0 <= rel(r) < 33.0])
-    elif case == "range_gap":
-        edit("ranges.csv", lambda h, rows: [r for r in rows if not 30.0 <= rel(r) < 38.0])
+    elif case in RANGE_GAPS_S:
+        g0, g1 = RANGE_GAPS_S[case]
+        edit("ranges.csv", lambda h, rows: [r for r in rows if not g0 <= rel(r) < g1])
     elif case == "half_rate_imu":
         edit("imu.csv", lambda h, rows: rows[::2])
     elif case == "repeated_ranges":
@@ -130,7 +138,7 @@ def perturb(case, src, dst, t0, seed, anchor):
         raise SystemExit("realdata_stress: unknown case %r (known: %s)" % (case, ", ".join(CASES)))
 
 
-def run_case(case, dataset, out, bin_dir, t0, seed, anchor):
+def run_case(case, dataset, out, bin_dir, t0, seed, anchor, config=None):
     """Perturb, run, evaluate one case; returns a result dict (a failed run is a result, not an exception)."""
     base = os.path.join(out, case)
     if os.path.exists(base):
@@ -139,9 +147,10 @@ def run_case(case, dataset, out, bin_dir, t0, seed, anchor):
     data, run = os.path.join(base, "dataset"), os.path.join(base, "run")
     perturb(case, dataset, data, t0, seed, anchor)
     res = {"case": case, "run_rc": None, "initialized": False, "ate_m": float("nan"), "max_late_m": float("nan"),
-           "gated": 0, "recoveries": 0, "health": "", "error": ""}
+           "ate_with_outage_m": float("nan"), "gated": 0, "recoveries": 0, "health": "", "error": ""}
     res["run_rc"] = robustness.run_command(
-        [os.path.join(bin_dir, "meshnav_run"), "--dataset", data, "--out", run], os.path.join(base, "meshnav_run.log"))
+        [os.path.join(bin_dir, "meshnav_run"), "--dataset", data, "--out", run] + (["--config", config] if config else []),
+        os.path.join(base, "meshnav_run.log"))
     status = os.path.join(run, "status.txt")
     if not os.path.exists(status):
         res["error"] = "no status.txt (see %s)" % os.path.join(base, "meshnav_run.log")
@@ -168,6 +177,24 @@ def run_case(case, dataset, out, bin_dir, t0, seed, anchor):
         res["ate_m"], res["max_late_m"] = m["pos_rmse_m"], m["max_err_after_10s_m"]
     except (OSError, ValueError, KeyError, RuntimeError) as e:
         res["error"] = "evaluation: %s" % e
+        return res
+    if case in RANGE_GAPS_S:
+        # Scored without the outage and its settling time (module docstring); the whole run beside it.
+        res["ate_with_outage_m"] = res["ate_m"]
+        g0, g1 = RANGE_GAPS_S[case]
+        scored = os.path.join(base, "scored")
+        metrics = os.path.join(scored, "metrics.json")
+        rc = robustness.run_command([os.path.join(bin_dir, "meshnav_eval"), "--dataset", data, "--run", run,
+                                     "--out", scored, "--no-plots", "--json", metrics,
+                                     "--exclude", "%.6f:%.6f" % (t0 + g0, t0 + g1 + SETTLE_S)],
+                                    os.path.join(base, "meshnav_eval_scored.log"))
+        try:
+            if rc != 0:
+                raise RuntimeError("meshnav_eval --exclude exited %d" % rc)
+            m = robustness.metrics_of(metrics, os.path.join(scored, "errors.csv"), status)
+            res["ate_m"], res["max_late_m"] = m["pos_rmse_m"], m["max_err_after_10s_m"]
+        except (OSError, ValueError, KeyError, RuntimeError) as e:
+            res["error"] = "evaluation without the outage: %s" % e
     return res
 
 
@@ -180,11 +207,11 @@ def holds(res, clean_ate):
 def write_csv(path, results, clean):
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["case", "run_rc", "initialized", "ate_m", "max_late_m", "gated", "recoveries", "health", "holds",
-                    "error"])
+        w.writerow(["case", "run_rc", "initialized", "ate_m", "max_late_m", "ate_with_outage_m", "gated", "recoveries",
+                    "health", "holds", "error"])
         for r in results:
-            w.writerow([r["case"], r["run_rc"], r["initialized"], r["ate_m"], r["max_late_m"], r["gated"],
-                        r["recoveries"], r["health"], holds(r, clean["ate_m"]), r["error"]])
+            w.writerow([r["case"], r["run_rc"], r["initialized"], r["ate_m"], r["max_late_m"], r["ate_with_outage_m"],
+                        r["gated"], r["recoveries"], r["health"], holds(r, clean["ate_m"]), r["error"]])
 
 
 def main():
@@ -197,6 +224,7 @@ def main():
     ap.add_argument("--cases", default=",".join(CASES), help="comma-separated cases (default: all)")
     ap.add_argument("--seed", type=int, default=1, help="seed of the outlier draw (default 1)")
     ap.add_argument("--anchor", help="anchor id of anchor_out (default: the one with the most ranges)")
+    ap.add_argument("--config", help="estimator options file given to every meshnav_run (default: none, the defaults)")
     ap.add_argument("--expect-fail", default="", help="comma-separated cases known not to hold (not failed)")
     a = ap.parse_args()
     cases = [c for c in a.cases.split(",") if c]
@@ -216,7 +244,7 @@ def main():
     results = []
     for case in cases:
         print("[realdata_stress] %s ..." % case, file=sys.stderr, flush=True)
-        results.append(run_case(case, a.dataset, a.out, a.bin, t0, a.seed, anchor))
+        results.append(run_case(case, a.dataset, a.out, a.bin, t0, a.seed, anchor, a.config))
     clean = results[0]
     write_csv(os.path.join(a.out, "stress.csv"), results, clean)
     if not holds(clean, clean["ate_m"]):
@@ -224,17 +252,18 @@ def main():
         return 1
     print("dataset %s (anchor_out: %s); holds: exit 0, initialized, ATE <= max(%.0f x clean, clean + %.2f m)"
           % (a.dataset, anchor, HOLD_FACTOR, HOLD_SLACK_M))
-    print("| case | meshnav_run exit | ATE [m] | max error after 10 s [m] | ranges gated | recoveries | "
-          "health at end | holds |")
-    print("| --- | ---: | ---: | ---: | ---: | ---: | --- | --- |")
+    print("| case | meshnav_run exit | ATE [m] | max error after 10 s [m] | ATE with the outage [m] | ranges gated | "
+          "recoveries | health at end | holds |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |")
     failed = []
     for r in results:
         ok = holds(r, clean["ate_m"])
         verdict = "yes" if ok else ("no (expected)" if r["case"] in expect_fail else "**no**")
         if not ok and r["case"] not in expect_fail:
             failed.append(r["case"])
-        print("| %s | %s | %s | %s | %d | %d | %s | %s |" % (
-            r["case"], r["run_rc"], robustness.fmt(r["ate_m"], 3), robustness.fmt(r["max_late_m"], 3), r["gated"],
+        print("| %s | %s | %s | %s | %s | %d | %d | %s | %s |" % (
+            r["case"], r["run_rc"], robustness.fmt(r["ate_m"], 3), robustness.fmt(r["max_late_m"], 3),
+            robustness.fmt(r["ate_with_outage_m"], 3) if r["case"] in RANGE_GAPS_S else "-", r["gated"],
             r["recoveries"], r["health"] or "-", verdict + (" " + r["error"] if r["error"] else "")))
     if failed:
         print("realdata_stress: %d case(s) do not hold: %s" % (len(failed), ", ".join(failed)))

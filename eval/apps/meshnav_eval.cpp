@@ -6,6 +6,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
+#include <optional>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -28,6 +30,23 @@ constexpr char kDescription[] =
     "multilateration baseline of a dataset alone (no --run); or, with --batch, the paper-style table over many "
     "runs.";
 
+/// "T0:T1" [s] with finite T0 < T1; nullopt otherwise.
+std::optional<std::pair<double, double>> parseWindow(const std::string& w) {
+  const size_t colon = w.find(':');
+  if (colon == std::string::npos) return std::nullopt;
+  try {
+    size_t n0 = 0, n1 = 0;
+    const std::string a = w.substr(0, colon), b = w.substr(colon + 1);
+    const double t0 = std::stod(a, &n0), t1 = std::stod(b, &n1);
+    if (n0 != a.size() || n1 != b.size() || !std::isfinite(t0) || !std::isfinite(t1) || !(t0 < t1))
+      return std::nullopt;
+    (void)Timestamp::fromSec(t0), (void)Timestamp::fromSec(t1);  // throws beyond the int64 µs range
+    return std::pair{t0, t1};
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
 /// The command line of meshnav_eval (EvalOptions holds the defaults of the metric options).
 struct EvalCli {
   EvalOptions eval;
@@ -35,6 +54,7 @@ struct EvalCli {
   std::string align;
   std::string dataset, run, out, json, calibration, batch, table_md;
   std::string dataset_subdir = "dataset", run_subdir = "run";
+  std::vector<std::string> exclude;
   bool no_plots = false, plots = false;
 };
 
@@ -53,6 +73,16 @@ void declareOptions(Cli& cli, EvalCli& c) {
   cli.flag("no-truth-check", c.no_truth_check,
            "keep the ground truth where it contradicts imu.csv's gyro (by default those windows are left out and "
            "listed: a motion-capture dropout; eval/truth_consistency.h)");
+  cli.optional("exclude", c.exclude,
+               "leave out the ground truth of dataset times T0 to T1 [s] (the files' stamps), given as T0:T1, so that "
+               "the estimates there enter neither the alignment nor the figures (a sensor outage scored apart); "
+               "repeatable")
+      ->type_name("WINDOW")
+      ->check(CLI::Validator(
+          [](std::string& w) -> std::string {
+            return parseWindow(w) ? std::string() : "'" + w + "' is not a window T0:T1 [s] with T0 < T1";
+          },
+          "T0 < T1"));
   cli.option("max-gt-gap", c.eval.max_gt_gap_s, "largest ground-truth gap that is interpolated [s]")
       ->type_name("S")->check(cli::positive());
   cli.optional("align", c.align,
@@ -90,6 +120,7 @@ EvalOptions optionsFrom(const EvalCli& c) {
   o.baseline = !c.no_baseline;
   o.check_truth_with_gyro = !c.no_truth_check;
   if (!c.align.empty()) o.align = parseAlignmentMode(c.align);
+  for (const std::string& w : c.exclude) o.exclude_windows_s.push_back(*parseWindow(w));
   return o;
 }
 

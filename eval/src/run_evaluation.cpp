@@ -65,6 +65,26 @@ void checkTruthWithGyro(RunEvaluation& ev, const fs::path& ds, Diagnostics& diag
   ev.has_ground_truth = ev.ground_truth.size() >= 2;
 }
 
+/// Drops the truth in the windows of --exclude (noted, counted "eval:excluded_truth_pose").
+void excludeWindows(RunEvaluation& ev, Diagnostics& diag) {
+  if (ev.options.exclude_windows_s.empty() || !ev.has_ground_truth) return;
+  std::vector<TruthFault> windows;
+  std::string where;
+  for (const auto& [t0, t1] : ev.options.exclude_windows_s) {
+    TruthFault w;
+    w.t0 = Timestamp::fromSec(t0);
+    w.t1 = Timestamp::fromSec(t1);
+    windows.push_back(w);
+    where += (where.empty() ? "" : ", ") + formatSeconds(w.t0) + "–" + formatSeconds(w.t1) + " s";
+  }
+  const size_t dropped = dropTruthInFaults(ev.ground_truth, windows);
+  diag.count("eval:excluded_truth_pose", static_cast<int64_t>(dropped));
+  note(ev, "--exclude " + where + ": " + std::to_string(dropped) + " ground-truth poses left out (their estimates "
+           "enter neither the alignment nor the figures)");
+  ev.has_ground_truth = ev.ground_truth.size() >= 2;
+  if (!ev.has_ground_truth) note(ev, "fewer than 2 ground-truth poses outside --exclude; pose metrics skipped");
+}
+
 /// The alignment of the estimate: --align if given, else se3 when truth.yaml says the ground truth
 /// is in another frame, else none.
 void chooseAlignment(RunEvaluation& ev, const std::optional<Truth>& truth) {
@@ -162,6 +182,7 @@ RunEvaluation evaluateRun(const std::string& dataset_dir, const std::string& run
 
   readGroundTruth(ev, ds, diag);
   checkTruthWithGyro(ev, ds, diag);
+  excludeWindows(ev, diag);
 
   // Setup (known anchors) and truth.
   std::map<SensorId, Eigen::Vector3d> known;

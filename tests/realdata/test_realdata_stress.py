@@ -37,7 +37,7 @@ class IsasStress(unittest.TestCase):
 
     def test_every_case_holds(self):
         self.assertEqual(self.proc.returncode, 0, self.proc.stdout + self.proc.stderr[-2000:])
-        self.assertEqual(set(self.rows), {"clean", "late_start", "imu_gap", "range_gap", "outliers", "anchor_out",
+        self.assertEqual(set(self.rows), {"clean", "late_start", "imu_gap", "range_gap", "range_gap_late", "outliers", "anchor_out",
                                           "half_rate_imu", "repeated_ranges"})
         for case, r in self.rows.items():
             self.assertEqual(r["holds"], "True", f"{case}: {r}")
