@@ -149,10 +149,8 @@ struct UwbOptions {
   /// (N(0, σ²), σ this value [m]). With `estimate_tag_biases` the γ are states of the tag's
   /// instance with that prior (covariance σ_c² 11ᵀ + σ² I); else σ_c² + σ² inflates the pair's
   /// range noise. 0: an unlisted pair is exact (γ = 0; calibrated ranges, setup `noise.sigma_gamma: 0`).
-  /// Default 0 (opt-in; 0.1 is the measured spread): on, with `range_error_correlation_s` 0.1, STAR-loc
-  /// reaches issue 34's targets, but ISAS-Walk1's stress cases range_gap and anchor_out then fail
-  /// (docs/uwb_bias_model.md, "Why opt-in").
-  double uncalibrated_gamma_sigma_m = 0.0;
+  /// Default 0.1 m, the measured spread (docs/uwb_bias_model.md).
+  double uncalibrated_gamma_sigma_m = 0.1;
   /// σ_c of the common part above [m]. Model parameter: the STAR-loc run is the same to 1 mm for
   /// 0.2–1.0 m (the data fix c), so it is a wide prior, not a tuning.
   double uncalibrated_common_gamma_sigma_m = 0.5;
@@ -161,9 +159,9 @@ struct UwbOptions {
   /// Model parameter: STAR-loc's errors against its truth have autocorrelation 0.52 at 0.1 s (one
   /// pair's ranges 0.072 s apart), which a first-order process has at τ ≈ 0.1 s; ranges of a pair
   /// seconds apart (MILUV's) are unchanged. 0: white errors. setup.yaml `noise.range_correlation_time`
-  /// overrides it: the simulator, whose errors are drawn independently, writes 0. Default 0
-  /// (opt-in, as `uncalibrated_gamma_sigma_m`; 0.1 s is STAR-loc's).
-  double range_error_correlation_s = 0.0;
+  /// overrides it: the simulator, whose errors are drawn independently, writes 0. The step weights
+  /// a range by (1 + ρ)/(1 − ρ) R; its gate and NIS judge it by R (Linearization::step_noise_factor).
+  double range_error_correlation_s = 0.1;
   /// A range's error is a line-of-sight / NLOS mixture (estimator/core/nlos_mixture.h): with prior
   /// probability `nlos_fraction` a positive excess nlos_min_excess_m + Exp(nlos_mean_excess_m); a
   /// range that passed the gate is weighted by its posterior probability of line of sight (only

@@ -116,8 +116,8 @@ TEST(InitialStates, UnlistedPairsShareTheirTagsCommonOffsetAndKeepTheirOwnPart) 
   EXPECT_EQ(g->state().values<TagBiasKind>().at(11).peers, (std::vector<SensorId>{101, 103}));
   EXPECT_EQ(g->state().values<TagBiasKind>().count(12), 0u);
   // The range errors' correlation time comes from the setup too (a simulator's: 0, independent).
-  EXPECT_DOUBLE_EQ(e.uwb.range_error_correlation_s, 0.0);  // opt-in
-  n.range_correlation_time_s = 0.1;
+  EXPECT_DOUBLE_EQ(e.uwb.range_error_correlation_s, 0.1);  // STAR-loc's, the default
+  n.range_correlation_time_s = 0.0;
   e.applySetupNoise(n);
-  EXPECT_DOUBLE_EQ(e.uwb.range_error_correlation_s, 0.1);
+  EXPECT_DOUBLE_EQ(e.uwb.range_error_correlation_s, 0.0);
 }
