@@ -134,6 +134,7 @@ Truth makeTruth(const SimulationOptions& o, const PaperScenario& scenario, const
   sc["sigma_range_m"] = o.uwb.sigma_range_m;
   sc["outlier_fraction"] = o.uwb.outlier_fraction;
   sc["drop_fraction"] = o.uwb.drop_fraction;
+  if (o.uwb.time_offset_s != 0.0) sc["range_time_offset_s"] = o.uwb.time_offset_s;  // the stamps' delay
   sc["tdma_slot_s"] = o.uwb.slot_s;
   sc["tdma_t0_s"] = f.tdma_t0_s;
   sc["n_range_slots"] = static_cast<double>(f.uwb->slotCount());

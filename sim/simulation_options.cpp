@@ -1,3 +1,4 @@
+#include <cmath>
 #include "sim/simulation_options.h"
 
 #include <sstream>
@@ -17,6 +18,7 @@ void SimulationOptions::validate() const {
   require(uwb.nlos_excess == "uniform" || uwb.nlos_excess == "exponential", "nlos excess must be uniform or exponential");
   require(uwb.outlier_mean_m > 0.0, "outlier mean excess must be > 0 [m]");
   require(uwb.correlation_time_s >= 0.0 && uwb.correlation_time_s <= 60.0, "range correlation time must be in [0, 60] s");
+  require(std::abs(uwb.time_offset_s) <= 1.0, "range time offset must be in [-1, 1] s");
   require(uwb.slot_s > 0.0, "slot_s must be > 0");
   require(imu.rate_hz > 0.0 && baro.rate_hz > 0.0, "sensor rates must be > 0");
   require(ground_truth_rate_hz > 0.0 && flight_state_rate_hz > 0.0, "output rates must be > 0");

@@ -18,6 +18,7 @@ std::string UwbRangeOptions::toString() const {
   else
     s << " (+U(" << outlier_min_m << ", " << outlier_max_m << ") m)";
   s << ", drops " << drop_fraction;
+  if (time_offset_s != 0.0) s << ", stamps " << time_offset_s * 1e3 << " ms late against the IMU";
   return s.str();
 }
 
@@ -63,6 +64,8 @@ std::vector<SimulatedRange> UwbRangeSimulator::simulate(const Trajectory& trajec
       ++n_dropped_;
       continue;
     }
+    const double stamp_s = slot.t_s + options_.time_offset_s;  // the UWB clock's stamp of the instant slot.t_s
+    if (stamp_s < 0.0) continue;
     const TrajectoryState st = trajectory.evaluate(slot.t_s);
     const double d = (devicePosition(slot.initiator, st) - devicePosition(slot.responder, st)).norm();
     const PairBias& bias = biases_.truth(slot.initiator, slot.responder);
@@ -74,7 +77,7 @@ std::vector<SimulatedRange> UwbRangeSimulator::simulate(const Trajectory& trajec
       z += excess;
       ++n_outliers_;
     }
-    r.sample.t = Timestamp::fromSec(slot.t_s);
+    r.sample.t = Timestamp::fromSec(stamp_s);
     r.sample.id_initiator = slot.initiator;
     r.sample.id_responder = slot.responder;
     r.sample.type_initiator = scenario_.typeOf(slot.initiator);

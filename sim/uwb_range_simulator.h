@@ -13,6 +13,9 @@
 /// previous slot (real multipath changes with the geometry, slowly: STAR-loc, docs/uwb_bias_model.md);
 /// τ = 0: independent. Every slot consumes the same random draws whatever the options, so e.g.
 /// disabling noise leaves the outlier pattern unchanged, and the defaults draw the paper's ranges.
+/// With a time offset δ the UWB system stamps late (or early, δ < 0) against the IMU's clock: the
+/// distance at t is written with stamp t + δ (STAR-loc's IMU stamps lead its ranges by about 30 ms,
+/// docs/uwb_bias_model.md); a range whose stamp would be before 0 is not written.
 /// The written `R` is σ_d², `range_corr` equals the raw range, `LOS` is always 1 (as in real data,
 /// where the flag carries no information; outliers are marked only in `SimulatedRange`).
 
@@ -39,6 +42,7 @@ struct UwbRangeOptions {
   double outlier_mean_m = 0.3;     ///< mean excess beyond outlier_min_m (exponential) [m]
   double correlation_time_s = 0.0;  ///< τ of a pair's range error, 0 = independent [s]
   double drop_fraction = 0.02;     ///< δ [-]
+  double time_offset_s = 0.0;      ///< the stamps' delay against the IMU clock: d(t) is stamped t + this [s]
   std::string toString() const;
 };
 

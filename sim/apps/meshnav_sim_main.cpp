@@ -94,6 +94,11 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
              "correlation time of a pair's range error, a first-order process (real multipath: about 0.1 s at a "
              "walk), written to setup.yaml noise.range_correlation_time; 0 = independent [s]")
       ->type_name("S")->check(cli_checks::nonNegative())->group("Sensors");
+  cli.option("range-time-offset", o.uwb.time_offset_s,
+             "the UWB stamps' delay against the IMU clock: the distance at t is stamped t + S (STAR-loc's IMU "
+             "stamps lead its ranges by about 0.03 s); written to truth.yaml range_time_offset_s, not to setup.yaml "
+             "[s]")
+      ->type_name("S")->check(cli_checks::finite())->group("Sensors");
   cli.option("drop,--drop-fraction", o.uwb.drop_fraction, "fraction of dropped range messages")
       ->type_name("F")->check(cli_checks::nonNegative())->group("Sensors");
   c.bias_max_m = o.hardware.gamma_max_m;

@@ -192,3 +192,37 @@ TEST(SimUwbRangeSimulator, CorrelatedErrorsFollowAFirstOrderProcessPerPair) {
   EXPECT_NEAR(std::sqrt(s2 / rb.size()), 1.0, 0.1);
   for (size_t k = 0; k < ra.size(); k += 97) EXPECT_EQ(ra[k].outlier, rb[k].outlier);
 }
+
+TEST(SimUwbRangeSimulator, ATimeOffsetStampsTheDistanceAtTWithTPlusTheOffset) {
+  // Noise-free: the range stamped s is the distance at s − δ exactly (and, the vehicle moving, not
+  // the distance at s); the same slots, draws and values as without the offset, only the stamps
+  // move; a stamp that would fall before 0 is not written.
+  Fixture f;
+  UwbRangeOptions plain, late, early;
+  plain.sigma_range_m = late.sigma_range_m = early.sigma_range_m = 0.0;
+  late.time_offset_s = 0.05;
+  early.time_offset_s = -0.05;
+  UwbRangeSimulator a(f.scenario, f.biases, plain, 4), b(f.scenario, f.biases, late, 4), c(f.scenario, f.biases, early, 4);
+  const auto ra = a.simulate(f.trajectory, f.schedule, 30.0);
+  const auto rb = b.simulate(f.trajectory, f.schedule, 30.0);
+  const auto rc = c.simulate(f.trajectory, f.schedule, 30.0);
+  ASSERT_EQ(ra.size(), rb.size());
+  double moved = 0.0;
+  for (size_t k = 0; k < rb.size(); ++k) {
+    EXPECT_EQ(rb[k].sample.range_m, ra[k].sample.range_m);
+    EXPECT_EQ(rb[k].sample.t.us - ra[k].sample.t.us, 50000);
+    if (rb[k].outlier) continue;
+    const auto& bias = f.biases.truth(rb[k].sample.id_initiator, rb[k].sample.id_responder);
+    const auto at = [&](double t) {
+      const auto st = f.trajectory.evaluate(t);
+      return bias.beta * (b.devicePosition(rb[k].sample.id_initiator, st) - b.devicePosition(rb[k].sample.id_responder, st)).norm() +
+             bias.gamma_m;
+    };
+    EXPECT_NEAR(rb[k].sample.range_m, at(rb[k].sample.t.sec() - 0.05), 1e-9);
+    moved = std::max(moved, std::abs(rb[k].sample.range_m - at(rb[k].sample.t.sec())));
+  }
+  EXPECT_GT(moved, 0.01) << "the vehicle moves: 50 ms change some distances by centimetres";
+  ASSERT_FALSE(rc.empty());
+  EXPECT_GE(rc.front().sample.t.us, 0);
+  EXPECT_LE(rc.size(), ra.size());
+}
