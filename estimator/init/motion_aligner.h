@@ -126,7 +126,9 @@ class MotionAligner {
   /// Distinct minima that fit within the ambiguity margin are rivals. Without `heading` the window
   /// is then refused. With it each minimum k scores its negative log-posterior in the cost's units,
   /// J_k = c_k + v (ψ_k − ψ_prior)² / σ_ψ² (v the robust variance factor: the costs are v-scaled
-  /// χ²), and the lowest is taken when every other scores beyond the margin; else refused.
+  /// χ²), and the lowest is taken when every other scores beyond the margin; else refused. A fit
+  /// without rivals is taken by its cost, as without a prior. The pose taken is then combined with
+  /// the prior (finish) unless it contradicts it.
   std::optional<AlignmentResult> solve(const Eigen::Vector3d& bias_gyro_rad_s,
                                        const std::optional<HeadingPrior>& heading = std::nullopt);
   /// Which way gravity points in G, by the data. The estimator assumes −z (z up); an anchor
@@ -153,6 +155,8 @@ class MotionAligner {
   int relinearizations() const { return relinearizations_; }
   /// Solves in which the heading prior chose a rival over the best fit by cost (all calls).
   int headingDecisions() const { return heading_decisions_; }
+  /// Poses whose heading contradicted the prior (beyond `ambiguity_chi2`, 1 dof): kept without it.
+  int headingPriorRejections() const { return heading_prior_rejections_; }
   /// Why the last `solve` refused.
   const std::string& reason() const { return reason_; }
   /// Data span currently held [s].
@@ -239,8 +243,8 @@ class MotionAligner {
   std::vector<Unknowns> starts(const std::vector<Obs>& obs) const;
   /// Covariance, end state and the acceptance checks of the best fit. With `heading`, the end
   /// state is first combined with the prior heading (a Kalman update of the yaw, H = [0 0 nᵀ 0 0],
-  /// n = R_ItoGᵀ e_z, so that the fit's heading and the prior's weigh by their variances); the
-  /// checks then judge the combined pose.
+  /// n = R_ItoGᵀ e_z, so that the fit's heading and the prior's weigh by their variances) unless
+  /// its innovation r²/s exceeds `ambiguity_chi2`; the checks then judge the pose.
   std::optional<AlignmentResult> finish(const std::vector<Obs>& obs, const std::vector<HeightObs>& heights,
                                         const Unknowns& x, const Info& info, const Increments& end,
                                         const Eigen::Vector3d& bias_gyro,
@@ -253,6 +257,7 @@ class MotionAligner {
   double gravity_z_sign_ = -1.0, assumed_gravity_z_sign_ = -1.0;
   int relinearizations_ = 0;  ///< re-integrations over this aligner's life
   int heading_decisions_ = 0;  ///< solves whose heading prior chose a rival (headingDecisions)
+  int heading_prior_rejections_ = 0;  ///< priors the pose contradicted (headingPriorRejections)
   /// The caller's gyro bias (the prior's centre) and the bias the best fit of the last solve found
   /// about it; the next solve with the same prior integrates at the latter [rad/s]
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> last_fit_;

@@ -308,6 +308,7 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
     double score;
   };
   std::vector<Minimum> minima{{best, best_end, best_cost + headingTerm(best_end)}};
+  bool ranges_ambiguous = false;  // a distinct minimum fits within the margin by the ranges alone
   std::vector<ImuState> checked;
   for (const size_t k : rivalOrder(cands, best_end.p_IinG)) {
     if (checked.size() >= 6) break;
@@ -319,13 +320,17 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
     const double c = fit(obs, heights, w.dbg_prior_mean, rival, nullptr);
     const ImuState rival_end = endState(rival, end, b_lin);
     if (!distinctPoses(rival_end, best_end)) continue;
-    if (!heading && c - best_cost < margin) {
-      reason_ = ambiguity(rival_end, best_end, c - best_cost);
-      return std::nullopt;
+    if (c - best_cost < margin) {
+      if (!heading) {
+        reason_ = ambiguity(rival_end, best_end, c - best_cost);
+        return std::nullopt;
+      }
+      ranges_ambiguous = true;
     }
     minima.push_back({rival, rival_end, c + headingTerm(rival_end)});
   }
-  if (heading) {
+  // The prior decides only what the ranges leave open: an unambiguous fit is taken by its cost.
+  if (heading && ranges_ambiguous) {
     // The lowest score, unless another distinct minimum scores within the margin of it.
     std::sort(minima.begin(), minima.end(), [](const Minimum& a, const Minimum& b) { return a.score < b.score; });
     for (size_t k = 1; k < minima.size(); ++k)
@@ -415,10 +420,17 @@ std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs
     h.segment<3>(ImuErr::kTheta) = res.imu.q_ItoG.conjugate() * Eigen::Vector3d::UnitZ();  // δψ = nᵀ δθ
     const Eigen::Matrix<double, 15, 1> Ph = res.cov * h;
     const double s = h.dot(Ph) + heading->var_rad2;
-    const Eigen::Matrix<double, 15, 1> K = Ph / s;
-    res.imu.boxplus(K * std::remainder(heading->yaw_rad - so3::yawOf(res.imu.q_ItoG), 2.0 * M_PI));
-    res.cov -= K * Ph.transpose();
-    res.cov = (0.5 * (res.cov + res.cov.transpose())).eval();
+    const double r = std::remainder(heading->yaw_rad - so3::yawOf(res.imu.q_ItoG), 2.0 * M_PI);
+    // A prior the fit contradicts (r²/s beyond the ambiguity bound, χ²₁) is the lost filter's
+    // error, not information: the pose keeps the fit's own heading.
+    if (r * r / s <= options_.ambiguity_chi2) {
+      const Eigen::Matrix<double, 15, 1> K = Ph / s;
+      res.imu.boxplus(K * r);
+      res.cov -= K * Ph.transpose();
+      res.cov = (0.5 * (res.cov + res.cov.transpose())).eval();
+    } else {
+      ++heading_prior_rejections_;
+    }
   }
   res.t = imu_.back().t;
   res.last_imu = imu_.back();

@@ -19,8 +19,8 @@
 namespace meshnav::estimator {
 
 namespace {
-/// Added to a lost filter's heading variance before it judges rival poses: the aligner's own
-/// attitude floor is 0.5° per axis; a filter that was lost carries at least that much more [rad²].
+/// Added to a lost filter's heading variance before it judges rival poses: a floor of (1°)², twice
+/// the aligner's own attitude floor of 0.5° per axis, for a filter that was lost [rad²].
 constexpr double kHeadingPriorFloorRad2 = (1.0 * M_PI / 180.0) * (1.0 * M_PI / 180.0);
 }  // namespace
 
@@ -117,9 +117,10 @@ void EstimatorNode::tryRecover(Timestamp t) {
         cur_.filter->covariance(setup_.imu_id, setup_.imu_id).block<3, 3>(ImuErr::kTheta, ImuErr::kTheta);
     heading = MotionAligner::HeadingPrior{so3::yawOf(x.q_ItoG), so3::yawVariance(x.q_ItoG, P_tt) + kHeadingPriorFloorRad2};
   }
-  const int decided = init_.aligner().headingDecisions();
+  const int decided = init_.aligner().headingDecisions(), contradicted = init_.aligner().headingPriorRejections();
   const auto r = init_.align(cur_.filter->state().imu.bias_gyro_rad_s, heading);
   if (r && init_.aligner().headingDecisions() != decided) diag_.count("recovery_heading_prior_decided");
+  if (init_.aligner().headingPriorRejections() != contradicted) diag_.count("recovery_heading_prior_contradicted");
   if (!r) {
     if (!lost) return;  // degraded: nothing to compare with
     diag_.count("recovery_refused");

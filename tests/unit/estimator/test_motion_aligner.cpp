@@ -2,8 +2,11 @@
 /// consistent with noise, refused while landed (yaw unobservable) and without enough anchors.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <optional>
 #include <random>
 
+#include "estimator/core/so3.h"
 #include "estimator/init/motion_aligner.h"
 #include "sim/imu_simulator.h"
 #include "sim/paper_scenario.h"
@@ -141,6 +144,36 @@ TEST(MotionAligner, AHeadingPriorFixesTheHeadingTheRangesLeaveOpen) {
     EXPECT_LE(r->sigma_yaw_deg, 3.0 + 1e-9);  // the prior's σ, or less where the data add to it
     EXPECT_LT((r->imu.p_IinG - s_end.p_IinG).norm(), 0.3);
   }
+}
+
+TEST(MotionAligner, AHeadingPriorTheFitContradictsIsNotTaken) {
+  // In flight one tag's 6 s window fixes the heading on its own (σ_ψ about 19°): a lost filter's
+  // heading 120° off (σ 3°, r²/s about 38) is its own error. The fit is taken as without a prior
+  // (same pose, same heading) and the rejection is counted; a prior that agrees is fused and
+  // narrows the heading.
+  const Flight f(2e-3, 2e-4);
+  auto solveWith = [&](const std::optional<MotionAligner::HeadingPrior>& prior, int* rejections) {
+    MotionAligner a(MotionAlignerOptions{}, {{100, sim::PaperScenario::paper().tags_p_TinI.at(100)}});
+    std::mt19937_64 rng(7);
+    feed(a, f, 40.0, 46.0, {101, 102, 103, 104}, 0.1, &rng);
+    auto r = a.solve(Eigen::Vector3d::Zero(), prior);
+    *rejections = a.headingPriorRejections();
+    return r;
+  };
+  int rejections = 0;
+  const auto free = solveWith(std::nullopt, &rejections);
+  ASSERT_TRUE(free);
+  const double yaw = so3::yawOf(free->imu.q_ItoG), var = std::pow(3.0 * M_PI / 180.0, 2);
+  const auto wrong = solveWith(MotionAligner::HeadingPrior{yaw + 120.0 * M_PI / 180.0, var}, &rejections);
+  ASSERT_TRUE(wrong);
+  EXPECT_EQ(rejections, 1);
+  EXPECT_EQ(wrong->imu.q_ItoG.coeffs(), free->imu.q_ItoG.coeffs());
+  EXPECT_EQ(wrong->imu.p_IinG, free->imu.p_IinG);
+  const auto agreeing = solveWith(MotionAligner::HeadingPrior{yaw, var}, &rejections);
+  ASSERT_TRUE(agreeing);
+  EXPECT_EQ(rejections, 0);
+  EXPECT_LT(agreeing->sigma_yaw_deg, free->sigma_yaw_deg);
+  EXPECT_NEAR(so3::yawOf(agreeing->imu.q_ItoG), yaw, 1e-9);
 }
 
 TEST(MotionAligner, RefusesWithTwoAnchorsOrAShortWindow) {
