@@ -17,14 +17,12 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/diagnostics.h"
 #include "common/types.h"
 #include "eval/chi_square.h"
-#include <utility>
-#include <vector>
-
 #include "eval/pose_error.h"
 #include "eval/trajectory_alignment.h"
 

@@ -202,6 +202,11 @@ int runSingle(const EvalCli& cli) {
     return 1;
   }
   if (!(ev.trajectory.n_selected > 0 || ev.anchors)) return 1;
+  // Windows that left no pose to score make the run's figures missing, not healthy.
+  if (!ev.options.exclude_windows_s.empty() && ev.trajectory.n_selected == 0) {
+    spdlog::error("--exclude left no estimate to score");
+    return 1;
+  }
   return badTimeRows(ev) ? 3 : 0;
 }
 

@@ -23,6 +23,13 @@ std::vector<PoseError> associate(const std::vector<PoseEstimate>& estimates,
   out.reserve(estimates.size());
   const Duration max_gap = Duration::fromSec(options.max_gt_gap_s);
   for (const auto& est : estimates) {
+    // In an excluded window even where the truth left around it is close enough to interpolate.
+    const double t_s = est.t.sec();
+    if (std::any_of(options.exclude_windows_s.begin(), options.exclude_windows_s.end(),
+                    [&](const auto& w) { return t_s >= w.first && t_s <= w.second; })) {
+      diag.count("eval:excluded_estimate");
+      continue;
+    }
     const auto truth = interpolatePose(ground_truth, est.t, max_gap);
     if (!truth) {
       diag.count("eval:outside_ground_truth");

@@ -136,6 +136,15 @@ TEST_F(RunEvaluationTest, AnExcludedWindowIsLeftOutOfTheFiguresAndCounted) {
   EXPECT_NE(std::find_if(ev.notes.begin(), ev.notes.end(),
                          [](const std::string& n) { return n.find("--exclude") != std::string::npos; }),
             ev.notes.end());
+  // A window shorter than the interpolation gap (0.2 s) is excluded too, not bridged by the truth
+  // around it; one that holds no truth (seconds where the files hold other stamps) says so.
+  opt.exclude_windows_s = {{4.0, 4.1}, {500.0, 600.0}};
+  const RunEvaluation short_window = evaluateRun(ds_.string(), run_.string(), opt);
+  EXPECT_EQ(short_window.trajectory.n_associated, 200 - 2);  // 4.025 and 4.075 s
+  EXPECT_EQ(short_window.diagnostics.at("eval:excluded_estimate"), 2);
+  EXPECT_NE(std::find_if(short_window.notes.begin(), short_window.notes.end(),
+                         [](const std::string& n) { return n.find("holds no ground-truth pose") != std::string::npos; }),
+            short_window.notes.end());
 }
 
 TEST_F(RunEvaluationTest, MetricsTablesAndFiles) {
