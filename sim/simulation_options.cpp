@@ -1,6 +1,6 @@
-#include <cmath>
 #include "sim/simulation_options.h"
 
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 

@@ -14,8 +14,8 @@
 /// τ = 0: independent. Every slot consumes the same random draws whatever the options, so e.g.
 /// disabling noise leaves the outlier pattern unchanged, and the defaults draw the paper's ranges.
 /// With a time offset δ the UWB system stamps late (or early, δ < 0) against the IMU's clock: the
-/// distance at t is written with stamp t + δ (STAR-loc's IMU stamps lead its ranges by about 30 ms,
-/// docs/uwb_bias_model.md); a range whose stamp would be before 0 is not written.
+/// distance at t is written with stamp t + δ (issue 34 measured STAR-loc's IMU stamps leading its
+/// ranges by about 30 ms); a range whose stamp would be before 0 is not written.
 /// The written `R` is σ_d², `range_corr` equals the raw range, `LOS` is always 1 (as in real data,
 /// where the flag carries no information; outliers are marked only in `SimulatedRange`).
 

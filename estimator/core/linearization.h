@@ -45,8 +45,6 @@ struct Linearization {
   /// "Correlated errors"); 1: white errors.
   double step_noise_factor = 1.0;
   int dim() const { return static_cast<int>(residual.size()); }
-  /// The factor on s = H P Hᵀ + R of this (scalar) measurement after the gate: the Huber weight
-  /// times the NLOS mixture's 1/w (both 1 when off or not scalar).
   /// The innovation covariance of the step for s = H P Hᵀ + R that passed the gate at `nis`:
   /// (s + (step_noise_factor − 1) R) times the robust weights (robustInflation, judged on s).
   template <class Mat>
@@ -56,6 +54,8 @@ struct Linearization {
     if (dim() == 1) out *= robustInflation(nis, s(0, 0));
     return out;
   }
+  /// The factor on s = H P Hᵀ + R of this (scalar) measurement after the gate: the Huber weight
+  /// times the NLOS mixture's 1/w (both 1 when off or not scalar).
   double robustInflation(double nis, double s) const {
     if (dim() != 1) return 1.0;
     const bool measurement_dominated = (s - R(0, 0)) / R(0, 0) <= huber_max_prior_ratio;

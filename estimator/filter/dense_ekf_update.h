@@ -20,7 +20,7 @@ struct DenseUpdateOutput {
   double nis = 0.0;
   Eigen::VectorXd dx;  ///< δx in `layout` order (when accepted)
   Eigen::MatrixXd K;   ///< gain n × m (when accepted)
-  Eigen::MatrixXd S;   ///< innovation covariance H P Hᵀ + R_eff, m × m (when accepted; R_eff = R unless Huber-weighted)
+  Eigen::MatrixXd S;   ///< innovation covariance H P Hᵀ + R_eff, m × m (when accepted; R_eff = R unless weighted: Linearization::stepCovariance)
 };
 
 /// Updates `P` (laid out as `layout`) in place when the NIS passes `nis_gate` (≤ 0: no gate).

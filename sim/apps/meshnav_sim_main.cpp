@@ -95,8 +95,8 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
              "walk), written to setup.yaml noise.range_correlation_time; 0 = independent [s]")
       ->type_name("S")->check(cli_checks::nonNegative())->group("Sensors");
   cli.option("range-time-offset", o.uwb.time_offset_s,
-             "the UWB stamps' delay against the IMU clock: the distance at t is stamped t + S (STAR-loc's IMU "
-             "stamps lead its ranges by about 0.03 s); written to truth.yaml range_time_offset_s, not to setup.yaml "
+             "the UWB stamps' delay against the IMU clock: the distance at t is stamped t + S (issue 34 measured "
+             "STAR-loc's IMU stamps leading its ranges by about 0.03 s); written to truth.yaml range_time_offset_s, not to setup.yaml "
              "[s]")
       ->type_name("S")->check(cli_checks::finite())->group("Sensors");
   cli.option("drop,--drop-fraction", o.uwb.drop_fraction, "fraction of dropped range messages")

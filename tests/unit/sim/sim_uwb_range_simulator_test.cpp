@@ -224,5 +224,5 @@ TEST(SimUwbRangeSimulator, ATimeOffsetStampsTheDistanceAtTWithTPlusTheOffset) {
   EXPECT_GT(moved, 0.01) << "the vehicle moves: 50 ms change some distances by centimetres";
   ASSERT_FALSE(rc.empty());
   EXPECT_GE(rc.front().sample.t.us, 0);
-  EXPECT_LE(rc.size(), ra.size());
+  EXPECT_LT(rc.size(), ra.size());  // slots in the first 0.05 s would be stamped before 0
 }
