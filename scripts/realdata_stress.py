@@ -138,6 +138,18 @@ def perturb(case, src, dst, t0, seed, anchor):
         raise SystemExit("realdata_stress: unknown case %r (known: %s)" % (case, ", ".join(CASES)))
 
 
+def evaluate(bin_dir, data, run, out, log, status, extra=()):
+    """(ATE, max error after 10 s) [m] of `run` by meshnav_eval into `out`; raises RuntimeError when
+    it fails or finds nothing to score."""
+    metrics = os.path.join(out, "metrics.json")
+    rc = robustness.run_command([os.path.join(bin_dir, "meshnav_eval"), "--dataset", data, "--run", run, "--out", out,
+                                 "--no-plots", "--json", metrics] + list(extra), log)
+    if rc != 0:
+        raise RuntimeError("meshnav_eval exited %d (see %s)" % (rc, log))
+    m = robustness.metrics_of(metrics, os.path.join(out, "errors.csv"), status)
+    return m["pos_rmse_m"], m["max_err_after_10s_m"]
+
+
 def run_case(case, dataset, out, bin_dir, t0, seed, anchor, config=None):
     """Perturb, run, evaluate one case; returns a result dict (a failed run is a result, not an exception)."""
     base = os.path.join(out, case)
@@ -166,35 +178,18 @@ def run_case(case, dataset, out, bin_dir, t0, seed, anchor, config=None):
     if refusal is not None:
         res["error"] = "never initialized: " + refusal
         return res
-    metrics = os.path.join(run, "metrics.json")
-    rc = robustness.run_command([os.path.join(bin_dir, "meshnav_eval"), "--dataset", data, "--run", run,
-                                 "--no-plots", "--json", metrics], os.path.join(base, "meshnav_eval.log"))
-    if rc != 0:
-        res["error"] = "meshnav_eval exited %d (see %s)" % (rc, os.path.join(base, "meshnav_eval.log"))
-        return res
     try:
-        m = robustness.metrics_of(metrics, os.path.join(run, "errors.csv"), status)
-        res["ate_m"], res["max_late_m"] = m["pos_rmse_m"], m["max_err_after_10s_m"]
+        res["ate_m"], res["max_late_m"] = evaluate(bin_dir, data, run, run, os.path.join(base, "meshnav_eval.log"),
+                                                   status)
+        if case in RANGE_GAPS_S:
+            # Scored without the outage and its settling time (module docstring); the whole run beside it.
+            res["ate_with_outage_m"] = res["ate_m"]
+            g0, g1 = RANGE_GAPS_S[case]
+            res["ate_m"], res["max_late_m"] = evaluate(
+                bin_dir, data, run, os.path.join(base, "scored"), os.path.join(base, "meshnav_eval_scored.log"), status,
+                ["--exclude", "%.6f:%.6f" % (t0 + g0, t0 + g1 + SETTLE_S)])
     except (OSError, ValueError, KeyError, RuntimeError) as e:
         res["error"] = "evaluation: %s" % e
-        return res
-    if case in RANGE_GAPS_S:
-        # Scored without the outage and its settling time (module docstring); the whole run beside it.
-        res["ate_with_outage_m"] = res["ate_m"]
-        g0, g1 = RANGE_GAPS_S[case]
-        scored = os.path.join(base, "scored")
-        metrics = os.path.join(scored, "metrics.json")
-        rc = robustness.run_command([os.path.join(bin_dir, "meshnav_eval"), "--dataset", data, "--run", run,
-                                     "--out", scored, "--no-plots", "--json", metrics,
-                                     "--exclude", "%.6f:%.6f" % (t0 + g0, t0 + g1 + SETTLE_S)],
-                                    os.path.join(base, "meshnav_eval_scored.log"))
-        try:
-            if rc != 0:
-                raise RuntimeError("meshnav_eval --exclude exited %d" % rc)
-            m = robustness.metrics_of(metrics, os.path.join(scored, "errors.csv"), status)
-            res["ate_m"], res["max_late_m"] = m["pos_rmse_m"], m["max_err_after_10s_m"]
-        except (OSError, ValueError, KeyError, RuntimeError) as e:
-            res["error"] = "evaluation without the outage: %s" % e
     return res
 
 

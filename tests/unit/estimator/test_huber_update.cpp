@@ -56,6 +56,18 @@ double innovationVariance(const FusionStrategy& f, const Linearization& lin) {
   return s;
 }
 
+/// Updates `weighted` with `lin` and `plain` with `lin_eff`, the plain update with the R_eff the
+/// weighting stands for: both accepted, the same states and cross-covariances. Returns the
+/// weighted update's result.
+UpdateResult expectThePlainUpdateWithREff(FusionStrategy& weighted, const Linearization& lin, FusionStrategy& plain,
+                                          const Linearization& lin_eff) {
+  const UpdateResult rw = weighted.update(lin, 0.0), rp = plain.update(lin_eff, 0.0);
+  EXPECT_TRUE(rw.accepted && rp.accepted);
+  EXPECT_LT(test::relativeDifference(weighted, plain), 1e-12);
+  EXPECT_LT(crossDifference(weighted, plain), 1e-15);
+  return rw;
+}
+
 }  // namespace
 
 TEST(HuberUpdate, InflationIsRootNisOverKBeyondKAndOneElsewhere) {
@@ -85,11 +97,8 @@ TEST(HuberUpdate, EqualsThePlainUpdateWithTheInflatedNoiseInEveryStrategy) {
     lin.huber_max_prior_ratio = 1.0;
     Linearization lin_eff = test::imuAnchorRange(plain->state(), 106, 4.0);
     lin_eff.R(0, 0) += S * (e / 2.0 - 1.0);
-    const UpdateResult rh = robust->update(lin, 0.0), rp = plain->update(lin_eff, 0.0);
-    ASSERT_TRUE(rh.accepted && rp.accepted);
+    const UpdateResult rh = expectThePlainUpdateWithREff(*robust, lin, *plain, lin_eff);
     EXPECT_NEAR(rh.nis, r * r / S, 1e-12) << "the NIS of the stated R";
-    EXPECT_LT(test::relativeDifference(*robust, *plain), 1e-12);
-    EXPECT_LT(crossDifference(*robust, *plain), 1e-15);
     // Against the plain update with the stated R, the step δx = P Hᵀ ν / S shrinks by k / e.
     auto stated = makeStrategy(name, 0.05);
     ASSERT_TRUE(stated->update(test::imuAnchorRange(stated->state(), 106, 4.0), 0.0).accepted);
@@ -158,11 +167,8 @@ TEST(StepNoiseFactor, TheStepWeighsRTimesTheFactorTheGateAndTheNisJudgeR) {
     lin.step_noise_factor = 2.5;
     Linearization lin_eff = test::imuAnchorRange(plain->state(), 106, 3.7);
     lin_eff.R(0, 0) *= 2.5;
-    const UpdateResult rw = weighted->update(lin, 0.0), rp = plain->update(lin_eff, 0.0);
-    ASSERT_TRUE(rw.accepted && rp.accepted);
+    const UpdateResult rw = expectThePlainUpdateWithREff(*weighted, lin, *plain, lin_eff);
     EXPECT_NEAR(rw.nis, r * r / S, 1e-12) << "the NIS of the stated R";
-    EXPECT_LT(test::relativeDifference(*weighted, *plain), 1e-12);
-    EXPECT_LT(crossDifference(*weighted, *plain), 1e-15);
 
     // Gated on the stated R: a gate between the NIS of R and that of R·f rejects the range.
     auto gated = makeStrategy(name, 0.05);
@@ -190,7 +196,6 @@ TEST(StepNoiseFactor, TheStepWeighsRTimesTheFactorTheGateAndTheNisJudgeR) {
     Linearization l2_eff = test::imuAnchorRange(ref->state(), 106, 4.0);
     const double R = l2_eff.R(0, 0);
     l2_eff.R(0, 0) = 2.5 * R + (S2 + 1.5 * R) * (e / 2.0 - 1.0);
-    ASSERT_TRUE(both->update(l2, 0.0).accepted && ref->update(l2_eff, 0.0).accepted);
-    EXPECT_LT(test::relativeDifference(*both, *ref), 1e-12);
+    expectThePlainUpdateWithREff(*both, l2, *ref, l2_eff);
   }
 }
