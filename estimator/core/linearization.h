@@ -45,14 +45,14 @@ struct Linearization {
   /// "Correlated errors"); 1: white errors.
   double step_noise_factor = 1.0;
   int dim() const { return static_cast<int>(residual.size()); }
-  /// The innovation covariance of the step for s = H P Hᵀ + R that passed the gate at `nis`:
-  /// (s + (step_noise_factor − 1) R) times the robust weights (robustInflation, judged on s).
+  /// The innovation covariance of the step for s = H P Hᵀ + R that passed the gate:
+  /// (s + (step_noise_factor − 1) R) · `robust`, the robust weights robustInflation(nis, s) judged
+  /// on the stated s (the dense and the DAH update both take it from here).
   template <class Mat>
-  Mat stepCovariance(const Mat& s, double nis) const {
+  Mat stepCovariance(const Mat& s, double robust) const {
     Mat out = s;
     if (step_noise_factor > 1.0) out += (step_noise_factor - 1.0) * R;
-    if (dim() == 1) out *= robustInflation(nis, s(0, 0));
-    return out;
+    return out * robust;
   }
   /// The factor on s = H P Hᵀ + R of this (scalar) measurement after the gate: the Huber weight
   /// times the NLOS mixture's 1/w (both 1 when off or not scalar).

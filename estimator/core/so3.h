@@ -58,10 +58,18 @@ inline double yawOf(const Eigen::Quaterniond& q_ItoG) {
   return std::atan2(R(1, 0), R(0, 0));
 }
 
-/// Variance of the heading for a local attitude error δθ (R = R̂ Exp(δθ)) of covariance Σ_θ:
-/// a rotation about G's z is δθ along n = R̂ᵀ e_z, so σ_ψ² = nᵀ Σ_θ n (≥ 0).
+/// ψ_a − ψ_b wrapped to [−π, π] [rad].
+inline double yawDifference(double psi_a, double psi_b) { return std::remainder(psi_a - psi_b, 2.0 * M_PI); }
+
+/// ∂ψ/∂δθ for a local attitude error δθ (R = R̂ Exp(δθ)): a rotation about G's z is δθ along
+/// n = R̂ᵀ e_z, so δψ = nᵀ δθ (to first order, exactly at zero pitch).
+inline Eigen::Vector3d yawDirection(const Eigen::Quaterniond& q_ItoG) {
+  return q_ItoG.conjugate() * Eigen::Vector3d::UnitZ();
+}
+
+/// Variance of the heading for a local attitude error of covariance Σ_θ: σ_ψ² = nᵀ Σ_θ n (≥ 0).
 inline double yawVariance(const Eigen::Quaterniond& q_ItoG, const Eigen::Matrix3d& Sigma_theta) {
-  const Eigen::Vector3d n = q_ItoG.conjugate() * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d n = yawDirection(q_ItoG);
   return std::max(n.dot(Sigma_theta * n), 0.0);
 }
 

@@ -30,8 +30,8 @@ DenseUpdateOutput denseEkfUpdate(Eigen::MatrixXd& P, const StateLayout& layout, 
   if (!std::isfinite(out.nis) || (nis_gate > 0.0 && out.nis > nis_gate)) return out;
   // Correlated errors and robust weights, after the gate: R_eff = R·f + S'(inflate − 1); the Joseph
   // form below uses S = H P Hᵀ + R_eff.
-  if (lin.step_noise_factor > 1.0 || (m == 1 && lin.robustInflation(out.nis, S(0, 0)) > 1.0)) {
-    S = lin.stepCovariance(S, out.nis);
+  if (const double robust = lin.robustInflation(out.nis, S(0, 0)); lin.step_noise_factor > 1.0 || robust > 1.0) {
+    S = lin.stepCovariance(S, robust);
     ldlt.compute(S);
   }
   out.K = ldlt.solve(U.transpose()).transpose();  // n × m

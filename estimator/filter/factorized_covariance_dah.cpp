@@ -257,8 +257,7 @@ class DahUpdate {
     res->nis = r * (invertible_ ? r / s_ : 0.0);
     if (!std::isfinite(res->nis) || (nis_gate > 0.0 && res->nis > nis_gate)) return false;
     // Correlated errors, Huber and NLOS weights (Linearization::stepCovariance), after the gate.
-    if (lin_.step_noise_factor > 1.0) s_ += (lin_.step_noise_factor - 1.0) * lin_.R(0, 0);
-    s_ *= lin_.robustInflation(res->nis, S(0, 0));
+    s_ = lin_.stepCovariance(S, lin_.robustInflation(res->nis, s_))(0, 0);
     Kv_.resize(n_);
     for (int i = 0; i < n_; ++i) Kv_(i) = invertible_ ? U_(i) / s_ : 0.0;
     // Element (i, j) and (j, i) in one pass over the upper triangle, then symmetrized.

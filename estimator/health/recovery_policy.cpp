@@ -34,7 +34,7 @@ bool RecoveryPolicy::alignmentDue(Timestamp t, Health h, bool accepted_fit) {
 double RecoveryPolicy::disagreement(const ImuState& x, const ImuMatrix& P, const AlignmentResult& r) {
   Eigen::Vector4d d;
   d.head<3>() = r.imu.p_IinG - x.p_IinG;
-  d(3) = std::remainder(so3::yawOf(r.imu.q_ItoG) - so3::yawOf(x.q_ItoG), 2.0 * M_PI);
+  d(3) = so3::yawDifference(so3::yawOf(r.imu.q_ItoG), so3::yawOf(x.q_ItoG));
   Eigen::Matrix4d S = Eigen::Matrix4d::Zero();
   S.topLeftCorner<3, 3>() = P.block<3, 3>(ImuErr::kP, ImuErr::kP) + r.cov.block<3, 3>(ImuErr::kP, ImuErr::kP);
   S(3, 3) = so3::yawVariance(x.q_ItoG, P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta)) +

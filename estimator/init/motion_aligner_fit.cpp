@@ -31,7 +31,7 @@ Eigen::Matrix3d rotZ(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d
 
 /// Two end states are different answers: > 0.5 m apart or > 15° apart in yaw.
 bool distinctPoses(const ImuState& a, const ImuState& b) {
-  const double dyaw = std::remainder(so3::yawOf(a.q_ItoG) - so3::yawOf(b.q_ItoG), 2 * M_PI);
+  const double dyaw = so3::yawDifference(so3::yawOf(a.q_ItoG), so3::yawOf(b.q_ItoG));
   return (a.p_IinG - b.p_IinG).norm() > 0.5 || std::abs(dyaw) > 15.0 * kDeg;
 }
 
@@ -291,11 +291,11 @@ std::optional<AlignmentResult> MotionAligner::solve(const Eigen::Vector3d& bias_
   // The heading term of a minimum's score, in the cost's units (solve's contract); 0 without a prior.
   auto headingTerm = [&](const ImuState& e) {
     if (!heading) return 0.0;
-    const double d = std::remainder(so3::yawOf(e.q_ItoG) - heading->yaw_rad, 2.0 * M_PI);
+    const double d = so3::yawDifference(so3::yawOf(e.q_ItoG), heading->yaw_rad);
     return v * d * d / heading->var_rad2;
   };
   auto ambiguity = [&](const ImuState& a, const ImuState& b, double dcost) {
-    const double dyaw = std::remainder(so3::yawOf(a.q_ItoG) - so3::yawOf(b.q_ItoG), 2.0 * M_PI) / kDeg;
+    const double dyaw = so3::yawDifference(so3::yawOf(a.q_ItoG), so3::yawOf(b.q_ItoG)) / kDeg;
     return "motion alignment: ambiguous (two poses " + fmt::format("{:.2f} m and {:.1f} deg", (a.p_IinG - b.p_IinG).norm(),
                                                                    std::abs(dyaw)) +
            " apart score within " + fmt::format("{:.1f} (margin {:.1f}{})", dcost, margin,
@@ -417,10 +417,10 @@ std::optional<AlignmentResult> MotionAligner::finish(const std::vector<Obs>& obs
   }
   if (heading) {
     Eigen::Matrix<double, 15, 1> h = Eigen::Matrix<double, 15, 1>::Zero();
-    h.segment<3>(ImuErr::kTheta) = res.imu.q_ItoG.conjugate() * Eigen::Vector3d::UnitZ();  // δψ = nᵀ δθ
+    h.segment<3>(ImuErr::kTheta) = so3::yawDirection(res.imu.q_ItoG);  // δψ = nᵀ δθ
     const Eigen::Matrix<double, 15, 1> Ph = res.cov * h;
     const double s = h.dot(Ph) + heading->var_rad2;
-    const double r = std::remainder(heading->yaw_rad - so3::yawOf(res.imu.q_ItoG), 2.0 * M_PI);
+    const double r = so3::yawDifference(heading->yaw_rad, so3::yawOf(res.imu.q_ItoG));
     // A prior the fit contradicts (r²/s beyond the ambiguity bound, χ²₁) is the lost filter's
     // error, not information: the pose keeps the fit's own heading.
     if (r * r / s <= options_.ambiguity_chi2) {
