@@ -86,6 +86,7 @@ void writeStatus(const EstimatorStatus& st, double wall_s, double data_s, const 
   out << "strategy: " << st.strategy << "\ninitialized: " << (st.initialized ? "true" : "false")
       << "\nhealth: " << st.health << "\nhealth_reason: \"" << st.health_reason << "\""
       << "\nsigma_p_max_m: " << st.sigma_p_max_m << "\nsigma_yaw_deg: " << st.sigma_yaw_deg
+      << "\nuwb_clock_offset_s: " << st.uwb_clock_offset_s << "\nuwb_clock_offset_sigma_s: " << st.uwb_clock_offset_sigma_s
       << "\nfilter_time_s: " << formatSeconds(st.t) << "\nwall_time_s: " << wall_s << "\ndata_duration_s: " << data_s
       << "\nrealtime_factor: " << (wall_s > 0 ? data_s / wall_s : 0.0) << "\ncounters:\n";
   for (const auto& [k, v] : st.counters) out << "  " << k << ": " << v << '\n';
@@ -126,6 +127,10 @@ int report(const EstimatorNode& node, double data_s, double wall_s, const std::s
                  who, pose->p_IinG.x(), pose->p_IinG.y(), pose->p_IinG.z(), pose->bias_gyro_rad_s.x(),
                  pose->bias_gyro_rad_s.y(), pose->bias_gyro_rad_s.z(), pose->bias_acc_m_s2.x(),
                  pose->bias_acc_m_s2.y(), pose->bias_acc_m_s2.z(), node.processNoiseScale());
+  if (node.initialized())
+    spdlog::info("{}UWB clock: stamps {:.1f} ms late against the IMU ({})", who, st.uwb_clock_offset_s * 1e3,
+                 st.uwb_clock_offset_sigma_s > 0 ? fmt::format("estimated, σ {:.1f} ms", st.uwb_clock_offset_sigma_s * 1e3)
+                                                  : std::string("setup.yaml's constant"));
   std::string counters;
   for (const auto& [k, v] : st.counters) counters += fmt::format("{}={} ", k, v);
   spdlog::info("{}counters: {}", who, counters);

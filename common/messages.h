@@ -39,6 +39,10 @@ struct EstimatorStatus {
   double sigma_p_max_m = 0.0;                            ///< largest principal position σ [m]
   Eigen::Vector3d weak_axis_G = Eigen::Vector3d::Zero(); ///< its direction (unit, G)
   double sigma_yaw_deg = 0.0;                            ///< yaw σ [deg]
+  /// The UWB stamps' delay against the IMU clock in use (a range stamped t was measured at the
+  /// IMU-clock instant t − this) [s], and its σ [s] (0: setup.yaml's constant, not a state).
+  double uwb_clock_offset_s = 0.0;
+  double uwb_clock_offset_sigma_s = 0.0;
 };
 
 /// ESTIMATOR_CMD: run-time control of the instance set.

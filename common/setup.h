@@ -59,11 +59,20 @@ struct NoiseFigures {
   std::optional<double> baro_pressure_sigma_pa;  ///< [Pa]
 };
 
+/// The UWB clock against the IMU clock (setup.yaml `uwb_clock`): the UWB stamps' delay δ_u [s], a
+/// range stamped t was measured at the IMU-clock instant t − δ_u.
+struct UwbClock {
+  double offset_s = 0.0;          ///< prior mean of δ_u [s]
+  std::optional<double> sigma_s;  ///< its prior σ [s] (overrides uwb.clock_offset_sigma_s); 0: known exactly
+};
+
 /// Everything a user knows about the system before flight.
 struct SystemSetup {
   SensorId imu_id = 1;
   SensorId baro_id = 2;
   SensorId height_id = 3;  ///< downward laser rangefinder (height.csv), its bias instance
+  SensorId uwb_clock_id = 4;  ///< the UWB clock's offset instance (estimated when its prior σ > 0)
+  UwbClock uwb_clock;
   std::map<SensorId, Eigen::Vector3d> rel_tag_positions;    ///< p_TinI: tag in IMU frame [m]
   std::map<SensorId, Eigen::Vector3d> abs_anchor_positions; ///< p_AinG: known anchors [m]
   /// Extension: position σ of known-but-uncertain anchors [m] (missing: exactly known).
@@ -79,9 +88,10 @@ struct SystemSetup {
 
   bool isTag(SensorId id) const { return rel_tag_positions.count(id) > 0; }
   bool isKnownAnchor(SensorId id) const { return abs_anchor_positions.count(id) > 0; }
-  /// The id of the IMU or the baro, instances every run has: never an anchor's. (height_id is
-  /// an instance only once heights come; the estimator refuses an anchor on it while it is one.)
-  bool isSensorInstanceId(SensorId id) const { return id == imu_id || id == baro_id; }
+  /// The id of the IMU, the baro or the UWB clock, instances a run may have from its start: never
+  /// an anchor's. (height_id is an instance only once heights come; the estimator refuses an anchor
+  /// on it while it is one.)
+  bool isSensorInstanceId(SensorId id) const { return id == imu_id || id == baro_id || id == uwb_clock_id; }
   /// Pair bias for (a, b) in either order, if given.
   std::optional<PairBias> findPairBias(SensorId a, SensorId b) const;
 };

@@ -42,7 +42,8 @@ SKIP_S = 10.0           # initial transient left out of the max error [s]
 BAD_ANCHOR_M = 0.5      # final error of a calibrated anchor that counts as a bad anchor [m]
 ANCHOR_NEES_BOUND = 13.93  # chi^2(3) at 99.7 %: a final anchor NEES above it is overconfident
 SCENARIO_KEYS = {"name", "seed", "trajectory", "hall", "anchor_layout", "tags", "known", "unknown",
-                 "sigma_range", "outliers", "drop", "imu_grade", "duration", "bias_max", "nlos", "range_correlation"}
+                 "sigma_range", "outliers", "drop", "imu_grade", "duration", "bias_max", "nlos", "range_correlation",
+                 "range_time_offset"}
 
 
 def pick(rng, items):
@@ -57,9 +58,11 @@ def uniform(rng, lo, hi, digits):
 def draw_scenarios(runs, seed, duration_s, widened=False):
     """`runs` scenarios drawn deterministically from `seed` over the sweep's space. `widened`: the
     range errors of real hardware too (issue 34): NLOS excess 0.2 m + Exp(0.3 m) instead of
-    U(0.5, 3) m, and a pair's error correlated over U(0, 0.3) s; the other draws are the same."""
+    U(0.5, 3) m, a pair's error correlated over U(0, 0.3) s, and range stamps U(-0.05, 0.05) s late
+    against the IMU clock; the other draws are the same."""
     rng = random.Random(seed)
     wide_rng = random.Random("widened-%d" % seed)  # its own stream: the other draws stay the plain sweep's
+    clock_rng = random.Random("widened-clock-%d" % seed)  # and one more: the correlation draws stay as they were
     out = []
     for i in range(runs):
         layout = pick(rng, LAYOUTS)
@@ -82,6 +85,7 @@ def draw_scenarios(runs, seed, duration_s, widened=False):
         if widened:
             sc["nlos"] = "exponential"
             sc["range_correlation"] = uniform(wide_rng, 0.0, 0.3, 3)
+            sc["range_time_offset"] = uniform(clock_rng, -0.05, 0.05, 3)
         out.append(sc)
     return out
 
@@ -115,7 +119,7 @@ def sim_args(sc):
     flags = [("seed", "seed"), ("trajectory", "trajectory"), ("anchor_layout", "anchor-layout"), ("tags", "tags"),
              ("known", "known"), ("unknown", "unknown"), ("sigma_range", "sigma-range"), ("outliers", "outliers"),
              ("drop", "drop"), ("imu_grade", "imu-grade"), ("duration", "duration"), ("bias_max", "bias-max"),
-             ("nlos", "nlos"), ("range_correlation", "range-correlation")]
+             ("nlos", "nlos"), ("range_correlation", "range-correlation"), ("range_time_offset", "range-time-offset")]
     args = []
     for key, flag in flags:
         if key in sc and sc[key] is not None:
@@ -368,7 +372,8 @@ def parse_args(argv):
     p.add_argument("--config", help="estimator options YAML for meshnav_run --config (default: its built-in defaults)")
     p.add_argument("--widened", action="store_true",
                    help="with --runs: draw real hardware's range errors too (NLOS excess 0.2 m + Exp(0.3 m), "
-                        "errors correlated over U(0, 0.3) s; docs/robustness.md)")
+                        "errors correlated over U(0, 0.3) s, range stamps U(-0.05, 0.05) s late against the IMU; "
+                        "docs/robustness.md)")
     p.add_argument("--duration", type=float, default=90.0, help="sequence length of drawn scenarios [s] (default 90)")
     p.add_argument("--calibration", choices=["off", "auto"], default="off",
                    help="off: known anchors only (default); auto: the unknown anchors are calibrated fly-by and "

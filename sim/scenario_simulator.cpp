@@ -96,6 +96,8 @@ SystemSetup makeSetup(const SimulationOptions& o, const PaperScenario& scenario,
   if (o.imu.acc_bias_initial_sigma > 0.0) setup.noise.imu_acc_bias_sigma = o.imu.acc_bias_initial_sigma;
   if (o.imu.gyro_bias_initial_sigma > 0.0) setup.noise.imu_gyro_bias_sigma = o.imu.gyro_bias_initial_sigma;
   setup.noise.baro_pressure_sigma_pa = o.baro.pressure_sigma_pa;
+  // Clocks drawn as one are known to be one; a drawn delay is for the estimator to find (its prior).
+  if (o.uwb.time_offset_s == 0.0) setup.uwb_clock.sigma_s = 0.0;
   return setup;
 }
 

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -166,11 +167,11 @@ void writeText(const std::string& path, const std::string& header, const char* b
   out << header << body << "\n";
 }
 
-/// Every id names one device: a collision is an error naming both roles. imu_id, baro_id and
-/// height_id left out of the file default to 1, 2 and 3; when a tag or anchor of the file uses that
-/// id, the smallest free id is taken instead (the published toolbox's config.yaml numbers anchors
-/// 1, 2, 3).
-void checkIds(SystemSetup& s, const std::string& path, bool imu_given, bool baro_given, bool height_given) {
+/// Every id names one device: a collision is an error naming both roles. imu_id, baro_id,
+/// height_id and uwb_clock_id left out of the file default to 1, 2, 3 and 4; when a tag or anchor of
+/// the file, or an id given or placed before it in that order, uses that id, the smallest free id is
+/// taken instead (the published toolbox's config.yaml numbers anchors 1, 2, 3).
+void checkIds(SystemSetup& s, const std::string& path, const YamlOptions& y) {
   auto role = [&](SensorId id) -> std::string {
     if (s.rel_tag_positions.count(id)) return "a tag (rel_tag_positions." + std::to_string(id) + ")";
     if (s.abs_anchor_positions.count(id)) return "an anchor (abs_anchor_positions." + std::to_string(id) + ")";
@@ -178,33 +179,34 @@ void checkIds(SystemSetup& s, const std::string& path, bool imu_given, bool baro
   };
   for (const auto& [id, p] : s.rel_tag_positions)
     if (s.abs_anchor_positions.count(id)) fail(path, "id " + std::to_string(id) + " is both a tag and an anchor");
-  const std::array<std::tuple<const char*, bool, SensorId*>, 3> ids{
-      {{"imu_id", imu_given, &s.imu_id}, {"baro_id", baro_given, &s.baro_id}, {"height_id", height_given, &s.height_id}}};
-  auto freeId = [&](std::initializer_list<SensorId> avoid) {
-    SensorId id = 1;
-    while (!role(id).empty() || std::find(avoid.begin(), avoid.end(), id) != avoid.end()) ++id;
-    return id;
+  const std::array<std::pair<const char*, SensorId*>, 4> ids{{{"imu_id", &s.imu_id},
+                                                              {"baro_id", &s.baro_id},
+                                                              {"height_id", &s.height_id},
+                                                              {"uwb_clock_id", &s.uwb_clock_id}}};
+  // A default id makes way for the ids given in the file and for the defaults placed before it.
+  auto taken = [&](size_t i, SensorId id) {
+    for (size_t j = 0; j < ids.size(); ++j)
+      if (j != i && *ids[j].second == id && (y.has(ids[j].first) || j < i)) return true;
+    return false;
   };
-  for (auto [key, given, id] : ids) {
+  for (size_t i = 0; i < ids.size(); ++i) {
+    auto [key, id] = ids[i];
+    const bool given = y.has(key);
     if (*id < 0) fail(path, std::string("key '") + key + "' must be an id >= 0, got " + std::to_string(*id));
     const std::string other = role(*id);
-    const bool height = id == &s.height_id;
-    // A default height id also makes way for the IMU and the baro (their ids came first).
-    const bool height_clash = height && !given && (*id == s.imu_id || *id == s.baro_id);
-    if (other.empty() && !height_clash) continue;
+    if (other.empty() && (given || !taken(i, *id))) continue;
     if (given) fail(path, std::string("key '") + key + "' = " + std::to_string(*id) + " is also " + other);
-    const SensorId moved = height                ? freeId({s.imu_id, s.baro_id})
-                           : id == &s.imu_id     ? freeId({s.baro_id})
-                                                 : freeId({s.imu_id});
+    SensorId moved = 1;
+    while (!role(moved).empty() || taken(i, moved)) ++moved;
     spdlog::info("{}: {} not given and its default {} is {}: using {}", path, key, *id,
-                 other.empty() ? std::string("the IMU's or the baro's") : other, moved);
+                 other.empty() ? std::string("another sensor's id") : other, moved);
     *id = moved;
   }
   for (size_t i = 0; i < ids.size(); ++i)
     for (size_t j = i + 1; j < ids.size(); ++j)
-      if (*std::get<2>(ids[i]) == *std::get<2>(ids[j]))
-        fail(path, std::string("key '") + std::get<0>(ids[i]) + "' and key '" + std::get<0>(ids[j]) +
-                       "' are the same id " + std::to_string(*std::get<2>(ids[i])));
+      if (*ids[i].second == *ids[j].second)
+        fail(path, std::string("key '") + ids[i].first + "' and key '" + ids[j].first + "' are the same id " +
+                       std::to_string(*ids[i].second));
 }
 
 /// `flight_volume: {min_m, max_m}` (both required), or none.
@@ -279,13 +281,20 @@ SystemSetup loadSetup(const std::string& path) {
   // The one rule of common/yaml_options.h: unknown keys and bad values name the file and the key,
   // a missing key keeps its default (docs/configuration.md).
   YamlOptions y(root, path);
-  for (const char* section : {"baro", "height", "initial_pose", "noise"})
+  for (const char* section : {"baro", "height", "initial_pose", "noise", "uwb_clock"})
     if (root[section] && root[section].IsNull()) y.take(section);  // `key:` with nothing: defaults
   for (const char* ignored : {"tag_topics", "anchor_topics", "pose_topics"}) y.take(ignored);  // toolbox config.yaml
   SystemSetup s;
   y.read("imu_id", s.imu_id);
   y.read("baro_id", s.baro_id);
   y.read("height_id", s.height_id);
+  y.read("uwb_clock_id", s.uwb_clock_id);
+  y.read("uwb_clock.offset_s", s.uwb_clock.offset_s);
+  y.read("uwb_clock.sigma_s", s.uwb_clock.sigma_s);
+  if (!(std::abs(s.uwb_clock.offset_s) <= 1.0))
+    y.fail("uwb_clock.offset_s", "must be the UWB stamps' delay against the IMU clock within [-1, 1] s");
+  if (s.uwb_clock.sigma_s && !(*s.uwb_clock.sigma_s >= 0.0 && *s.uwb_clock.sigma_s <= 1.0))
+    y.fail("uwb_clock.sigma_s", "must be in [0, 1] s (0: the offset is known exactly)");
   s.rel_tag_positions = idVecMap(y.take("rel_tag_positions"), path, "rel_tag_positions");
   s.abs_anchor_positions = idVecMap(y.take("abs_anchor_positions"), path, "abs_anchor_positions");
   readAnchorSigmas(y.take("abs_anchor_sigmas"), path, s);
@@ -325,7 +334,7 @@ SystemSetup loadSetup(const std::string& path) {
                                   " m outside): the volume and the anchors must be in the same frame G [m]");
   s.noise = readNoise(y);
   y.rejectUnknown();
-  checkIds(s, path, y.has("imu_id"), y.has("baro_id"), y.has("height_id"));
+  checkIds(s, path, y);
   return s;
 }
 
@@ -357,6 +366,16 @@ void saveSetup(const SystemSetup& s, const std::string& path) {
     e << YAML::Key << "height" << YAML::Value << YAML::BeginMap;
     e << YAML::Key << "p_IH" << YAML::Comment("downward rangefinder in the IMU frame [m]") << YAML::Value;
     emitVec(e, s.height_p_IH);
+    e << YAML::EndMap;
+  }
+  if (s.uwb_clock_id != SystemSetup{}.uwb_clock_id) e << YAML::Key << "uwb_clock_id" << YAML::Value << s.uwb_clock_id;
+  if (s.uwb_clock.offset_s != 0.0 || s.uwb_clock.sigma_s) {  // only when not the defaults
+    e << YAML::Key << "uwb_clock" << YAML::Value << YAML::BeginMap;
+    e << YAML::Key << "offset_s" << YAML::Value << s.uwb_clock.offset_s
+      << YAML::Comment("UWB stamps' delay against the IMU clock: a range stamped t was measured at t - offset_s [s]");
+    if (s.uwb_clock.sigma_s)
+      e << YAML::Key << "sigma_s" << YAML::Value << *s.uwb_clock.sigma_s
+        << YAML::Comment("its prior sigma [s]; 0: known exactly");
     e << YAML::EndMap;
   }
   if (s.initial_pose) {

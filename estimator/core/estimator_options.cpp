@@ -130,6 +130,8 @@ const Field kModelParameters[] = {
     {"uwb.uncalibrated_common_gamma_sigma_m", field<&EstimatorOptions::uwb, &UwbOptions::uncalibrated_common_gamma_sigma_m>, "1 sigma of the offset common to an unlisted tag's pairs [m]"},
     {"uwb.nlos_min_excess_m", field<&EstimatorOptions::uwb, &UwbOptions::nlos_min_excess_m>, "smallest NLOS excess b0 [m]"},
     {"uwb.nlos_mean_excess_m", field<&EstimatorOptions::uwb, &UwbOptions::nlos_mean_excess_m>, "mean NLOS excess beyond b0 [m]"},
+    {"uwb.clock_offset_sigma_s", field<&EstimatorOptions::uwb, &UwbOptions::clock_offset_sigma_s>, "prior sigma of the UWB stamps' delay against the IMU clock when setup.yaml uwb_clock.sigma_s gives none (setup.yaml is where a user states it; 0 there = known exactly) [s]"},
+    {"uwb.clock_offset_rw_s_per_sqrt_s", field<&EstimatorOptions::uwb, &UwbOptions::clock_offset_rw_s_per_sqrt_s>, "random walk of that delay [s/sqrt(s)]"},
     {"uwb.reentry_hold_s", field<&EstimatorOptions::uwb, &UwbOptions::reentry_hold_s>, "longest hold after a gap, at most window_s [s]"},
     {"uwb.reentry_min_ranges", field<&EstimatorOptions::uwb, &UwbOptions::reentry_min_ranges>, "held ranges needed to test them against each other [-]"},
     {"uwb.reentry_min_anchors", field<&EstimatorOptions::uwb, &UwbOptions::reentry_min_anchors>, "distinct anchors among them [-]"},
@@ -299,6 +301,9 @@ void EstimatorOptions::validate() const {
        "uwb.uncalibrated_gamma_sigma_m and uwb.uncalibrated_common_gamma_sigma_m in [0, 10] [m]");
   need(uwb.range_error_correlation_s >= 0 && uwb.range_error_correlation_s <= 60,
        "uwb.range_error_correlation_s in [0, 60] [s]");
+  need(uwb.clock_offset_sigma_s >= 0 && uwb.clock_offset_sigma_s <= 1 && uwb.clock_offset_rw_s_per_sqrt_s >= 0 &&
+           uwb.clock_offset_rw_s_per_sqrt_s <= 0.1,
+       "uwb.clock_offset_sigma_s in [0, 1] [s], uwb.clock_offset_rw_s_per_sqrt_s in [0, 0.1] [s/sqrt(s)]");
   need(uwb.nlos_fraction >= 0 && uwb.nlos_fraction < 1 && uwb.nlos_min_excess_m >= 0 && uwb.nlos_mean_excess_m > 0,
        "uwb.nlos_fraction in [0, 1), uwb.nlos_min_excess_m >= 0, uwb.nlos_mean_excess_m > 0");
   need(process_noise.batch >= 5 && process_noise.upper_ratio > 1.0 && process_noise.lower_ratio > 0.0 &&

@@ -162,6 +162,17 @@ struct UwbOptions {
   /// overrides it: the simulator, whose errors are drawn independently, writes 0. The step weights
   /// a range by (1 + ρ)/(1 − ρ) R; its gate and NIS judge it by R (Linearization::step_noise_factor).
   double range_error_correlation_s = 0.1;
+  /// Prior σ of the UWB clock's delay against the IMU clock (ClockOffsetKind) when setup.yaml
+  /// `uwb_clock.sigma_s` gives none [s]; 0: the offset is not a state (setup's `uwb_clock.offset_s`,
+  /// default 0, is applied as a constant). Model parameter: host-stamped streams put tens of
+  /// milliseconds between the two (STAR-loc's IMU leads its ranges by about 30 ms, issue 34); at a
+  /// walk the data fix the delay only slowly (σ 50 → 23 ms over STAR-loc's 34 s), so the prior
+  /// matters: 0.05 s let it wander to −75 ms there, 0.03 s gives −52 ms, 0.02 s −34 ms
+  /// (docs/uwb_bias_model.md, "Clock offset"). The simulator writes 0 for clocks it draws as one.
+  double clock_offset_sigma_s = 0.03;
+  /// Random walk of that delay [s/√s] (two free-running clocks drift apart; 1e-4 s/√s lets it move
+  /// 1 ms in 100 s).
+  double clock_offset_rw_s_per_sqrt_s = 1e-4;
   /// A range's error is a line-of-sight / NLOS mixture (estimator/core/nlos_mixture.h): with prior
   /// probability `nlos_fraction` a positive excess nlos_min_excess_m + Exp(nlos_mean_excess_m); a
   /// range that passed the gate is weighted by its posterior probability of line of sight (only

@@ -8,8 +8,8 @@
 /// Only instances with an error state appear in the filter's layout: the IMU (15), a barometer
 /// (its bias, 1), a downward rangefinder (its bias, 1), estimated anchors (position, 3, followed
 /// by one γ per estimated pair bias towards its peers) and tags whose constant biases γ towards
-/// exactly known anchors are estimated (one state per such pair). Exactly known anchors are
-/// instances without state.
+/// exactly known anchors are estimated (one state per such pair) and the UWB clock's offset against
+/// the IMU (1). Exactly known anchors are instances without state.
 
 #include <array>
 #include <string>
@@ -19,13 +19,14 @@
 #include "estimator/height/height_bias_kind.h"
 #include "estimator/imu/imu_kind.h"
 #include "estimator/uwb/anchor_kind.h"
+#include "estimator/uwb/clock_offset_kind.h"
 #include "estimator/uwb/tag_bias_kind.h"
 
 namespace meshnav::estimator {
 
 /// THE registration: every kind with state, the IMU (the body) first. The order is the order in
 /// which a recovery re-adds the instances.
-using InstanceKinds = KindList<ImuKind, BaroBiasKind, HeightBiasKind, AnchorKind, TagBiasKind>;
+using InstanceKinds = KindList<ImuKind, BaroBiasKind, HeightBiasKind, AnchorKind, TagBiasKind, ClockOffsetKind>;
 
 /// Type of a sensor instance: its kind's position in `InstanceKinds` (kindOf<K>).
 enum class InstanceKind : int {};
@@ -51,7 +52,7 @@ inline int errorDim(InstanceKind k) {
   return d;
 }
 
-/// The kind's name as in EstimatorStatus ("imu", "baro", "height", "anchor", "tag").
+/// The kind's name as in EstimatorStatus ("imu", "baro", "height", "anchor", "tag", "uwb_clock").
 inline std::string kindName(InstanceKind k) {
   std::string name = "?";
   forEachKind([&]<class K>() {

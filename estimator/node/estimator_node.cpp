@@ -339,6 +339,7 @@ EstimatorStatus EstimatorNode::status() const {
   s.mean_step_us = timings_.means();
   s.health = healthName(health());
   s.health_reason = initialized() ? health_.reason() : waitingFor();
+  s.uwb_clock_offset_s = setup_.uwb_clock.offset_s;  // setup's constant, or the state's estimate below
   if (initialized()) {
     const Eigen::MatrixXd P = cur_.filter->covariance(setup_.imu_id, setup_.imu_id);
     const auto [sigma_p, axis] = weakestPositionAxis(P.block<3, 3>(ImuErr::kP, ImuErr::kP));
@@ -347,6 +348,10 @@ EstimatorStatus EstimatorNode::status() const {
     s.sigma_yaw_deg =
         std::sqrt(so3::yawVariance(cur_.filter->state().imu.q_ItoG, P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta))) *
         180.0 / M_PI;
+    for (const auto& [id, delay_s] : cur_.filter->state().values<ClockOffsetKind>()) {
+      s.uwb_clock_offset_s = delay_s;
+      s.uwb_clock_offset_sigma_s = std::sqrt(cur_.filter->covariance(id, id)(0, 0));
+    }
   }
   return s;
 }

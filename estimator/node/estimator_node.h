@@ -203,8 +203,15 @@ class EstimatorNode : private RerunReplayer {
   /// into the volume, else the position is truncated to the volume's side of the anchors' plane.
   void checkFlightVolume(Timestamp t);
   /// Replaces the IMU instance (state, covariance, time); every other instance keeps its mean and
-  /// marginal covariance (cross-covariances dropped). History before `t` is forgotten.
+  /// marginal covariance (cross-covariances dropped), but the UWB clock's offset, which returns to
+  /// its prior (setUwbClockPrior). History before `t` is forgotten.
   void replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu);
+  /// Puts the UWB clock's offset instance (ClockOffsetKind) in `f` with its prior from setup.yaml
+  /// `uwb_clock` / `uwb.clock_offset_sigma_s`, replacing the one there, when that σ is > 0 and
+  /// ranges are used. At initialization, and when a re-initialization replaces a pose that was
+  /// wrong: the offset's only information is the ranges against that pose's motion (a gravity
+  /// flipped for 8 s on ISAS-Walk1 took it to −158 ms, −4 ms after it), so it starts again.
+  void setUwbClockPrior(FusionStrategy& f) const;
   /// Starts the pending re-run (AnchorRerun::start), a worker's replay node made by makeReplayNode.
   void startRerun();
   /// A replay node for a worker re-run: this node's options and setup, without the start-up report,

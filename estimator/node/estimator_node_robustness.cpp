@@ -65,6 +65,7 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   sensors_.height.setBiasPrior(b.height_bias);  // the height instance is added at the first usable height
   addSetupAnchorStates(*filter, setup_, options_.uwb);
   addTagBiasStates(*filter, setup_, options_.uwb);
+  setUwbClockPrior(*filter);
   resume_.restoreKept(*filter, b.t, sensors_.baro.reference());  // replace the priors
   cur_.filter = std::move(filter);
   cur_.mean_reading.reset();
@@ -163,8 +164,19 @@ void EstimatorNode::checkFlightVolume(Timestamp t) {
 
 void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu) {
   cur_.replaceImu(x, P, t, last_imu, options_, setup_.imu_id, gravity_.zSign());
+  setUwbClockPrior(*cur_.filter);
   reentry_.restart(t);  // held ranges were in the history; the new pose comes from ranges
   onReinitialized(t);
+}
+
+void EstimatorNode::setUwbClockPrior(FusionStrategy& f) const {
+  const double sigma_s = ClockOffsetKind::priorSigma(setup_, options_);
+  if (!(sigma_s > 0.0) || !sensors_.range.enabled()) return;
+  const std::vector<SensorId> joint_set = f.jointSetOf(setup_.uwb_clock_id);  // DAH: stays in its set
+  f.removeInstance(setup_.uwb_clock_id);
+  f.addInstance<ClockOffsetKind>(setup_.uwb_clock_id, setup_.uwb_clock.offset_s,
+                                 Eigen::MatrixXd::Constant(1, 1, sigma_s * sigma_s));
+  if (!joint_set.empty()) f.joinJointSet(joint_set);
 }
 
 void EstimatorNode::onReinitialized(Timestamp t) {

@@ -60,7 +60,8 @@ void EstimatorNode::processHeight(const HeightSample& s, bool first) {
 
 void EstimatorNode::processRange(const RangeSample& s, bool first) {
   if (!sensors_.range.enabled()) return;
-  const RangeMeasurement z = sensors_.range.measurement(s);
+  RangeMeasurement z = sensors_.range.measurement(s);
+  if (cur_.last_imu) z.omega_IinI_rad_s = cur_.last_imu->gyro_rad_s;  // the body rate at t (range_model.h)
   if (const std::string why = sensors_.range.refusal(z, *cur_.filter, *cur_.network); !why.empty()) {
     if (why == "unknown_id")
       event(first, why,

@@ -19,7 +19,8 @@ std::string AnchorJoin::apply(const AnchorInit& a, FusionStrategy& f, std::share
   const bool height = f.state().values<HeightBiasKind>().count(a.id) > 0;
   if (net->isTag(a.id)) return " is a tag";
   if (setup_.isSensorInstanceId(a.id) || height)
-    return " is the IMU's, the baro's or the height sensor's (imu_id, baro_id, height_id in setup.yaml)";
+    return " is the IMU's, the baro's, the UWB clock's or the height sensor's (imu_id, baro_id, uwb_clock_id, "
+           "height_id in setup.yaml)";
   net->removeDevice(a.id);  // an exactly known anchor becomes an estimated one
   net->setCalibrated(a.id, true);
   for (PairBias b : a.biases) {
@@ -79,12 +80,13 @@ void AnchorJoin::joinSet(SensorId id, FusionStrategy& f, const UwbNetwork& netwo
   if (options_.dah_joint_tag_biases)  // merges every batch into one set with the tags' γ
     for (const auto& [tag, value] : f.state().values<TagBiasKind>()) set.push_back(tag);
   if (options_.dah_joint_imu) {
-    // With the IMU the biases of its vertical aids (baro, height sensor): a range correlates them
-    // with every member through the pose, and left outside they would keep each member's DAH
-    // correction (and its cost) on every update of the set.
+    // With the IMU the biases of its vertical aids (baro, height sensor) and the UWB clock's offset:
+    // a range correlates them with every member through the pose, and left outside they would keep
+    // each member's DAH correction (and its cost) on every update of the set.
     set.push_back(f.state().imu_id);
     for (const auto& [baro, value] : f.state().values<BaroBiasKind>()) set.push_back(baro);
     for (const auto& [height, value] : f.state().values<HeightBiasKind>()) set.push_back(height);
+    for (const auto& [clock, value] : f.state().values<ClockOffsetKind>()) set.push_back(clock);
   }
   f.joinJointSet(set);
   boundJointSetAnchors(f, id, options_.dah_joint_max_anchors);

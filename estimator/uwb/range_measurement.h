@@ -2,6 +2,8 @@
 /// @file range_measurement.h
 /// @brief A two-way range between UWB devices a and b as fused by the filter.
 
+#include <Eigen/Core>
+
 #include "common/time.h"
 #include "common/types.h"
 
@@ -13,6 +15,9 @@ struct RangeMeasurement {
   SensorId b = 0;       ///< responder
   double z_m = 0.0;     ///< measured range [m]
   double R_m2 = 0.0;    ///< variance from the source [m²], 0 = unknown
+  /// The body's angular rate at t as the gyro measured it (newest reading, bias not removed), ω_IinI
+  /// [rad/s]: where a tag on a lever arm was a clock offset earlier (range_model.h). Zero: unknown.
+  Eigen::Vector3d omega_IinI_rad_s = Eigen::Vector3d::Zero();
 };
 
 }  // namespace meshnav::estimator

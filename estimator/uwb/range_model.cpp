@@ -3,21 +3,43 @@
 namespace meshnav::estimator {
 namespace {
 
+/// The UWB stamps' delay against the IMU clock δ_u [s]: the ClockOffsetKind state (one per
+/// estimator) when there is one, else setup's constant.
+struct ClockOffset {
+  double delay_s = 0.0;
+  std::optional<SensorId> state_id;
+};
+
+ClockOffset clockOffset(const NominalState& x, const UwbNetwork& net) {
+  const auto& c = x.values<ClockOffsetKind>();
+  if (!c.empty()) return {c.begin()->second, c.begin()->first};
+  return {net.clockOffsetPrior_s(), std::nullopt};
+}
+
 /// One end of a range: where it is and how it depends on the state.
 struct End {
   enum class Kind { Tag, StateAnchor, ExactAnchor } kind = Kind::ExactAnchor;
   SensorId id = 0;
   Eigen::Vector3d p_inG = Eigen::Vector3d::Zero();
   const Eigen::Vector3d* p_TinI = nullptr;  // tags only
+  /// Tags only: the lever arm as it stood δ_u earlier, l = p_TinI − δ_u [ω̂]× p_TinI (ω̂ = ω − b_ω),
+  /// and the tag's velocity v_T = v_IinG + R_ItoG (ω̂ × p_TinI) in G [m/s].
+  Eigen::Vector3d lever_then = Eigen::Vector3d::Zero();
+  Eigen::Vector3d v_TinG = Eigen::Vector3d::Zero();
 };
 
-std::optional<End> resolve(SensorId id, const NominalState& x, const UwbNetwork& net) {
+std::optional<End> resolve(SensorId id, const RangeMeasurement& z, const NominalState& x, const UwbNetwork& net,
+                           double delay_s) {
   End e;
   e.id = id;
   if (const Eigen::Vector3d* lever = net.tagLeverArm(id)) {
+    // The tag where it was when the range was measured, δ_u before its stamp (first order in δ_u).
+    const Eigen::Vector3d omega = z.omega_IinI_rad_s - x.imu.bias_gyro_rad_s;
     e.kind = End::Kind::Tag;
     e.p_TinI = lever;
-    e.p_inG = x.imu.p_IinG + x.imu.q_ItoG * (*lever);
+    e.lever_then = *lever - delay_s * omega.cross(*lever);
+    e.v_TinG = x.imu.v_IinG + x.imu.q_ItoG * omega.cross(*lever);
+    e.p_inG = x.imu.p_IinG - delay_s * x.imu.v_IinG + x.imu.q_ItoG * e.lever_then;
     return e;
   }
   const auto& anchors = x.values<AnchorKind>();
@@ -86,7 +108,8 @@ RangeModel::Status RangeModel::classify(const RangeMeasurement& z, const Nominal
 
 std::optional<std::pair<double, double>> RangeModel::predict(const RangeMeasurement& z, const NominalState& x,
                                                              const UwbNetwork& net) {
-  const auto a = resolve(z.a, x, net), b = resolve(z.b, x, net);
+  const double delay_s = clockOffset(x, net).delay_s;
+  const auto a = resolve(z.a, z, x, net, delay_s), b = resolve(z.b, z, x, net, delay_s);
   if (!a || !b) return std::nullopt;
   const PairBias pb = net.pairBias(z.a, z.b);
   const double d = (b->p_inG - a->p_inG).norm();
@@ -95,7 +118,8 @@ std::optional<std::pair<double, double>> RangeModel::predict(const RangeMeasurem
 
 RangeModel::Status RangeModel::linearize(const RangeMeasurement& z, const NominalState& x, const UwbNetwork& net,
                                          Linearization* out) {
-  auto a = resolve(z.a, x, net), b = resolve(z.b, x, net);
+  const ClockOffset clock = clockOffset(x, net);
+  auto a = resolve(z.a, z, x, net, clock.delay_s), b = resolve(z.b, z, x, net, clock.delay_s);
   if (!a || !b) return Status::UnknownId;
   if (a->kind == End::Kind::Tag && b->kind == End::Kind::Tag) return Status::TagTag;
   if (a->kind == End::Kind::ExactAnchor && b->kind == End::Kind::ExactAnchor) return Status::NoState;
@@ -116,10 +140,16 @@ RangeModel::Status RangeModel::linearize(const RangeMeasurement& z, const Nomina
   lin.residual = Eigen::VectorXd::Constant(1, z.z_m - (pb.beta * d + pairGamma(pb, gs)));
   lin.R = Eigen::MatrixXd::Constant(1, 1, sigma * sigma + var_gamma + d * d * pb.sigma_beta * pb.sigma_beta);
   if (a->kind == End::Kind::Tag) {
+    // p_T = p_IinG − δ_u v_IinG + R_ItoG (p_TinI − δ_u [ω − b_ω]× p_TinI), ∂h/∂p_T = −β uᵀ.
+    const Eigen::Matrix3d R_ItoG = x.imu.q_ItoG.toRotationMatrix();
     Eigen::MatrixXd H = Eigen::MatrixXd::Zero(1, ImuErr::kDim);
     H.block<1, 3>(0, ImuErr::kP) = -pb.beta * u;
-    H.block<1, 3>(0, ImuErr::kTheta) = pb.beta * u * x.imu.q_ItoG.toRotationMatrix() * so3::skew(*a->p_TinI);
+    H.block<1, 3>(0, ImuErr::kV) = pb.beta * clock.delay_s * u;
+    H.block<1, 3>(0, ImuErr::kTheta) = pb.beta * u * R_ItoG * so3::skew(a->lever_then);
+    H.block<1, 3>(0, ImuErr::kBg) = pb.beta * clock.delay_s * u * R_ItoG * so3::skew(*a->p_TinI);
     lin.blocks.push_back({x.imu_id, std::move(H)});
+    if (clock.state_id)  // ∂h/∂δ_u = β uᵀ v_T: the tag was −δ_u v_T from where the stamp puts it
+      lin.blocks.push_back({*clock.state_id, Eigen::MatrixXd::Constant(1, 1, pb.beta * u.dot(a->v_TinG.transpose()))});
   }
   // An estimated anchor's block: ±β uᵀ on its position, zero on its γ states (but the pair's).
   auto anchorBlock = [&](SensorId id, double sign) {

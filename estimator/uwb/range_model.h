@@ -3,8 +3,13 @@
 /// @brief Range model (paper eq. UWB-meas-range): z = β_ab d_ab + γ_ab + ν, with
 ///   tag T on the IMU: p_TinG = p_IinG + R_ItoG p_TinI,  d = ‖p_A − p_TinG‖,
 ///   anchor–anchor:    d = ‖p_Ab − p_Aa‖.
+/// A range stamped t (UWB clock) was measured at the IMU-clock instant t − δ_u (δ_u: the UWB
+/// stamps' delay, a ClockOffsetKind state or setup's constant): the tag is taken where it was then,
+/// to first order in δ_u, with ω̂ = ω − b_ω the measurement's body rate:
+///   p_TinG = p_IinG − δ_u v_IinG + R_ItoG l,  l = p_TinI − δ_u [ω̂]× p_TinI.
 /// Jacobians with u = (p_far − p_near)/d (unit vector from the tag / first anchor):
-///   ∂z/∂δp_IinG = −β uᵀ,  ∂z/∂δθ = β uᵀ R̂ [p_TinI]×,  ∂z/∂δp_A = β uᵀ (estimated anchor),
+///   ∂z/∂δp_IinG = −β uᵀ,  ∂z/∂δv = β δ_u uᵀ,  ∂z/∂δθ = β uᵀ R̂ [l]×,  ∂z/∂δb_ω = β δ_u uᵀ R̂ [p_TinI]×,
+///   ∂z/∂δδ_u = β uᵀ v_T with v_T = v_IinG + R̂ (ω̂ × p_TinI),  ∂z/∂δp_A = β uᵀ (estimated anchor),
 ///   anchor–anchor: ∂z/∂δp_Aa = −β uᵀ, ∂z/∂δp_Ab = β uᵀ.
 /// Noise variance R = σ² + σ_γ² + (d σ_β)² (pair uncertainties inflate the noise), except when γ
 /// of the pair is a state — of an estimated anchor at one end (its calibration's γ towards tags,

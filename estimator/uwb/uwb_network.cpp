@@ -7,7 +7,8 @@ namespace meshnav::estimator {
 UwbNetwork::UwbNetwork(const SystemSetup& setup, double fallback_sigma_m, double uncalibrated_gamma_sigma_m)
     : tags_p_TinI_(setup.rel_tag_positions),
       setup_sigma_m_(setup.noise.sigma_range_m),
-      fallback_sigma_m_(fallback_sigma_m) {
+      fallback_sigma_m_(fallback_sigma_m),
+      clock_offset_s_(setup.uwb_clock.offset_s) {
   for (const auto& [id, p] : setup.abs_anchor_positions)
     if (!setup.abs_anchor_sigmas_m.count(id)) exact_anchors_p_AinG_[id] = p;
   for (const PairBias& b : setup.pair_biases) setPairBias(b);

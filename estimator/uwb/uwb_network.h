@@ -51,6 +51,9 @@ class UwbNetwork {
   /// Range σ [m]: the pair's σ if the pair is in the dictionary, else setup.noise.sigma_range,
   /// else √R of the range when R > 0, else the config fallback.
   double rangeSigma(SensorId a, SensorId b, double R_m2) const;
+  /// The UWB stamps' delay against the IMU clock from setup.yaml `uwb_clock.offset_s` [s]: the
+  /// range model's constant while the offset is not a state (ClockOffsetKind).
+  double clockOffsetPrior_s() const { return clock_offset_s_; }
 
  private:
   std::map<SensorId, Eigen::Vector3d> tags_p_TinI_;
@@ -59,6 +62,7 @@ class UwbNetwork {
   std::set<SensorId> calibrated_;
   std::optional<double> setup_sigma_m_;
   double fallback_sigma_m_ = 0.15;
+  double clock_offset_s_ = 0.0;
 };
 
 }  // namespace meshnav::estimator

@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
   es.instances = {{1, "imu", 2000, 0}, {100, "tag", 150, 3}, {106, "anchor", 80, 1}};
   es.counters = {{"gated_range", 3}, {"rejected_too_old", 0}};
   es.mean_step_us = {{"propagate", 12.5}, {"update", 40.0}};
-  es.health = "ok"; es.sigma_p_max_m = 0.2; es.weak_axis_G = {0, 0, 1}; es.sigma_yaw_deg = 2.0;
+  es.health = "ok"; es.sigma_p_max_m = 0.2; es.weak_axis_G = {0, 0, 1}; es.sigma_yaw_deg = 2.0; es.uwb_clock_offset_s = 0.03; es.uwb_clock_offset_sigma_s = 0.002;
   save(toLcm(es));
   EstimatorCommand ec;
   ec.t = t; ec.action = EstimatorCommand::Action::AddAnchor; ec.id = 106; ec.anchor = init;

@@ -122,6 +122,11 @@ void RunRecorder::finish(const Diagnostics& process_diag) {
     e << YAML::Key << "t" << YAML::Value << s.t.sec();
     e << YAML::Key << "initialized" << YAML::Value << s.initialized;
     e << YAML::Key << "strategy" << YAML::Value << s.strategy;
+    e << YAML::Key << "health" << YAML::Value << s.health;
+    e << YAML::Key << "uwb_clock_offset_s" << YAML::Comment("UWB stamps' delay against the IMU clock")
+      << YAML::Value << s.uwb_clock_offset_s;
+    e << YAML::Key << "uwb_clock_offset_sigma_s" << YAML::Comment("0: setup.yaml's constant") << YAML::Value
+      << s.uwb_clock_offset_sigma_s;
     e << YAML::Key << "counters" << YAML::Value << YAML::BeginMap;
     for (const auto& [k, v] : s.counters) e << YAML::Key << k << YAML::Value << v;
     e << YAML::EndMap;

@@ -96,8 +96,9 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
       ->type_name("S")->check(cli_checks::nonNegative())->group("Sensors");
   cli.option("range-time-offset", o.uwb.time_offset_s,
              "the UWB stamps' delay against the IMU clock: the distance at t is stamped t + S (issue 34 measured "
-             "STAR-loc's IMU stamps leading its ranges by about 0.03 s); written to truth.yaml range_time_offset_s, not to setup.yaml "
-             "[s]")
+             "STAR-loc's IMU stamps leading its ranges by about 0.03 s); written to truth.yaml range_time_offset_s; "
+             "setup.yaml then leaves it to the estimator (uwb_clock: its prior), while 0 writes uwb_clock.sigma_s: 0 "
+             "(the clocks are one) [s]")
       ->type_name("S")->check(cli_checks::finite())->group("Sensors");
   cli.option("drop,--drop-fraction", o.uwb.drop_fraction, "fraction of dropped range messages")
       ->type_name("F")->check(cli_checks::nonNegative())->group("Sensors");

@@ -3,7 +3,8 @@
 leaves out 6.34-7.32 s, where the Vicon truth contradicts the IMU's gyro (the dataset README's
 dropout; eval/truth_consistency.h); the test asserts that it finds that stretch.
 With the defaults it asserts the issue's targets (ATE <= 0.25 m, orientation <= 5 deg, position
-ANEES <= 6; measured 2026-12-05: see MEASURED). With issue 34's pair-bias and correlated-error
+ANEES <= 6; measured 2026-12-05: see MEASURED) and that the UWB clock's delay it states agrees with
+the one measured against the truth. With issue 34's pair-bias and correlated-error
 models turned off (uwb.uncalibrated_gamma_sigma_m 0, uwb.range_error_correlation_s 0: the models
 before the issue) the filter is overconfident again (ANEES 88): the test holds that row too, so that
 a change which makes the models inert shows. Plain multilateration scored as tag positions
@@ -22,7 +23,11 @@ STARLOC_DIR = os.path.join(rs.SHARED, "data", "real-starloc-loop2d-s1")
 # ATE [m], position ANEES, orientation RMSE [deg], multilateration ATE [m] (2026-12-05, defaults:
 # the pair-bias and correlated-error models, the gate on each range's own error; before issue 34
 # 0.542 m, 88, 12.85 deg).
-MEASURED = {"ate": 0.142, "anees": 4.71, "ori": 3.13, "multilateration": 1.257}
+MEASURED = {"ate": 0.141, "anees": 4.66, "ori": 3.12, "multilateration": 1.257}
+# The IMU's stamps lead the ranges by about 30 ms (measured against the truth, issue 34): the UWB
+# stamps' delay against the IMU clock is about -0.030 s. The estimator's state (prior sigma 0.03 s)
+# found -52.5 ms, sigma 19.2 ms (2026-12-05).
+CLOCK_DELAY_S = -0.030
 MEASURED_WITHOUT_MODELS = {"ate": 0.545, "anees": 88.09, "ori": 12.65}
 TARGET = {"ate": 0.25, "anees": 6.0, "ori": 5.0}  # issue 34
 ATE_MARGIN_M = 0.05  # deterministic run; the margin absorbs compiler/libm differences
@@ -43,6 +48,13 @@ class StarlocEndToEnd(unittest.TestCase):
             self.assertEqual(r.returncode, 0, (r.stdout + r.stderr)[-3000:])
             e = subprocess.run([exe_eval, "--dataset", STARLOC_DIR, "--run", run, "--no-plots"], capture_output=True,
                                text=True, timeout=120)
+            with open(os.path.join(run, "status.txt")) as f:
+                status = f.read()
+        # Every run states the clock offset it used (issue 34): in status.txt and at the end of its log.
+        clock = re.search(r"^uwb_clock_offset_s: (\S+)\nuwb_clock_offset_sigma_s: (\S+)$", status, re.M)
+        self.assertIsNotNone(clock, status)
+        self.assertRegex(r.stdout + r.stderr, r"UWB clock: stamps -?[0-9.]+ ms late against the IMU")
+        self.clock = (float(clock.group(1)), float(clock.group(2)))
         self.assertEqual(e.returncode, 0, e.stdout + e.stderr)
         self.assertIn("alignment: none", e.stdout)
         ate = re.search(r"^meshnav\s+([0-9.]+)\s+[0-9.]+\s+[0-9.]+\s+(\d+)\s+none", e.stdout, re.M)
@@ -65,6 +77,12 @@ class StarlocEndToEnd(unittest.TestCase):
         self.assertLess(ate, min(TARGET["ate"], MEASURED["ate"] + ATE_MARGIN_M), out)
         self.assertLess(anees, TARGET["anees"], out)
         self.assertLess(ori, TARGET["ori"], out)
+        # The delay is a state the ranges inform (its sigma below the prior's 0.03 s) and agrees with
+        # the lead measured against the truth within 3 sigma.
+        delay_s, sigma_s = self.clock
+        self.assertGreater(sigma_s, 0.0)
+        self.assertLess(sigma_s, 0.025)
+        self.assertLess(abs(delay_s - CLOCK_DELAY_S), 3.0 * sigma_s, self.clock)
 
     def test_without_the_range_error_models_the_filter_is_overconfident(self):
         with tempfile.NamedTemporaryFile("w", suffix=".yaml") as cfg:

@@ -76,6 +76,8 @@ estimator_status_t toLcm(const EstimatorStatus& s) {
   m.sigma_p_max_m = s.sigma_p_max_m;
   for (int i = 0; i < 3; ++i) m.weak_axis_G[i] = s.weak_axis_G[i];
   m.sigma_yaw_deg = s.sigma_yaw_deg;
+  m.uwb_clock_offset_s = s.uwb_clock_offset_s;
+  m.uwb_clock_offset_sigma_s = s.uwb_clock_offset_sigma_s;
   return m;
 }
 EstimatorStatus fromLcm(const estimator_status_t& m) {
@@ -99,6 +101,8 @@ EstimatorStatus fromLcm(const estimator_status_t& m) {
   s.sigma_p_max_m = m.sigma_p_max_m;
   s.weak_axis_G = Eigen::Vector3d(m.weak_axis_G[0], m.weak_axis_G[1], m.weak_axis_G[2]);
   s.sigma_yaw_deg = m.sigma_yaw_deg;
+  s.uwb_clock_offset_s = m.uwb_clock_offset_s;
+  s.uwb_clock_offset_sigma_s = m.uwb_clock_offset_sigma_s;
   return s;
 }
 

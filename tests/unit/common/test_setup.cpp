@@ -56,6 +56,18 @@ TEST(Setup, RoundTrip) {
   const auto rh = loadSetup((d / "height.yaml").string());
   EXPECT_EQ(rh.height_id, 7);
   EXPECT_TRUE(rh.height_p_IH.isApprox(h.height_p_IH));
+  EXPECT_EQ(rh.uwb_clock_id, 4);
+  EXPECT_FALSE(rh.uwb_clock.sigma_s);
+  // The UWB clock's id and prior, written only when not the defaults.
+  auto clock = s;
+  clock.uwb_clock_id = 9;
+  clock.uwb_clock = UwbClock{-0.03, 0.0};
+  saveSetup(clock, (d / "clock.yaml").string());
+  const auto r_clock = loadSetup((d / "clock.yaml").string());
+  EXPECT_EQ(r_clock.uwb_clock_id, 9);
+  EXPECT_DOUBLE_EQ(r_clock.uwb_clock.offset_s, -0.03);
+  ASSERT_TRUE(r_clock.uwb_clock.sigma_s);
+  EXPECT_EQ(*r_clock.uwb_clock.sigma_s, 0.0);
   EXPECT_FALSE(rh.carried_height);
   // A hand-held rig's carrying height, written only when given.
   auto c = s;
@@ -169,6 +181,12 @@ TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
             std::string::npos);
   EXPECT_NE(error(base + "imu_id: 7\nbaro_id: 7\n").find("same id 7"), std::string::npos);
   EXPECT_NE(error(base + "height_id: 105\n").find("key 'height_id' = 105 is also a tag"), std::string::npos);
+  EXPECT_NE(error(base + "uwb_clock_id: 101\n").find("key 'uwb_clock_id' = 101 is also an anchor"), std::string::npos);
+  EXPECT_NE(error(base + "imu_id: 9\nuwb_clock_id: 9\n").find("key 'imu_id' and key 'uwb_clock_id' are the same id 9"),
+            std::string::npos);
+  EXPECT_NE(error(base + "uwb_clock: {offset_s: 2}\n").find("key 'uwb_clock.offset_s'"), std::string::npos);
+  EXPECT_NE(error(base + "uwb_clock: {sigma_s: -0.1}\n").find("key 'uwb_clock.sigma_s'"), std::string::npos);
+  EXPECT_NE(error(base + "uwb_clock: {offset: 0.03}\n").find("unknown key 'uwb_clock.offset'"), std::string::npos);
   EXPECT_NE(error(base + "imu_id: 3\nheight_id: 3\n").find("key 'imu_id' and key 'height_id' are the same id 3"),
             std::string::npos);
   EXPECT_NE(error(base + "height: {p_IH: [0, 0]}\n").find("height.p_IH"), std::string::npos);
@@ -209,6 +227,9 @@ TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
   EXPECT_EQ(s.imu_id, 3);
   EXPECT_EQ(s.baro_id, 4);
   EXPECT_EQ(s.height_id, 5);  // its default 3 made way for the IMU
+  EXPECT_EQ(s.uwb_clock_id, 6);  // its default 4 made way for the baro
+  EXPECT_DOUBLE_EQ(s.uwb_clock.offset_s, 0.0);
+  EXPECT_FALSE(s.uwb_clock.sigma_s);  // the estimator's option gives the prior
   ASSERT_TRUE(s.initial_pose);
   EXPECT_DOUBLE_EQ(s.initial_pose->sigma_p_m, InitialPose{}.sigma_p_m);
 }

@@ -321,11 +321,14 @@ TEST(DahJointSets, NodePutsAnchorsAddedTogetherIntoOneSetWithTheImu) {
     const SensorId imu = f->state().imu_id;
     EXPECT_NE(std::find(set.begin(), set.end(), 202), set.end());
     EXPECT_NE(std::find(set.begin(), set.end(), imu), set.end()) << "uwb.dah_joint_imu";
-    // With the IMU its baro bias, else every member of the set keeps a pair outside it.
+    // With the IMU its baro bias and the UWB clock's offset, else every member of the set keeps a
+    // pair outside it.
     EXPECT_NE(std::find(set.begin(), set.end(), ds.setup.baro_id), set.end()) << "uwb.dah_joint_imu";
-    EXPECT_EQ(set.size(), 4u);  // the synthetic setup has no tag γ states (uwb.dah_joint_tag_biases)
+    EXPECT_NE(std::find(set.begin(), set.end(), ds.setup.uwb_clock_id), set.end()) << "uwb.dah_joint_imu";
+    EXPECT_EQ(set.size(), 5u);  // the synthetic setup has no tag γ states (uwb.dah_joint_tag_biases)
     f->checkInvariants();
-    // A re-initialization (here the test hook's pose fault) keeps the set together.
+    // A re-initialization (here the test hook's pose fault) keeps the set together, the clock's offset
+    // back at its prior in it.
     EstimatorNodeTesting::injectPoseError(node, Eigen::Vector3d(1.0, 0.0, 0.0), 0.3);
     const auto* g = dynamic_cast<const ModularFilter*>(node.filter());
     ASSERT_NE(g, nullptr);

@@ -49,7 +49,9 @@ TEST(InstanceKinds, RandomWalksFromOptionsAreTheKindsOwn) {
   EstimatorOptions o;
   o.baro.bias_rw_m_per_sqrt_s = 0.011;
   o.height.bias_rw_m_per_sqrt_s = 0.007;
+  o.uwb.clock_offset_rw_s_per_sqrt_s = 0.0003;
   const KindRandomWalks w = KindRandomWalks::fromOptions(o);
+  EXPECT_EQ(w.of(kindOf<ClockOffsetKind>), 0.0003);
   EXPECT_EQ(w.of(kindOf<BaroBiasKind>), 0.011);
   EXPECT_EQ(w.of(kindOf<HeightBiasKind>), 0.007);
   EXPECT_EQ(w.of(kindOf<ImuKind>), 0.0);

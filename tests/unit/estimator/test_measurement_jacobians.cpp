@@ -12,22 +12,30 @@ using namespace meshnav::estimator::test;
 
 namespace {
 
-UwbNetwork network() {
+UwbNetwork network(double clock_offset_s = 0.0) {
   SystemSetup s;
   s.rel_tag_positions = {{100, {-0.19, 0.105, -0.07}}, {105, {0.05, -0.105, -0.07}}};
   s.abs_anchor_positions = {{101, {-1.308, -4.140, 0.66}}, {106, {-1.772, 0.943, 3.256}}, {107, {-2.021, 1.814, 1.732}}};
   s.abs_anchor_sigmas_m = {{106, 0.1}, {107, 0.1}};
   s.pair_biases.push_back({100, 106, 0.2, 1.02, 0.1, 0.0, 0.0});
   s.pair_biases.push_back({106, 107, -0.1, 0.98, 0.1, 0.0, 0.0});
+  s.uwb_clock.offset_s = clock_offset_s;
   return UwbNetwork(s, 0.15);
 }
 
-void expectRangeJacobian(SensorId a, SensorId b, std::initializer_list<SensorId> expected_blocks) {
-  const UwbNetwork net = network();
+/// How the UWB clock enters: not at all, as setup's constant delay, or as a state (id 4).
+enum class Clock { None, Constant, State };
+
+void expectRangeJacobian(SensorId a, SensorId b, std::initializer_list<SensorId> expected_blocks,
+                         Clock clock = Clock::None) {
+  const UwbNetwork net = network(clock == Clock::Constant ? 0.035 : 0.0);
   for (unsigned seed = 1; seed <= 5; ++seed) {
-    const NominalState x = randomState(seed);
-    const StateLayout layout = layoutOf(x);
+    NominalState x = randomState(seed);
+    if (clock == Clock::State) x.values<ClockOffsetKind>()[4] = -0.04;
+    StateLayout layout = layoutOf(x);
+    if (clock == Clock::State) layout.add(4, kindOf<ClockOffsetKind>);
     RangeMeasurement z{Timestamp{}, a, b, 5.0, 0.0};
+    z.omega_IinI_rad_s = Eigen::Vector3d(0.8, -1.5, 2.2);  // a tag on a lever arm: ω enters with the delay
     Linearization lin;
     ASSERT_EQ(RangeModel::linearize(z, x, net, &lin), RangeModel::Status::Ok);
     ASSERT_EQ(lin.blocks.size(), expected_blocks.size());
@@ -49,6 +57,33 @@ TEST(MeasurementJacobians, RangeExactAnchorToTag) { expectRangeJacobian(101, 105
 TEST(MeasurementJacobians, RangeTagToEstimatedAnchorWithBias) { expectRangeJacobian(106, 100, {1, 106}); }
 TEST(MeasurementJacobians, RangeAnchorToAnchor) { expectRangeJacobian(106, 107, {106, 107}); }
 TEST(MeasurementJacobians, RangeEstimatedToExactAnchor) { expectRangeJacobian(101, 107, {107}); }
+TEST(MeasurementJacobians, RangeWithAConstantClockDelay) { expectRangeJacobian(100, 101, {1}, Clock::Constant); }
+TEST(MeasurementJacobians, RangeWithTheClockDelayAsAState) { expectRangeJacobian(100, 101, {1, 4}, Clock::State); }
+TEST(MeasurementJacobians, RangeBetweenAnchorsIgnoresTheClock) { expectRangeJacobian(106, 107, {106, 107}, Clock::State); }
+
+/// The delay moves the tag back along its path: a tag 10 m from an anchor, flying away from it at
+/// 2 m/s, with its ranges stamped 0.05 s late, was 0.1 m nearer when the range was measured.
+TEST(MeasurementJacobians, TheClockDelayTakesTheTagWhereItWas) {
+  SystemSetup s;
+  s.rel_tag_positions = {{100, {0, 0, 0}}};
+  s.abs_anchor_positions = {{101, {0, 0, 0}}};
+  s.uwb_clock.offset_s = 0.05;
+  NominalState x;
+  x.imu_id = 1;
+  x.imu.p_IinG = Eigen::Vector3d(10, 0, 0);
+  x.imu.v_IinG = Eigen::Vector3d(2, 0, 0);
+  const RangeMeasurement z{Timestamp{}, 100, 101, 9.9, 0.0};
+  EXPECT_NEAR(RangeModel::predict(z, x, UwbNetwork(s, 0.1))->first, 9.9, 1e-12);
+  s.uwb_clock.offset_s = 0.0;
+  EXPECT_NEAR(RangeModel::predict(z, x, UwbNetwork(s, 0.1))->first, 10.0, 1e-12);
+  // As a state: ∂h/∂δ_u = uᵀ v_T = −2 m/s (u points from the tag to the anchor).
+  x.values<ClockOffsetKind>()[4] = 0.05;
+  Linearization lin;
+  ASSERT_EQ(RangeModel::linearize(z, x, UwbNetwork(s, 0.1), &lin), RangeModel::Status::Ok);
+  ASSERT_NE(lin.find(4), nullptr);
+  EXPECT_NEAR(lin.find(4)->H(0, 0), -2.0, 1e-12);
+  EXPECT_NEAR(lin.residual(0), 0.0, 1e-12);
+}
 
 TEST(MeasurementJacobians, RangeClassification) {
   const UwbNetwork net = network();

@@ -85,6 +85,8 @@ TEST(RunRecorder, FinishWritesSummaryAnchorInitsAndGroundTruth) {
     st.counters = {{"out_of_sequence", 17}, {"gated_range", 3}};
     st.mean_step_us = {{"propagate", 11.5}};
     st.instances = {{1, "imu", 28000, 0}, {106, "anchor", 40, 1}};
+    st.uwb_clock_offset_s = -0.031;
+    st.uwb_clock_offset_sigma_s = 0.004;
     rec.onEstimatorStatus(st);
     CalibStatus cs;
     cs.anchors = {{107, "refused", 12, 2, "too few measurements: 12 < 50"}};
@@ -114,6 +116,8 @@ TEST(RunRecorder, FinishWritesSummaryAnchorInitsAndGroundTruth) {
   EXPECT_EQ(s["estimator_status"]["counters"]["out_of_sequence"].as<int>(), 17);
   EXPECT_EQ(s["estimator_status"]["strategy"].as<std::string>(), "dah");
   EXPECT_EQ(s["estimator_status"]["instances"][1]["id"].as<int>(), 106);
+  EXPECT_DOUBLE_EQ(s["estimator_status"]["uwb_clock_offset_s"].as<double>(), -0.031);
+  EXPECT_DOUBLE_EQ(s["estimator_status"]["uwb_clock_offset_sigma_s"].as<double>(), 0.004);
   EXPECT_EQ(s["calib_status"]["anchors"][0]["reason"].as<std::string>(), "too few measurements: 12 < 50");
   EXPECT_EQ(s["mission_status"]["text"].as<std::string>(), "calibrating");
   EXPECT_EQ(s["logger_counters"]["RANGE:decode_error"].as<int>(), 2);
