@@ -43,7 +43,13 @@ BAD_ANCHOR_M = 0.5      # final error of a calibrated anchor that counts as a ba
 ANCHOR_NEES_BOUND = 13.93  # chi^2(3) at 99.7 %: a final anchor NEES above it is overconfident
 SCENARIO_KEYS = {"name", "seed", "trajectory", "hall", "anchor_layout", "tags", "known", "unknown",
                  "sigma_range", "outliers", "drop", "imu_grade", "duration", "bias_max", "nlos", "range_correlation",
-                 "range_time_offset"}
+                 "range_time_offset", "imu_scale_sigma", "imu_misalignment"}
+
+
+# Largest sigma of the IMU axes' scale error [-] and misalignment [deg] the widened sweep draws per
+# grade, a datasheet's order of magnitude: a phone's IMU about 1 % and 0.5 deg, a flight
+# controller's (BMI088-like) 0.5 % and 0.25 deg, a tactical unit 0.05 % and 0.05 deg.
+IMU_AXIS_ERRORS = {"consumer": (0.01, 0.5), "fc": (0.005, 0.25), "tactical": (0.0005, 0.05)}
 
 
 def pick(rng, items):
@@ -58,11 +64,13 @@ def uniform(rng, lo, hi, digits):
 def draw_scenarios(runs, seed, duration_s, widened=False):
     """`runs` scenarios drawn deterministically from `seed` over the sweep's space. `widened`: the
     range errors of real hardware too (issue 34): NLOS excess 0.2 m + Exp(0.3 m) instead of
-    U(0.5, 3) m, a pair's error correlated over U(0, 0.3) s, and range stamps U(-0.05, 0.05) s late
-    against the IMU clock; the other draws are the same."""
+    U(0.5, 3) m, a pair's error correlated over U(0, 0.3) s, range stamps U(-0.05, 0.05) s late
+    against the IMU clock, and IMU axes with scale errors and misalignments of sigma up to its grade's
+    (IMU_AXIS_ERRORS); the other draws are the same."""
     rng = random.Random(seed)
     wide_rng = random.Random("widened-%d" % seed)  # its own stream: the other draws stay the plain sweep's
     clock_rng = random.Random("widened-clock-%d" % seed)  # and one more: the correlation draws stay as they were
+    imu_rng = random.Random("widened-imu-%d" % seed)  # and the IMU's axes their own
     out = []
     for i in range(runs):
         layout = pick(rng, LAYOUTS)
@@ -86,6 +94,9 @@ def draw_scenarios(runs, seed, duration_s, widened=False):
             sc["nlos"] = "exponential"
             sc["range_correlation"] = uniform(wide_rng, 0.0, 0.3, 3)
             sc["range_time_offset"] = uniform(clock_rng, -0.05, 0.05, 3)
+            scale_max, misalignment_max_deg = IMU_AXIS_ERRORS[sc["imu_grade"]]
+            sc["imu_scale_sigma"] = uniform(imu_rng, 0.0, scale_max, 5)
+            sc["imu_misalignment"] = uniform(imu_rng, 0.0, misalignment_max_deg, 3)
         out.append(sc)
     return out
 
@@ -119,7 +130,8 @@ def sim_args(sc):
     flags = [("seed", "seed"), ("trajectory", "trajectory"), ("anchor_layout", "anchor-layout"), ("tags", "tags"),
              ("known", "known"), ("unknown", "unknown"), ("sigma_range", "sigma-range"), ("outliers", "outliers"),
              ("drop", "drop"), ("imu_grade", "imu-grade"), ("duration", "duration"), ("bias_max", "bias-max"),
-             ("nlos", "nlos"), ("range_correlation", "range-correlation"), ("range_time_offset", "range-time-offset")]
+             ("nlos", "nlos"), ("range_correlation", "range-correlation"), ("range_time_offset", "range-time-offset"),
+             ("imu_scale_sigma", "imu-scale-sigma"), ("imu_misalignment", "imu-misalignment")]
     args = []
     for key, flag in flags:
         if key in sc and sc[key] is not None:
@@ -372,7 +384,8 @@ def parse_args(argv):
     p.add_argument("--config", help="estimator options YAML for meshnav_run --config (default: its built-in defaults)")
     p.add_argument("--widened", action="store_true",
                    help="with --runs: draw real hardware's range errors too (NLOS excess 0.2 m + Exp(0.3 m), "
-                        "errors correlated over U(0, 0.3) s, range stamps U(-0.05, 0.05) s late against the IMU; "
+                        "errors correlated over U(0, 0.3) s, range stamps U(-0.05, 0.05) s late against the IMU, "
+                        "IMU axis scale errors and misalignments up to the grade's (consumer 1 %% and 0.5 deg); "
                         "docs/robustness.md)")
     p.add_argument("--duration", type=float, default=90.0, help="sequence length of drawn scenarios [s] (default 90)")
     p.add_argument("--calibration", choices=["off", "auto"], default="off",

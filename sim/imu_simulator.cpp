@@ -46,6 +46,8 @@ std::string ImuNoiseOptions::toString() const {
     << gyro_noise_density << " rad/s/sqrt(Hz), acc bias rw " << acc_bias_rw << " m/s^3/sqrt(Hz), gyro bias rw "
     << gyro_bias_rw << " rad/s^2/sqrt(Hz), initial bias sigma " << acc_bias_initial_sigma << " m/s^2, "
     << gyro_bias_initial_sigma << " rad/s";
+  if (scale_sigma > 0.0 || misalignment_sigma_rad > 0.0)
+    s << ", axis scale sigma " << scale_sigma << ", misalignment sigma " << misalignment_sigma_rad << " rad";
   return s.str();
 }
 
@@ -73,6 +75,15 @@ std::vector<ImuSample> ImuSimulator::simulate(const Trajectory& trajectory, doub
   bias_gyro_ = rng_bias.gaussian3(options_.gyro_bias_initial_sigma);
   bias_acc0_ = bias_acc_;
   bias_gyro0_ = bias_gyro_;
+  // The axes from a stream of their own: exact axes leave every other draw as it was.
+  acc_T_ = gyro_T_ = Eigen::Matrix3d::Identity();
+  if (options_.scale_sigma > 0.0 || options_.misalignment_sigma_rad > 0.0) {
+    RandomStream rng_axes(RandomStream::deriveSeed(seed_, "imu_axes"));
+    for (Eigen::Matrix3d* T : {&acc_T_, &gyro_T_})
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          (*T)(i, j) += rng_axes.gaussian(i == j ? options_.scale_sigma : options_.misalignment_sigma_rad);
+  }
 
   std::vector<ImuSample> out;
   const auto n = static_cast<int64_t>(std::floor(t_end_s / dt + 1e-9)) + 1;
@@ -84,8 +95,8 @@ std::vector<ImuSample> ImuSimulator::simulate(const Trajectory& trajectory, doub
     }
     const double t = static_cast<double>(k) * dt;
     ImuSample s = ideal(trajectory.evaluate(t));
-    s.acc_m_s2 += bias_acc_ + rng_noise.gaussian3(sigma_acc_d);
-    s.gyro_rad_s += bias_gyro_ + rng_noise.gaussian3(sigma_gyro_d);
+    s.acc_m_s2 = acc_T_ * s.acc_m_s2 + bias_acc_ + rng_noise.gaussian3(sigma_acc_d);
+    s.gyro_rad_s = gyro_T_ * s.gyro_rad_s + bias_gyro_ + rng_noise.gaussian3(sigma_gyro_d);
     out.push_back(s);
   }
   return out;

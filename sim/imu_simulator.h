@@ -25,6 +25,12 @@ struct ImuNoiseOptions {
   double gyro_bias_rw = 2e-5;              ///< σ_w gyroscope bias random walk [rad/s²/√Hz]
   double acc_bias_initial_sigma = 0.05;    ///< σ of b_a(0) [m/s²]
   double gyro_bias_initial_sigma = 0.005;  ///< σ of b_g(0) [rad/s]
+  /// Axis errors of real MEMS parts (issue 34 item 4), both sensors, drawn once per sequence:
+  /// a reading is T ideal + b + n with T = I + diag(s) + the off-diagonal terms m_ij (axes that
+  /// are scaled and not orthogonal to the body's), s_i ~ N(0, scale_sigma²) [-],
+  /// m_ij ~ N(0, misalignment_sigma_rad²) [rad]. 0: exact axes (the default; draws nothing).
+  double scale_sigma = 0.0;
+  double misalignment_sigma_rad = 0.0;
 
   /// All noise and biases zero (ideal IMU).
   static ImuNoiseOptions noiseless();
@@ -52,6 +58,10 @@ class ImuSimulator {
   /// Bias at the first sample (after `simulate`) [m/s², rad/s].
   const Eigen::Vector3d& initialAccBias() const { return bias_acc0_; }
   const Eigen::Vector3d& initialGyroBias() const { return bias_gyro0_; }
+  /// The axis matrices T of the accelerometer and the gyroscope (after `simulate`; identity when
+  /// the options draw none).
+  const Eigen::Matrix3d& accAxes() const { return acc_T_; }
+  const Eigen::Matrix3d& gyroAxes() const { return gyro_T_; }
   /// Bias at the last sample (after `simulate`).
   const Eigen::Vector3d& finalAccBias() const { return bias_acc_; }
   const Eigen::Vector3d& finalGyroBias() const { return bias_gyro_; }
@@ -61,6 +71,7 @@ class ImuSimulator {
   uint64_t seed_;
   Eigen::Vector3d bias_acc0_ = Eigen::Vector3d::Zero(), bias_gyro0_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d bias_acc_ = Eigen::Vector3d::Zero(), bias_gyro_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d acc_T_ = Eigen::Matrix3d::Identity(), gyro_T_ = Eigen::Matrix3d::Identity();
 };
 
 }  // namespace meshnav::sim

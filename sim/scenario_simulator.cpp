@@ -152,6 +152,13 @@ Truth makeTruth(const SimulationOptions& o, const PaperScenario& scenario, const
     sc[std::string("imu_acc_bias_end_") + axes[i]] = f.imu->finalAccBias()[i];
     sc[std::string("imu_gyro_bias_end_") + axes[i]] = f.imu->finalGyroBias()[i];
   }
+  if (o.imu.scale_sigma > 0.0 || o.imu.misalignment_sigma_rad > 0.0)  // T = I + scale + misalignment
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const std::string ij = std::string(axes[i]) + axes[j];
+        sc["imu_acc_axes_" + ij] = f.imu->accAxes()(i, j);
+        sc["imu_gyro_axes_" + ij] = f.imu->gyroAxes()(i, j);
+      }
   addScenarioScalars(o, trajectory, sc);
   return truth;
 }

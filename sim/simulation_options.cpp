@@ -21,6 +21,9 @@ void SimulationOptions::validate() const {
   require(std::abs(uwb.time_offset_s) <= 1.0, "range time offset must be in [-1, 1] s");
   require(uwb.slot_s > 0.0, "slot_s must be > 0");
   require(imu.rate_hz > 0.0 && baro.rate_hz > 0.0, "sensor rates must be > 0");
+  require(imu.scale_sigma >= 0.0 && imu.scale_sigma <= 0.1 && imu.misalignment_sigma_rad >= 0.0 &&
+              imu.misalignment_sigma_rad <= 0.1,
+          "IMU axis scale sigma and misalignment sigma must be in [0, 0.1] (fraction, rad)");
   require(ground_truth_rate_hz > 0.0 && flight_state_rate_hz > 0.0, "output rates must be > 0");
   require(initial_pose_sigma_p_m >= 0.0 && initial_pose_sigma_yaw_deg >= 0.0, "initial pose sigmas must be >= 0");
   if (trajectory) trajectory->validate();

@@ -5,6 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cmath>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -34,6 +35,7 @@ struct SimCli {
   double duration_s = 0.0;
   double bias_max_m = 0.0;
   double uncertain_sigma_m = 0.0;
+  double imu_scale_sigma = 0.0, imu_misalignment_deg = 0.0;
   int fleet = 0;
   bool no_initial_pose = false, uncertain_known = false;
 };
@@ -111,6 +113,14 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
                "consumer|fc|tactical IMU noise densities and bias random walks, written to setup.yaml noise: "
                "(default fc, a flight-controller IMU)")
       ->type_name("G")->group("Sensors");
+  cli.option("imu-scale-sigma", c.imu_scale_sigma,
+             "sigma of each IMU axis's scale-factor error, accelerometer and gyroscope, drawn once (consumer MEMS: "
+             "about 0.01); in truth.yaml imu_*_axes_*, not in setup.yaml; 0 = exact [-]")
+      ->type_name("F")->check(cli_checks::nonNegative())->group("Sensors");
+  cli.option("imu-misalignment", c.imu_misalignment_deg,
+             "sigma of each off-diagonal term of the IMU's axis matrices (axes not orthogonal to the body's), both "
+             "sensors, drawn once (consumer MEMS: about 0.5 deg); 0 = exact [deg]")
+      ->type_name("DEG")->check(cli_checks::nonNegative())->group("Sensors");
   cli.flag("no-initial-pose", c.no_initial_pose,
            "do not write the take-off pad prior to setup.yaml (never written for hover and walk)")
       ->group("Sensors");
@@ -162,6 +172,8 @@ void applyScenarioOptions(const meshnav::Cli& cli, SimCli& c) {
       throw std::invalid_argument(std::string("--imu-grade: ") + e.what());
     }
   }
+  o.imu.scale_sigma = c.imu_scale_sigma;  // after the grade, which sets the noise figures only
+  o.imu.misalignment_sigma_rad = c.imu_misalignment_deg * M_PI / 180.0;
   if (cli.given("bias-max")) {
     if (!(c.bias_max_m > 0.0 && c.bias_max_m <= 2.0)) throw std::invalid_argument("--bias-max must be in (0, 2] m");
     o.hardware.gamma_sigma_m = 0.375 * c.bias_max_m;  // the default 0.15 m for 0.4 m

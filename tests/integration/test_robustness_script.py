@@ -34,12 +34,13 @@ class DrawTest(unittest.TestCase):
             self.assertEqual({sc[key] for sc in scs}, set(values), key)
 
     def test_widened_draws_the_same_scenarios_with_real_range_errors(self):
-        # --widened (issue 34): the standard draw plus the NLOS excess, the errors' correlation time
-        # and the stamps' delay of real hardware, passed to meshnav_sim; the other keys are those of
-        # the plain draw.
+        # --widened (issue 34): the standard draw plus the NLOS excess, the errors' correlation time,
+        # the stamps' delay and the IMU's axis errors of real hardware, passed to meshnav_sim; the
+        # other keys are those of the plain draw.
         plain, wide = robustness.draw_scenarios(50, 3, 75), robustness.draw_scenarios(50, 3, 75, widened=True)
         for p, w in zip(plain, wide):
-            self.assertEqual({k: v for k, v in w.items() if k not in ("nlos", "range_correlation", "range_time_offset")}, p)
+            self.assertEqual({k: v for k, v in w.items() if k not in ("nlos", "range_correlation", "range_time_offset",
+                                                                       "imu_scale_sigma", "imu_misalignment")}, p)
             self.assertEqual(w["nlos"], "exponential")
             self.assertTrue(0.0 <= w["range_correlation"] <= 0.3)
             args = robustness.sim_args(w)
@@ -47,6 +48,9 @@ class DrawTest(unittest.TestCase):
             self.assertEqual(float(args[args.index("--range-correlation") + 1]), w["range_correlation"])
             self.assertTrue(-0.05 <= w["range_time_offset"] <= 0.05)
             self.assertEqual(float(args[args.index("--range-time-offset") + 1]), w["range_time_offset"])
+            scale_max, misalignment_max = robustness.IMU_AXIS_ERRORS[w["imu_grade"]]
+            self.assertTrue(0.0 <= w["imu_scale_sigma"] <= scale_max and 0.0 <= w["imu_misalignment"] <= misalignment_max)
+            self.assertEqual(float(args[args.index("--imu-misalignment") + 1]), w["imu_misalignment"])
         self.assertGreater(len({w["range_correlation"] for w in wide}), 40)
         self.assertGreater(len({w["range_time_offset"] for w in wide}), 40)
 

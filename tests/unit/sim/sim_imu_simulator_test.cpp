@@ -85,3 +85,35 @@ TEST(SimImuSimulator, SameSeedSameSamples) {
   }
   EXPECT_NE(sa[10].acc_m_s2, sc[10].acc_m_s2);
 }
+
+TEST(SimImuSimulator, AxisErrorsScaleAndTiltTheReadingsAndLeaveTheOtherDrawsAsTheyWere) {
+  // Readings T ideal + b + n: noise-free, the axis matrix is the reading's map of the ideal one.
+  const SpiralTrajectory tr(TrajectoryOptions::randomized(1));
+  ImuNoiseOptions opt = ImuNoiseOptions::noiseless();
+  opt.scale_sigma = 0.01;
+  opt.misalignment_sigma_rad = 0.5 * M_PI / 180.0;
+  ImuSimulator sim(opt, 4);
+  const auto imu = sim.simulate(tr, 60.0);
+  const Eigen::Matrix3d Ta = sim.accAxes(), Tg = sim.gyroAxes();
+  EXPECT_FALSE(Ta.isApprox(Eigen::Matrix3d::Identity(), 1e-6));
+  EXPECT_FALSE(Ta.isApprox(Tg, 1e-6));  // each sensor its own axes
+  for (const Eigen::Matrix3d& T : {Ta, Tg}) {
+    EXPECT_LT((T.diagonal() - Eigen::Vector3d::Ones()).cwiseAbs().maxCoeff(), 5 * opt.scale_sigma);
+    EXPECT_LT((T - Eigen::Matrix3d(T.diagonal().asDiagonal())).cwiseAbs().maxCoeff(), 5 * opt.misalignment_sigma_rad);
+  }
+  for (const size_t k : {size_t{0}, size_t{4000}, size_t{9000}}) {
+    const auto ideal = ImuSimulator::ideal(tr.evaluate(imu[k].t.sec()));
+    EXPECT_LT((imu[k].acc_m_s2 - Ta * ideal.acc_m_s2).norm(), 1e-12);
+    EXPECT_LT((imu[k].gyro_rad_s - Tg * ideal.gyro_rad_s).norm(), 1e-12);
+  }
+  // Noise and biases drawn as without axis errors (their own streams).
+  ImuNoiseOptions noisy;
+  ImuNoiseOptions noisy_axes = noisy;
+  noisy_axes.scale_sigma = 0.01;
+  ImuSimulator plain(noisy, 7), axes(noisy_axes, 7);
+  plain.simulate(tr, 10.0);
+  axes.simulate(tr, 10.0);
+  EXPECT_EQ(plain.initialAccBias(), axes.initialAccBias());
+  EXPECT_EQ(plain.finalGyroBias(), axes.finalGyroBias());
+  EXPECT_TRUE(plain.accAxes().isIdentity());
+}
