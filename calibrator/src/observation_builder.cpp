@@ -72,7 +72,9 @@ std::vector<CalibObservation> ObservationBuilder::collect(SensorId x, const std:
     }
     CalibObservation o = rangeObservation(r, x, options_);
     if (setup_.isTag(ref)) {
-      const auto tp = tagPosition(ref, r.t);
+      // The pose when the range was measured: its stamp less the UWB stamps' delay of setup.yaml
+      // (uwb_clock.offset_s; the estimator's estimate of it is not the calibrator's to know).
+      const auto tp = tagPosition(ref, r.t - Duration::fromSec(setup_.uwb_clock.offset_s));
       if (!tp) {
         diag.count("calibrator:range_without_pose");
         continue;

@@ -128,7 +128,11 @@ void Initialization::feedRange(const RangeSample& r, const UwbNetwork& network, 
   if (!p && !p_est) return;
   const PairBias pb = network.pairBias(tag, anchor);
   AlignRange a;
-  a.t = r.t;
+  // The IMU-clock instant the range was measured: its stamp less setup.yaml's delay of the UWB stamps
+  // (estimator/uwb/clock_offset_kind.h). Not the filter's estimate of it: the aligner judges the
+  // filter, and a delay learnt while the pose was wrong (ISAS-Walk1's first seconds, −158 ms) moved
+  // its gravity check and re-alignments (ISAS-Walk1 0.250 → 0.257 m).
+  a.t = r.t - Duration::fromSec(network.clockOffsetPrior_s());
   a.tag = tag;
   a.anchor = anchor;
   a.p_AinG = p ? *p : *p_est;

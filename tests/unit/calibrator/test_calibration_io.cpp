@@ -200,6 +200,29 @@ TEST(CalibrationIo, OptionsFromYaml) {
   EXPECT_EQ(error("calibrator_node:\n  auto_mode: true\n"), "");  // the other map keeps its defaults
 }
 
+TEST(ObservationBuilder, ATagIsTakenWhereItWasWhenTheLateStampedRangeWasMeasured) {
+  // setup.yaml uwb_clock.offset_s: a range stamped t was measured at the IMU-clock instant t − 0.25 s.
+  SystemSetup setup;
+  setup.rel_tag_positions[100] = Eigen::Vector3d::Zero();
+  setup.uwb_clock.offset_s = 0.25;
+  CalibratorOptions o;
+  o.max_pose_gap_s = 2.0;  // the two poses below are 1 s apart
+  ObservationBuilder b(setup, o);
+  std::vector<PoseEstimate> poses(2);
+  poses[1].t = Timestamp::fromSec(1.0);
+  poses[1].p_IinG = Eigen::Vector3d(2, 0, 0);  // 2 m/s along x
+  b.setPoses(poses);
+  RangeSample r;
+  r.t = Timestamp::fromSec(0.75);
+  r.id_initiator = 100;
+  r.id_responder = 106;
+  r.range_m = 3.0;
+  Diagnostics diag;
+  const auto obs = b.collect(106, {r}, diag);
+  ASSERT_EQ(obs.size(), 1u);
+  EXPECT_LT((obs[0].p_RinG - Eigen::Vector3d(1.0, 0, 0)).norm(), 1e-9);  // at 0.5 s, not 1.5 m at 0.75 s
+}
+
 TEST(ObservationBuilder, TagsAtLeverArmKnownAnchorsAndDiagnostics) {
   SystemSetup setup;
   setup.rel_tag_positions[100] = Eigen::Vector3d(0.2, 0.0, -0.1);
