@@ -6,6 +6,8 @@
 ///    `abs_anchor_positons` must not silently leave a default),
 ///  - a value of the wrong type or a number that is not finite (`.inf`, `.nan`) is an error
 ///    naming the file and the key, with the value found,
+///  - a key given twice in one map is an error naming the file, the key and both lines (YAML
+///    readers differ on which one wins; the loaders here read the first),
 ///  - a missing key keeps its default; defaults and units live in one place per file: the options
 ///    struct (and the shipped file written from it), documented in docs/configuration.md.
 /// Range checks stay with each options struct (`validate()`), and their messages name the key too.
@@ -31,8 +33,12 @@ class YamlOptions {
   /// `root`: the map of options (null: every default). `file` names the file in messages; `prefix`
   /// is the key path of `root` inside it ("calibrator" → messages say 'calibrator.sigma_range').
   YamlOptions(const YAML::Node& root, std::string file, std::string prefix = "");
-  /// Loads `path` (an empty file is an empty map). Throws std::runtime_error "<path>: cannot read".
+  /// Loads `path` (an empty file is an empty map). Throws std::runtime_error "<path>: cannot read",
+  /// on a syntax error and on a key given twice (rejectDuplicateKeys).
   static YAML::Node loadFile(const std::string& path);
+  /// Throws std::runtime_error "<path>:<line>: key '<a.b>' given twice (first at line <l>)" for the
+  /// first map of `root` (at any depth) that holds a key twice.
+  static void rejectDuplicateKeys(const YAML::Node& root, const std::string& path);
 
   /// Reads `key` (dotted, relative to the root) into `field` when present; keeps the default when
   /// missing (or null). Types: bool, int, int64_t, uint64_t, double (finite), std::string,

@@ -87,11 +87,14 @@ YAML::Node loadYamlFile(const std::string& path) {
   if (!in) fail(path, "cannot open file");
   std::stringstream ss;
   ss << in.rdbuf();
+  YAML::Node root;
   try {
-    return YAML::Load(normalizeFlowMaps(ss.str()));
+    root = YAML::Load(normalizeFlowMaps(ss.str()));
   } catch (const YAML::Exception& e) {
     fail(path, std::string("YAML syntax error: ") + e.what());
   }
+  YamlOptions::rejectDuplicateKeys(root, path);  // (normalizeFlowMaps keeps the lines)
+  return root;
 }
 
 std::vector<PairBias> readPairBiases(const YAML::Node& n, const std::string& path, const std::string& key) {

@@ -1,6 +1,7 @@
 #include "common/yaml_options.h"
 
 #include <fstream>
+#include <map>
 #include <sstream>
 
 namespace meshnav {
@@ -17,11 +18,41 @@ YAML::Node YamlOptions::loadFile(const std::string& path) {
   if (!in) throw std::runtime_error(path + ": cannot open file");
   std::stringstream ss;
   ss << in.rdbuf();
+  YAML::Node root;
   try {
-    return YAML::Load(ss.str());
+    root = YAML::Load(ss.str());
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error (" + e.msg + ")");
   }
+  rejectDuplicateKeys(root, path);
+  return root;
+}
+
+namespace {
+
+void rejectDuplicateKeysIn(const YAML::Node& n, const std::string& path, const std::string& prefix) {
+  if (n.IsSequence()) {
+    int i = 0;
+    for (const auto& e : n) rejectDuplicateKeysIn(e, path, prefix + "[" + std::to_string(i++) + "]");
+    return;
+  }
+  if (!n.IsMap()) return;
+  std::map<std::string, int> first_line;  // key → its 1-based line
+  for (const auto& kv : n) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : "?";
+    const std::string full = prefix.empty() ? key : prefix + "." + key;
+    const int line = kv.first.Mark().line + 1;
+    if (const auto [it, fresh] = first_line.emplace(key, line); !fresh)
+      throw std::runtime_error(path + ":" + std::to_string(line) + ": key '" + full + "' given twice (first at line " +
+                               std::to_string(it->second) + ")");
+    rejectDuplicateKeysIn(kv.second, path, full);
+  }
+}
+
+}  // namespace
+
+void YamlOptions::rejectDuplicateKeys(const YAML::Node& root, const std::string& path) {
+  rejectDuplicateKeysIn(root, path, "");
 }
 
 std::string YamlOptions::fullKey(const std::string& key) const {

@@ -8,6 +8,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/yaml_options.h"
+
 namespace meshnav::mission {
 
 const char* toString(MissionAction a) {
@@ -143,6 +145,7 @@ Mission parseMission(const std::string& yaml_text, const std::string& source) {
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(source + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error (" + e.msg + ")");
   }
+  YamlOptions::rejectDuplicateKeys(root, source);
   return parseRoot(root, source);
 }
 

@@ -187,6 +187,14 @@ TEST(Setup, BadConfigurationIsRefusedWithFileAndKey) {
   EXPECT_NE(error(base + "uwb_clock: {offset_s: 2}\n").find("key 'uwb_clock.offset_s'"), std::string::npos);
   EXPECT_NE(error(base + "uwb_clock: {sigma_s: -0.1}\n").find("key 'uwb_clock.sigma_s'"), std::string::npos);
   EXPECT_NE(error(base + "uwb_clock: {offset: 0.03}\n").find("unknown key 'uwb_clock.offset'"), std::string::npos);
+  // A key given twice (issue 36): YAML readers differ on which wins; refused with both lines.
+  EXPECT_NE(error("imu_id: 7\n" + base + "imu_id: 9\n").find("key 'imu_id' given twice (first at line 1)"),
+            std::string::npos);
+  EXPECT_NE(error(base + "baro:\n  p_IP: [0, 0, 0]\n  p_IP: [0, 0, 1]\n").find("key 'baro.p_IP' given twice"),
+            std::string::npos);
+  EXPECT_NE(error(base + "pair_biases: [{ids: [100, 101], gamma: 0.1, gamma: 0.2}]\n")
+                .find("key 'pair_biases[0].gamma' given twice"),
+            std::string::npos);
   EXPECT_NE(error(base + "imu_id: 3\nheight_id: 3\n").find("key 'imu_id' and key 'height_id' are the same id 3"),
             std::string::npos);
   EXPECT_NE(error(base + "height: {p_IH: [0, 0]}\n").find("height.p_IH"), std::string::npos);

@@ -72,6 +72,9 @@ TEST(EstimatorOptions, UnknownKeysAndBadValuesNameFileAndKey) {
   EXPECT_NE(e.find("unknown key 'uwb.sigma_range_mm'"), std::string::npos) << e;
   e = loadError("opts_top.yaml", "windw_s: 1.0\n");
   EXPECT_NE(e.find("unknown key 'windw_s'"), std::string::npos) << e;
+  // A key given twice (issue 36): the first used to win silently.
+  e = loadError("opts_twice.yaml", "uwb:\n  sigma_range_m: 0.2\n  huber_k: 0\n  sigma_range_m: 0.3\n");
+  EXPECT_NE(e.find(":4: key 'uwb.sigma_range_m' given twice (first at line 2)"), std::string::npos) << e;
   e = loadError("opts_section.yaml", "zuptt:\n  enabled: false\n");
   EXPECT_NE(e.find("unknown key 'zuptt'"), std::string::npos) << e;
   e = loadError("opts_inf.yaml", "uwb:\n  sigma_range_m: .inf\n");
