@@ -40,11 +40,12 @@ class CsvRow {
 /// The readers keep every sample in memory (and the estimator's replay merges them once more), so
 /// a larger file is refused up front with a message instead of taking several times its size in
 /// memory (a 100 MB ranges.csv took 665 MB). The environment variable MESHNAV_MAX_CSV_MB raises or
-/// lowers it (whole MiB, > 0); docs/faults.md.
+/// lowers it (whole MiB, > 0; another value throws std::runtime_error naming it); docs/faults.md.
 uint64_t maxCsvBytes();
 
 /// Reads a comma separated file with a header line. A leading '#' on the header is ignored
-/// (TUM files). Blank lines and lines starting with '#' after the header are skipped.
+/// (TUM files), and so is a UTF-8 byte order mark before it. Blank lines and lines starting with
+/// '#' after the header are skipped.
 class CsvReader {
  public:
   /// Opens and reads the header. Throws std::runtime_error("file: ...") when missing/unreadable,

@@ -80,7 +80,12 @@ uint64_t maxCsvBytes() {
   if (const char* env = std::getenv("MESHNAV_MAX_CSV_MB"); env && *env) {
     char* end = nullptr;
     const unsigned long long v = std::strtoull(env, &end, 10);
-    if (end != env && *end == '\0' && v > 0 && v < (1ull << 40)) mib = v;
+    // A value that is not a limit is refused, not ignored (issue 36): the user meant something.
+    if (end == env || *end != '\0' || env[0] == '-' || !(v > 0 && v < (1ull << 40)))
+      throw std::runtime_error(std::string("MESHNAV_MAX_CSV_MB='") + env +
+                               "' is not a limit: a whole number of MiB, 1 or more (unset it for the default " +
+                               std::to_string(kDefaultMiB) + ")");
+    mib = v;
   }
   return mib << 20;
 }
@@ -104,6 +109,8 @@ CsvReader::CsvReader(const std::string& path, const std::vector<std::string>& re
     }
   }
   if (!got) throw std::runtime_error(path + ": empty file (no header line)");
+  // A UTF-8 byte order mark (spreadsheet exports write one) is not part of the first column's name.
+  if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
   std::string h = trim(line);
   if (!h.empty() && h[0] == '#') h = trim(h.substr(1));
   header_ = splitFields(h);

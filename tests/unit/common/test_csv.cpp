@@ -111,3 +111,34 @@ TEST(Csv, FilesAboveTheSizeLimitAreRefusedWithAMessage) {
   ASSERT_EQ(unsetenv("MESHNAV_MAX_CSV_MB"), 0);
   EXPECT_EQ(maxCsvBytes(), 64u << 20);
 }
+
+TEST(Csv, ALimitThatIsNotANumberIsRefusedNotIgnored) {
+  // Issue 36: MESHNAV_MAX_CSV_MB=2GB used to leave the 64 MiB default without a word.
+  for (const char* bad : {"2GB", "-5", "0", "1.5", "huge"}) {
+    ASSERT_EQ(setenv("MESHNAV_MAX_CSV_MB", bad, 1), 0);
+    try {
+      maxCsvBytes();
+      ADD_FAILURE() << bad << " was taken as a limit";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("MESHNAV_MAX_CSV_MB='") + bad + "' is not a limit"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  ASSERT_EQ(unsetenv("MESHNAV_MAX_CSV_MB"), 0);
+}
+
+TEST(Csv, AByteOrderMarkBeforeTheHeaderIsNotPartOfTheFirstColumn) {
+  // Issue 36: a spreadsheet's UTF-8 export gave "missing column 't'" with the invisible mark in it.
+  const test::TempDir d("csv");
+  const auto f = test::writeFile(d / "imu.csv", "\xEF\xBB\xBFt,x\n1.5,2\n");
+  CsvReader r(f, {"t", "x"});
+  Diagnostics diag;
+  int n = 0;
+  r.forEach([&](const CsvRow& row) {
+    EXPECT_DOUBLE_EQ(*row.number("t"), 1.5);
+    ++n;
+  }, diag);
+  EXPECT_EQ(n, 1);
+  EXPECT_EQ(diag.total(), 0);
+}
