@@ -28,7 +28,9 @@ namespace {
 constexpr char kDescription[] =
     "Metrics of a run against ground truth (pose RMSE, ARMSE, ANEES, anchor errors) and plots; the "
     "multilateration baseline of a dataset alone (no --run); or, with --batch, the paper-style table over many "
-    "runs.";
+    "runs. Exit status 0: evaluated; 1: nothing to evaluate (no estimate could be scored against the ground truth, "
+    "or a file could not be read or written); 2: bad command line; 3: rows with unusable time stamps were left "
+    "out.";
 
 /// "T0:T1" [s] with finite T0 < T1; nullopt otherwise.
 std::optional<std::pair<double, double>> parseWindow(const std::string& w) {
@@ -205,6 +207,13 @@ int runSingle(const EvalCli& cli) {
   // Windows that left no pose to score make the run's figures missing, not healthy.
   if (!ev.options.exclude_windows_s.empty() && ev.trajectory.n_selected == 0) {
     spdlog::error("--exclude left no estimate to score");
+    return 1;
+  }
+  // Ground truth to score against and no pose scored: the run's result is missing, whatever the
+  // anchors say (issue 36: this used to exit 0 with "pose metrics: not available").
+  if (ev.has_ground_truth && ev.trajectory.n_selected == 0) {
+    spdlog::error("no estimate of {} could be scored against the ground truth of {}: pose metrics not available{}",
+                  cli.run, cli.dataset, ev.notes.empty() ? std::string() : " (" + ev.notes.back() + ")");
     return 1;
   }
   return badTimeRows(ev) ? 3 : 0;
