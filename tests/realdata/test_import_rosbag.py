@@ -140,6 +140,24 @@ class SyntheticBag(unittest.TestCase):
             # No anchor list: positions come from the ranges' pos fields (ids of kept ranges only).
             self.assertIn("5: [1.0, 2.0, 3.0]", rs.read_text(os.path.join(tmp, "ds", "setup.yaml")))
 
+    def test_a_damaged_bag_is_a_clear_error_and_writes_nothing(self):
+        # Issue 36: a damaged chunk gave a Python traceback. 4 KiB of 0xff in the middle of a copy of
+        # ISAS-Walk1: the reader cannot go past it; the import stops with the place, exit 1.
+        rs.require(rs.ISAS_BAG)
+        with tempfile.TemporaryDirectory() as tmp:
+            bad = os.path.join(tmp, "damaged.bag")
+            with open(rs.ISAS_BAG, "rb") as f:
+                data = bytearray(f.read())
+            data[1600000:1600000 + 4096] = b"\xff" * 4096
+            with open(bad, "wb") as f:
+                f.write(data)
+            out = os.path.join(tmp, "ds")
+            code, log = rs.run_import("rosbag", "--bag", bad, "--out", out)
+            self.assertEqual(code, 1, log)
+            self.assertIn(f"{bad}: damaged after ", log)
+            self.assertNotIn("Traceback", log)
+            self.assertFalse(os.path.exists(out))
+
     def test_not_a_bag_is_a_clear_error(self):
         with tempfile.TemporaryDirectory() as tmp:
             bad = os.path.join(tmp, "bad.bag")

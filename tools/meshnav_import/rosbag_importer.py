@@ -198,7 +198,15 @@ def _read(bag, topic_roles, collector, report):
     progress = dw.Progress("reading bag", total)
     index = {t: 0 for t in topic_roles}
     n = 0
-    for topic, raw, bag_time in bag.read_messages(topics=list(topic_roles), raw=True):
+    messages = bag.read_messages(topics=list(topic_roles), raw=True)
+    while True:
+        try:
+            topic, raw, bag_time = next(messages)
+        except StopIteration:
+            break
+        except Exception as ex:  # a damaged chunk or record: the reader cannot go on past it
+            raise ValueError(f"{bag.filename}: damaged after {n} of {total} messages ({type(ex).__name__}: {ex}); "
+                             "nothing written (a partial recording would look complete)") from None
         where = f"{topic} #{index[topic]}"
         index[topic] += 1
         n += 1
