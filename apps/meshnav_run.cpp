@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -31,7 +32,9 @@ namespace {
 
 constexpr char kDescription[] =
     "Runs the estimator, calibrator and mission nodes on a dataset folder in one process, in time order, as fast "
-    "as possible (deterministic).";
+    "as possible (deterministic). Exit status 0: done; 1: an input or output file failed; 2: bad command line; "
+    "3: the estimate ended lost or never initialized (--allow-lost: 0); 130 / 143: stopped by SIGINT / SIGTERM, "
+    "the rows and end-of-run files written so far (status.txt complete: false).";
 
 /// The command line of meshnav_run.
 struct RunOptions {
@@ -73,6 +76,12 @@ void declareOptions(Cli& cli, RunOptions& o) {
            "print the estimator's model parameters (fixed in code, not options; docs/configuration.md) and exit");
 }
 
+/// SIGINT or SIGTERM received (its number; 0: none): the run stops feeding, then writes its rows
+/// and end-of-run files as at the end, and exits 128 + the signal (issue 36).
+volatile std::sig_atomic_t g_signal = 0;
+
+extern "C" void onStopSignal(int sig) { g_signal = sig; }
+
 void writeTimings(const StepTimings& timings, const std::string& path) {
   std::ofstream out(path);
   out << "step,count,mean_us,median_us,max_us\n";
@@ -83,6 +92,7 @@ void writeTimings(const StepTimings& timings, const std::string& path) {
 
 void writeStatus(const EstimatorStatus& st, double wall_s, double data_s, const std::string& path) {
   std::ofstream out(path);
+  out << "complete: " << (g_signal ? "false  # interrupted by a signal" : "true") << "\n";
   out << "strategy: " << st.strategy << "\ninitialized: " << (st.initialized ? "true" : "false")
       << "\nhealth: " << st.health << "\nhealth_reason: \"" << st.health_reason << "\""
       << "\nsigma_p_max_m: " << st.sigma_p_max_m << "\nsigma_yaw_deg: " << st.sigma_yaw_deg
@@ -99,13 +109,20 @@ void writeStatus(const EstimatorStatus& st, double wall_s, double data_s, const 
   checkedFlush(out, path);
 }
 
-/// Feeds every input of `inputs` (time order, each to its vehicle) to the pipeline, with a progress line every 25 %.
-/// Returns the wall time it took [s].
+/// Feeds every input of `inputs` (time order, each to its vehicle) to the pipeline, with a progress line every 25 %,
+/// until a stop signal. Returns the wall time it took [s].
 double feed(pipeline::Pipeline& pipe, const std::vector<pipeline::FleetInput>& inputs, double data_s) {
   const Timestamp t_first = inputTime(inputs.front().input);
   const auto wall0 = std::chrono::steady_clock::now();
   int next_progress = 1;
   for (const auto& [vehicle, input] : inputs) {
+    if (g_signal) {
+      spdlog::warn("interrupted by signal {} at t = {} s ({:.0f} % of the data): writing what was estimated so far; "
+                   "exit {}",
+                   static_cast<int>(g_signal), formatSeconds(inputTime(input)),
+                   data_s > 0 ? 100.0 * (inputTime(input) - t_first).sec() / data_s : 0.0, 128 + g_signal);
+      break;
+    }
     pipe.onInput(vehicle, input);
     if (data_s > 0 && (inputTime(input) - t_first).sec() >= next_progress * 0.25 * data_s) {
       spdlog::info("progress {:3d}% (t = {} s)", next_progress * 25, formatSeconds(inputTime(input)));
@@ -250,6 +267,8 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
                runs.size() > 1 ? fmt::format(", one anchor map for {} vehicles", runs.size()) : std::string());
 
   const double data_s = (inputTime(inputs.back().input) - inputTime(inputs.front().input)).sec();
+  std::signal(SIGINT, onStopSignal);
+  std::signal(SIGTERM, onStopSignal);
   const double wall_s = feed(pipe, inputs, data_s);
   int code = 0;
   for (size_t v = 0; v < runs.size(); ++v) {
@@ -280,7 +299,7 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
     writeStatus(node.status(), wall_s, data_s, (runs[v].out / "status.txt").string());
     code = std::max(code, report(node, data_s, wall_s, runs[v].out.string(), o.allow_lost, runs[v].who()));
   }
-  return code;
+  return g_signal ? 128 + g_signal : code;
 }
 
 /// The work of main: --print-config, or the pipeline on --dataset.
