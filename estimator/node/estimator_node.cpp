@@ -67,6 +67,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       setup_(setup),
       sinks_(std::move(sinks)),
       gate_(options_, diag_),
+      imu_units_(ImuUnitsCheck::Options{2.0, options_.gravity_m_s2, 3.0, 8.7}),
       init_(options_, setup_, diag_, timings_),
       gravity_(options_.init.motion_window_s, options_.init.gravity_early_check_nis_ratio, diag_),
       volume_(options_.flight_volume, setup_, diag_),
@@ -144,8 +145,18 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     spdlog::info("estimator: reset by command at t={}", formatSeconds(c->t));
     diag_.count("reset");
     resetAll();
+    imu_units_ = ImuUnitsCheck(ImuUnitsCheck::Options{2.0, options_.gravity_m_s2, 3.0, 8.7});  // a new stream
     return;
   }
+  // An IMU in other units than m/s² and rad/s: no estimate, the reason in the status.
+  if (const auto* s = std::get_if<ImuSample>(&in)) {
+    if (const std::string fault = imu_units_.add(*s); !fault.empty()) {
+      spdlog::error("estimator: {}: {}; the estimator stops (docs/faults.md)", where("IMU", s->t), fault);
+      diag_.count("imu_units_implausible");
+      resetAll();
+    }
+  }
+  if (!imu_units_.fault().empty()) return;
   const Timestamp t = inputTime(in);
   init_.feed(in, *cur_.network, cur_.filter.get());
   if (std::holds_alternative<ImuSample>(in)) init_.pruneStillness(timeline_.oldestReplayUs(t.us));

@@ -72,6 +72,7 @@
 #include "estimator/health/recovery_policy.h"
 #include "estimator/imu/imu_propagation.h"
 #include "estimator/imu/imu_readings.h"
+#include "estimator/imu/imu_units_check.h"
 #include "estimator/imu/process_noise_adapter.h"
 #include "estimator/health/flight_volume_guard.h"
 #include "estimator/init/gravity_direction.h"
@@ -244,6 +245,9 @@ class EstimatorNode : private RerunReplayer {
   Diagnostics diag_;
   StepTimings timings_;
   InputGate gate_;
+  /// The IMU's units (m/s², rad/s): a stream in other units stops the estimator with the reason
+  /// (waitingFor), counter `imu_units_implausible`; only a Reset command starts it again.
+  ImuUnitsCheck imu_units_;
   Initialization init_;
   GravityDirection gravity_;
   FlightVolumeGuard volume_;

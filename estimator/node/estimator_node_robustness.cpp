@@ -81,6 +81,7 @@ void EstimatorNode::initialize(const InitialBelief& b) {
 }
 
 std::string EstimatorNode::waitingFor() const {
+  if (!imu_units_.fault().empty()) return "IMU: " + imu_units_.fault();
   if (initialized()) return "";
   return init_.waitingFor();
 }
