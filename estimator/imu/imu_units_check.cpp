@@ -11,14 +11,14 @@ namespace meshnav::estimator {
 
 std::string ImuUnitsCheck::add(const ImuSample& s) {
   if (!fault_.empty()) return "";
-  window_.push_back(s);
-  if ((s.t - window_.front().t).sec() < options_.window_s) return "";
+  if (!window_start_) window_start_ = s.t;
+  if (!accel_checked_) sum_f_ += s.acc_m_s2.norm();
+  rates_.push_back(s.gyro_rad_s.norm());
+  if ((s.t - *window_start_).sec() < options_.window_s) return "";
   // A full window: the accelerometer's verdict on the first one, the gyro's on every one.
   if (!accel_checked_) {
     accel_checked_ = true;
-    double mean_f = 0.0;
-    for (const ImuSample& x : window_) mean_f += x.acc_m_s2.norm();
-    mean_f /= static_cast<double>(window_.size());
+    const double mean_f = sum_f_ / static_cast<double>(rates_.size());
     if (std::abs(mean_f - options_.gravity_m_s2) > options_.gravity_tolerance_m_s2) {
       const bool in_g = std::abs(mean_f - 1.0) < 0.3;
       fault_ = fmt::format("the accelerometer reads a mean |f| of {:.2f} over its first {:.0f} s where gravity gives "
@@ -28,18 +28,16 @@ std::string ImuUnitsCheck::add(const ImuSample& s) {
       return fault_;
     }
   }
-  std::vector<double> rates;
-  rates.reserve(window_.size());
-  for (const ImuSample& x : window_) rates.push_back(x.gyro_rad_s.norm());
-  std::nth_element(rates.begin(), rates.begin() + static_cast<long>(rates.size() / 2), rates.end());
-  const double median = rates[rates.size() / 2];
+  std::nth_element(rates_.begin(), rates_.begin() + static_cast<long>(rates_.size() / 2), rates_.end());
+  const double median = rates_[rates_.size() / 2];
   if (median > options_.max_median_rate_rad_s) {
     fault_ = fmt::format("the gyro reads a median |w| of {:.1f} over {:.0f} s, {:.0f} deg/s if that is rad/s: in "
                          "deg/s, not rad/s? (multiply by pi/180)",
                          median, options_.window_s, median * 180.0 / M_PI);
     return fault_;
   }
-  window_.clear();  // the next window (the gyro's check runs once per window_s)
+  rates_.clear();  // the next window (the gyro's check runs once per window_s)
+  window_start_.reset();
   return "";
 }
 

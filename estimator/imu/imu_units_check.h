@@ -13,9 +13,11 @@
 ///    deg/s at least 12 "rad/s" on a slow flight.
 /// Both verdicts are physical limits with a tenfold margin, not tuned on a recording.
 
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "common/time.h"
 #include "common/types.h"
 
 namespace meshnav::estimator {
@@ -34,10 +36,14 @@ class ImuUnitsCheck {
   std::string add(const ImuSample& s);
   /// The fault found ("" while none): the stream is not in m/s² and rad/s.
   const std::string& fault() const { return fault_; }
+  /// A new stream (a Reset command): nothing checked, no fault.
+  void reset() { *this = ImuUnitsCheck(options_); }
 
  private:
   Options options_;
-  std::vector<ImuSample> window_;  ///< the samples of the current window (the first: the accelerometer's)
+  std::optional<Timestamp> window_start_;
+  double sum_f_ = 0.0;         ///< Σ |f| over the first window (the accelerometer's) [m/s²]
+  std::vector<double> rates_;  ///< |ω| of the current window [rad/s]
   bool accel_checked_ = false;
   std::string fault_;
 };

@@ -67,7 +67,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       setup_(setup),
       sinks_(std::move(sinks)),
       gate_(options_, diag_),
-      imu_units_(ImuUnitsCheck::Options{2.0, options_.gravity_m_s2, 3.0, 8.7}),
+      imu_units_(ImuUnitsCheck::Options{.gravity_m_s2 = options_.gravity_m_s2}),
       init_(options_, setup_, diag_, timings_),
       gravity_(options_.init.motion_window_s, options_.init.gravity_early_check_nis_ratio, diag_),
       volume_(options_.flight_volume, setup_, diag_),
@@ -145,7 +145,7 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     spdlog::info("estimator: reset by command at t={}", formatSeconds(c->t));
     diag_.count("reset");
     resetAll();
-    imu_units_ = ImuUnitsCheck(ImuUnitsCheck::Options{2.0, options_.gravity_m_s2, 3.0, 8.7});  // a new stream
+    imu_units_.reset();  // a new stream
     return;
   }
   // An IMU in other units than m/s² and rad/s: no estimate, the reason in the status.

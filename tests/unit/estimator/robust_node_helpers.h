@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "estimator/node/estimator_node.h"
@@ -18,6 +19,7 @@ struct RunResult {
   double final_error_m = 0.0;
   double max_error_after_m = 0.0;
   double max_angle_error_after_deg = 0.0;  ///< largest rotation angle of R̂ᵀR after t_check [deg]
+  double rms_error_after_m = 0.0;          ///< position RMSE over the IMU samples after t_check [m]
   Health final_health = Health::Initializing;
 };
 
@@ -25,6 +27,8 @@ template <typename Hook>
 RunResult run(EstimatorNode& node, const Dataset& ds, double t_check, Hook hook) {
   RunResult res;
   size_t gi = 0;
+  double sq = 0.0;
+  long n = 0;
   for (const auto& in : mergeInTimeOrder(ds)) {
     node.onInput(in);
     hook(node, inputTime(in));
@@ -35,10 +39,13 @@ RunResult run(EstimatorNode& node, const Dataset& ds, double t_check, Hook hook)
     res.final_error_m = e;
     if (t.sec() <= t_check) continue;
     res.max_error_after_m = std::max(res.max_error_after_m, e);
+    sq += e * e;
+    ++n;
     const double angle = node.pose()->q_ItoG.angularDistance(ds.ground_truth[gi].q_ItoG) * 180.0 / M_PI;
     res.max_angle_error_after_deg = std::max(res.max_angle_error_after_deg, angle);
   }
   res.final_health = node.health();
+  if (n > 0) res.rms_error_after_m = std::sqrt(sq / static_cast<double>(n));
   return res;
 }
 

@@ -32,20 +32,9 @@ sim::SimulationOptions lateStamps(double delay_s) {
 
 ClockRun runWith(const Dataset& ds, const EstimatorOptions& o) {
   EstimatorNode node(o, ds.setup);
-  double sq = 0.0;
-  long n = 0;
-  size_t gi = 0;
-  for (const auto& in : mergeInTimeOrder(ds)) {
-    node.onInput(in);
-    if (!std::holds_alternative<ImuSample>(in) || !node.initialized()) continue;
-    const Timestamp t = inputTime(in);
-    while (gi + 1 < ds.ground_truth.size() && ds.ground_truth[gi + 1].t <= t) ++gi;
-    if (t.sec() < 10.0) continue;
-    sq += (node.pose()->p_IinG - ds.ground_truth[gi].p_IinG).squaredNorm();
-    ++n;
-  }
+  const RunResult r = run(node, ds, 10.0, [](EstimatorNode&, Timestamp) {});
   EXPECT_TRUE(node.initialized()) << node.waitingFor();
-  return {n > 0 ? std::sqrt(sq / n) : 1e9, node.status()};
+  return {r.rms_error_after_m > 0.0 ? r.rms_error_after_m : 1e9, node.status()};
 }
 
 bool hasClockInstance(const EstimatorStatus& s) {
