@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "common/cli_main.h"
 #include "common/dataset.h"
@@ -35,7 +36,8 @@ constexpr char kDescription[] =
     "Runs the estimator, calibrator and mission nodes on a dataset folder in one process, in time order, as fast "
     "as possible (deterministic). Exit status 0: done; 1: an input or output file failed; 2: bad command line; "
     "3: the estimate ended lost or never initialized (--allow-lost: 0); 4: the UWB clock's delay ended more than "
-    "5 sigma from its prior (setup.yaml uwb_clock); 130 / 143: stopped by SIGINT / SIGTERM, "
+    "5 sigma from its prior (setup.yaml uwb_clock); 5: the estimate ends more than 1 s before the vehicle's inputs "
+    "(an IMU file that ends early, a refused tail); 130 / 143: stopped by SIGINT / SIGTERM, "
     "the rows and end-of-run files written so far (status.txt complete: false).";
 
 /// The command line of meshnav_run.
@@ -142,11 +144,18 @@ double feed(pipeline::Pipeline& pipe, const std::vector<pipeline::FleetInput>& i
 /// widened-sweep run with the defaults ends within 2σ.
 constexpr double kClockDelayBeyondPrior = 5.0;
 
+/// How far before the vehicle's last input its estimate may end [s]: POSE follows the IMU, so an
+/// IMU file that ends at 70 s of a 141 s flight ended the estimate at 70 s with exit 0 (issue 36).
+/// A complete recording's streams end within a few IMU periods of each other; 1 s is ten times the
+/// longest IMU interval the estimator takes without an `imu_gap` event (imu.max_dt_s, 0.1 s).
+constexpr double kCoverageShortfall_s = 1.0;
+
 /// The end-of-run log lines of one vehicle (`who`: "" or "vehicle NAME: "); returns its exit code
 /// (3 when the estimate ends lost or never initialized, 4 when its UWB clock's delay ended beyond
-/// kClockDelayBeyondPrior of its prior).
+/// kClockDelayBeyondPrior of its prior, 5 when its last POSE, `last_pose`, is more than
+/// kCoverageShortfall_s before `last_input`, the vehicle's newest input).
 int report(const EstimatorNode& node, const SystemSetup& setup, double data_s, double wall_s, const std::string& out_dir,
-           bool allow_lost, const std::string& who) {
+           bool allow_lost, const std::string& who, std::optional<Timestamp> last_pose, Timestamp last_input) {
   const EstimatorStatus st = node.status();
   if (!node.initialized()) spdlog::error("{}the estimator never initialized: {}", who, node.waitingFor());
   if (auto pose = node.pose())
@@ -188,6 +197,14 @@ int report(const EstimatorNode& node, const SystemSetup& setup, double data_s, d
                   std::abs(st.uwb_clock_offset_s - setup.uwb_clock.offset_s) / prior_sigma_s,
                   setup.uwb_clock.offset_s * 1e3, prior_sigma_s * 1e3);
     return 4;
+  }
+  // Coverage (issue 36: an IMU file ending at half the flight ended the estimate there, exit 0).
+  // POSE follows the IMU: the filter may still fuse ranges after the IMU's end, but nothing is written.
+  if (last_pose && (last_input - *last_pose).sec() > kCoverageShortfall_s) {
+    spdlog::error("{}the estimate ends at {} s, {:.1f} s before the last input at {} s: the IMU ended early or the "
+                  "inputs after it were refused (counters above); the rest of the recording has no estimate; exit 5",
+                  who, formatSeconds(*last_pose), (last_input - *last_pose).sec(), formatSeconds(last_input));
+    return 5;
   }
   return 0;
 }
@@ -280,7 +297,11 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
   popts.calibrator = calib_config.calibrator;
   popts.calibrator_node = calib_config.node;
   pipeline::PipelineSinks psinks;
-  psinks.pose = [&](size_t v, const PoseEstimate& e) { runs[v].estimates->write(e); };
+  std::vector<std::optional<Timestamp>> last_pose(runs.size());  // each vehicle's newest POSE written
+  psinks.pose = [&](size_t v, const PoseEstimate& e) {
+    runs[v].estimates->write(e);
+    last_pose[v] = std::max(last_pose[v].value_or(e.t), e.t);
+  };
   psinks.anchors = [&](size_t v, const std::vector<AnchorEstimate>& list) {
     for (const auto& a : list) runs[v].anchors->write(a);
   };
@@ -323,7 +344,7 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
     const EstimatorNode& node = pipe.estimator(v);
     writeStatus(node.status(), wall_s, data_s, (runs[v].out / "status.txt").string());
     code = std::max(code, report(node, runs[v].ds.setup, data_s, wall_s, runs[v].out.string(), o.allow_lost,
-                                 runs[v].who()));
+                                 runs[v].who(), last_pose[v], inputTime(per_vehicle[v].back())));
   }
   return g_signal ? 128 + g_signal : code;
 }
