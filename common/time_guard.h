@@ -14,9 +14,17 @@
 /// each other, the clock moves to them (`Verdict::Rebased`, the input is accepted). One bad sensor
 /// among good ones never gets there (every accepted input restarts the count), nor do random time
 /// stamps (they do not agree). The first input sets the clock.
+///
+/// Inputs name their source (admit's `kind`: IMU, RANGE, …; check() without one is a single
+/// anonymous source). Once two sources have been accepted, a jump must be agreed on by two of
+/// them: a burst from one source alone (100 IMU messages stamped +1 h, issue 36) is that source's
+/// fault however long it lasts, refused and reported once per burst as "<kind>:time_jump_alone".
+/// A whole stream that jumps carries its other sources along, and the clock follows when the
+/// first of them agrees.
 
 #include <cstdint>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "common/diagnostics.h"
@@ -42,8 +50,9 @@ class TimeGuard {
   enum class Verdict { Accept, Ahead, Behind, Rebased };
 
   explicit TimeGuard(TimeGuardOptions options = {});
-  /// Checks an input stamped `t` (any int64 utime: no overflow) and updates the current time.
-  Verdict check(Timestamp t);
+  /// Checks an input stamped `t` (any int64 utime: no overflow) from `source` and updates the
+  /// current time.
+  Verdict check(Timestamp t, const std::string& source = "");
   /// check() for an input of `kind` (its channel name), reporting to `diag`: a refusal as
   /// "<kind>:time_ahead" / "<kind>:time_behind", a rebase as "time_rebased", each with a message
   /// naming the times. Returns the verdict (Ahead/Behind: drop the input).
@@ -64,6 +73,9 @@ class TimeGuard {
   std::optional<Timestamp> now_;
   int streak_ = 0;                 ///< consecutive refused inputs that agree
   int64_t streak_lo_ = 0, streak_hi_ = 0;  ///< their time span [µs]
+  std::set<std::string> streak_sources_;   ///< their sources
+  std::set<std::string> sources_;          ///< every source with an accepted input
+  bool alone_reported_ = false;            ///< this streak was reported as one source's jump
   Duration last_jump_;
 };
 

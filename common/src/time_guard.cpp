@@ -32,6 +32,8 @@ TimeGuard::TimeGuard(TimeGuardOptions options) : options_(options) {
 void TimeGuard::reset() {
   now_.reset();
   streak_ = 0;
+  streak_sources_.clear();
+  sources_.clear();
 }
 
 const char* TimeGuard::name(Verdict v) {
@@ -46,7 +48,7 @@ const char* TimeGuard::name(Verdict v) {
 
 TimeGuard::Verdict TimeGuard::admit(const std::string& kind, Timestamp t, Diagnostics& diag) {
   const std::optional<Timestamp> before = now_;
-  const Verdict v = check(t);
+  const Verdict v = check(t, kind);
   const std::string offset = std::to_string(options_.max_offset_s) + " s";
   if (v == Verdict::Ahead || v == Verdict::Behind)
     diag.report(kind + ":time_" + name(v), kind + " t=" + formatSeconds(t) + " is " + name(v) + " of the current time " +
@@ -55,6 +57,13 @@ TimeGuard::Verdict TimeGuard::admit(const std::string& kind, Timestamp t, Diagno
                                                     ? ", behind " + std::to_string(options_.max_behind_s) + " s"
                                                     : std::string()) +
                                                "); refused");
+  if ((v == Verdict::Ahead || v == Verdict::Behind) && streak_ >= options_.rebase_after && !alone_reported_) {
+    alone_reported_ = true;
+    diag.report(kind + ":time_jump_alone",
+                std::to_string(streak_) + " consecutive " + kind + " inputs agree on a time near " + formatSeconds(t) +
+                    " s, " + name(v) + " of the current time " + formatSeconds(*before) +
+                    ", and no other source does: refused as " + kind + "'s fault, the clock stays");
+  }
   if (v == Verdict::Rebased)
     diag.report("time_rebased", std::to_string(options_.rebase_after) + " consecutive inputs (the last: " + kind +
                                     ") agree on a time " + std::to_string(last_jump_.sec()) + " s from the current time " +
@@ -62,14 +71,16 @@ TimeGuard::Verdict TimeGuard::admit(const std::string& kind, Timestamp t, Diagno
   return v;
 }
 
-TimeGuard::Verdict TimeGuard::check(Timestamp t) {
+TimeGuard::Verdict TimeGuard::check(Timestamp t, const std::string& source) {
   if (!now_) {
     now_ = t;
+    sources_.insert(source);
     return Verdict::Accept;
   }
   if (t >= *now_ ? within(t.us, now_->us, max_offset_us_) : within(t.us, now_->us, max_behind_us_)) {
     now_ = std::max(*now_, t);
     streak_ = 0;
+    sources_.insert(source);
     return Verdict::Accept;
   }
   // Refused, unless it completes a run of refused inputs that agree among themselves.
@@ -82,13 +93,20 @@ TimeGuard::Verdict TimeGuard::check(Timestamp t) {
   } else {
     streak_ = 1;
     streak_lo_ = streak_hi_ = t.us;
+    streak_sources_.clear();
+    alone_reported_ = false;
   }
+  streak_sources_.insert(source);
   const Verdict refused = t > *now_ ? Verdict::Ahead : Verdict::Behind;
   if (streak_ < options_.rebase_after) return refused;
+  // Agreement across sources once there are two (one source's burst is its own fault).
+  const size_t sources_needed = std::min<size_t>(2, sources_.size());
+  if (streak_sources_.size() < sources_needed) return refused;
   const __int128 jump = static_cast<__int128>(streak_hi_) - now_->us;
   last_jump_ = Duration{static_cast<int64_t>(std::clamp<__int128>(jump, INT64_MIN, INT64_MAX))};
   now_ = Timestamp{streak_hi_};
   streak_ = 0;
+  sources_.insert(source);
   return Verdict::Rebased;
 }
 

@@ -101,6 +101,31 @@ TEST(TimeGuard, AnAcceptedInputRestartsTheCount) {
   EXPECT_EQ(g.check(sec(100.4)), V::Rebased);
 }
 
+TEST(TimeGuard, OnceTwoSourcesAreKnownOneAloneNeverMovesTheClock) {
+  // Issue 36: a burst of one source that disagrees with the others is that source's fault.
+  TimeGuard g({10.0, 5});
+  Diagnostics d;
+  EXPECT_EQ(g.admit("IMU", sec(1.0), d), V::Accept);
+  EXPECT_EQ(g.admit("RANGE", sec(1.01), d), V::Accept);
+  for (int i = 0; i < 100; ++i) EXPECT_EQ(g.admit("IMU", sec(3601.0 + 0.005 * i), d), V::Ahead) << i;
+  EXPECT_EQ(*g.now(), sec(1.01));
+  EXPECT_EQ(d.get("IMU:time_ahead"), 100);
+  EXPECT_EQ(d.get("IMU:time_jump_alone"), 1);  // once per burst
+  EXPECT_EQ(d.get("time_rebased"), 0);
+  EXPECT_EQ(g.admit("IMU", sec(1.02), d), V::Accept);  // the good stream goes on
+  // The whole stream jumping: the clock follows when a second source agrees.
+  for (int i = 0; i < 20; ++i) EXPECT_EQ(g.admit("IMU", sec(61.0 + 0.005 * i), d), V::Ahead);
+  EXPECT_EQ(g.admit("RANGE", sec(61.1), d), V::Rebased);
+  EXPECT_EQ(*g.now(), sec(61.1));
+  EXPECT_EQ(d.get("time_rebased"), 1);
+  // A single anonymous source (check() without one) keeps the old rule.
+  TimeGuard h({10.0, 3});
+  h.check(sec(0.0));
+  h.check(sec(100.0));
+  h.check(sec(100.1));
+  EXPECT_EQ(h.check(sec(100.2)), V::Rebased);
+}
+
 TEST(TimeGuard, AdmitCountsPerKind) {
   TimeGuard g({10.0, 50});
   Diagnostics d;

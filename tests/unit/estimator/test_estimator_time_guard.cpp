@@ -60,6 +60,34 @@ TEST(EstimatorTimeGuard, FutureStampedInputsAreRefusedAndChangeNothing) {
   EXPECT_EQ(test::stateDifference(*clean->filter(), *node->filter()), 0.0);
 }
 
+TEST(EstimatorTimeGuard, ABurstFromOneSourceNeverMovesTheClock) {
+  // Issue 36: 100 IMU messages stamped +1 h in a row (more than time.rebase_after) were taken as the
+  // whole stream moving: the estimator propagated across the hour and published poses 500 km
+  // away. The other sources never agreed: the burst is refused as the IMU's fault, reported once,
+  // and the estimate is exactly the one without it.
+  const Dataset ds = synthetic::makeSyntheticDataset(scenario());
+  const auto inputs = mergeInTimeOrder(ds);
+  const auto clean = run(ds, inputs, [](EstimatorNode&, double) {});
+  const int burst = 2 * test::testOptions().time.rebase_after;
+  ASSERT_GE(burst, 100);
+  bool injected = false;
+  const auto node = run(ds, inputs, [&](EstimatorNode& n, double t) {
+    if (injected || t < 6.0) return;
+    injected = true;
+    for (int i = 0; i < burst; ++i) {
+      ImuSample s = ds.imu.front();
+      s.t = Timestamp::fromSec(t + 3600.0 + 0.005 * i);
+      n.onImu(s);
+    }
+  });
+  ASSERT_TRUE(injected);
+  EXPECT_EQ(counter(*node, "IMU:time_ahead"), burst);
+  EXPECT_EQ(counter(*node, "IMU:time_jump_alone"), 1);
+  EXPECT_EQ(counter(*node, "time_rebased"), 0);
+  EXPECT_EQ(node->status().t, clean->status().t);
+  EXPECT_EQ(test::stateDifference(*clean->filter(), *node->filter()), 0.0);
+}
+
 TEST(EstimatorTimeGuard, RandomImuBytesDoNotMoveTheEstimate) {
   // What random bytes behind a valid imu_t fingerprint decode to: any utime, readings that may
   // even look plausible. Sprinkled over the flight they must leave the estimate as it was.
