@@ -37,7 +37,8 @@ constexpr char kDescription[] =
     "as possible (deterministic). Exit status 0: done; 1: an input or output file failed; 2: bad command line; "
     "3: the estimate ended lost or never initialized (--allow-lost: 0); 4: the UWB clock's delay ended more than "
     "5 sigma from its prior (setup.yaml uwb_clock); 5: the estimate ends more than 1 s before the vehicle's inputs "
-    "(an IMU file that ends early, a refused tail); 130 / 143: stopped by SIGINT / SIGTERM, "
+    "(an IMU file that ends early, a refused tail); 6: the last re-initialization was never confirmed by the "
+    "ranges after it (health ok for health.window_s with health.min_ranges ranges fitting; --allow-lost: 0); 130 / 143: stopped by SIGINT / SIGTERM, "
     "the rows and end-of-run files written so far (status.txt complete: false).";
 
 /// The command line of meshnav_run.
@@ -181,10 +182,21 @@ int report(const EstimatorNode& node, const SystemSetup& setup, double data_s, d
   if (node.initialized() && node.health() == Health::Lost)
     spdlog::error("{}the estimate ends LOST ({}); {} lost events, {} recoveries", who, st.health_reason, lost_events,
                   st.counters.count("recovery") ? st.counters.at("recovery") : 0);
-  else if (lost_events > 0)
+  else if (lost_events > 0 && !node.unconfirmedRecovery())
     spdlog::warn("{}the estimate was lost {} times during the run and recovered", who, lost_events);
   const bool healthy = node.initialized() && node.health() != Health::Lost;
   if (!(healthy || allow_lost)) return 3;
+  // A re-initialization is a recovery only once the ranges after it back it (issue 36: one ended
+  // 1.18 km off after "lost 1 times during the run and recovered", exit 0).
+  if (const auto rec = node.unconfirmedRecovery(); healthy && rec) {
+    spdlog::error("{}the estimate was re-initialized at t={} s and the ranges since never confirmed it (health ok "
+                  "for {:.1f} s at the end; confirmed takes {:.1f} s of health ok with {} tag ranges accepted at a mean "
+                  "NIS within {:.1f}): the estimate since then is not to be trusted{}",
+                  who, formatSeconds(rec->first), rec->second, node.options().health.window_s,
+                  node.options().health.min_ranges, node.options().health.degraded_mean_nis,
+                  allow_lost ? " (--allow-lost: exit 0)" : "; exit 6");
+    if (!allow_lost) return 6;
+  }
   // The delay's departure from its prior (issue 36: IMU stamps 0.5 s off the ranges passed silently).
   const double prior_sigma_s = ClockOffsetKind::priorSigma(setup, node.options());
   if (node.initialized() && st.uwb_clock_offset_sigma_s > 0.0 && prior_sigma_s > 0.0 &&

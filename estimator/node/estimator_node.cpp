@@ -80,6 +80,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
                ZuptModel(Eigen::Vector3d(0.0, 0.0, -options.gravity_m_s2))},
       health_(options_.health),
       recovery_(options_.recovery, options_.init.motion_window_s),
+      recovery_confirmation_(options_.health),
       reentry_(options_.uwb, diag_),
       resume_(options_, setup_, diag_),
       timeline_(options_.window_s, options_.refine, AnchorRerun::enabledBy(options_), diag_),
@@ -101,6 +102,7 @@ void EstimatorNode::resetAll() {
   volume_.reset();
   gravity_.reset();
   recovery_.reset();
+  recovery_confirmation_.reset();
   sensors_.zupt = ZuptModel(gravityG());
   cur_ = FilterContext{};
   cur_.noise_adapter = ProcessNoiseAdapter(options_.process_noise);

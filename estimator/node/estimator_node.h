@@ -69,6 +69,7 @@
 #include "estimator/restart/resume.h"
 #include "estimator/node/estimator_input.h"
 #include "estimator/health/health_monitor.h"
+#include "estimator/health/recovery_confirmation.h"
 #include "estimator/health/recovery_policy.h"
 #include "estimator/imu/imu_propagation.h"
 #include "estimator/imu/imu_readings.h"
@@ -132,6 +133,9 @@ class EstimatorNode : private RerunReplayer {
   double processNoiseScale() const { return cur_.noise_adapter.scale(); }
   Health health() const { return initialized() ? health_.health() : Health::Initializing; }
   const HealthMonitor& healthMonitor() const { return health_; }
+  /// The time of the last re-initialization while it is not yet confirmed by the ranges after it
+  /// (RecoveryConfirmation), with how long health has been ok since [s]; nullopt when confirmed.
+  std::optional<std::pair<Timestamp, double>> unconfirmedRecovery() const;
   /// Why the node is not initialized yet (empty once it is).
   std::string waitingFor() const;
   /// The state to persist for a restart (initialized only): IMU state and covariance, baro
@@ -265,6 +269,7 @@ class EstimatorNode : private RerunReplayer {
 
   HealthMonitor health_;
   RecoveryPolicy recovery_;
+  RecoveryConfirmation recovery_confirmation_;
   ReentryGate reentry_;
   Resume resume_;  ///< resumeFrom's checkpoint, until the initialization
 

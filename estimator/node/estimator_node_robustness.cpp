@@ -80,6 +80,12 @@ void EstimatorNode::initialize(const InitialBelief& b) {
   applyHeldAnchors(b.t);
 }
 
+std::optional<std::pair<Timestamp, double>> EstimatorNode::unconfirmedRecovery() const {
+  const auto t = recovery_confirmation_.pending();
+  if (!t || !initialized()) return std::nullopt;
+  return std::make_pair(*t, recovery_confirmation_.okFor(cur_.filter->state().t));
+}
+
 std::string EstimatorNode::waitingFor() const {
   if (!imu_units_.fault().empty()) return "IMU: " + imu_units_.fault();
   if (initialized()) return "";
@@ -102,9 +108,14 @@ void EstimatorNode::updateHealth(Timestamp t) {
     else
       spdlog::warn("{}", msg);
   }
+  const Health h = health_.health();
+  if (recovery_confirmation_.noteHealth(t, h)) {
+    diag_.count("recovery_confirmed");
+    spdlog::info("estimator: the recovery is confirmed at t={}: {} ranges fitted since (mean NIS {:.2f})",
+                 formatSeconds(t), recovery_confirmation_.rangesFitted(), recovery_confirmation_.meanNis());
+  }
   // Degraded by gating alone, with the accepted ranges fitting, is what NLOS outliers look like:
   // a re-alignment from those ranges is then more likely wrong than the filter (RecoveryPolicy).
-  const Health h = health_.health();
   if (recovery_.alignmentDue(t, h, h == Health::Degraded && health_.acceptedRangesFit(t))) tryRecover(t);
 }
 
@@ -141,6 +152,7 @@ void EstimatorNode::tryRecover(Timestamp t) {
   }
   const ImuState before = cur_.filter->state().imu;
   replaceImu(r->imu, r->cov, r->t, r->last_imu);
+  recovery_confirmation_.noteRecovery(t);
   diag_.count("recovery");
   spdlog::warn("estimator: recovered at t={}: re-initialized from {} ranges and the IMU (moved {:.2f} m, "
                "σ_p {:.2f} m, σ_yaw {:.1f} deg); anchors and bias states kept",

@@ -102,10 +102,12 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
   if (!r.accepted) diag_.count("gated_range");
   if (tag_range && r.accepted) reentry_.noteAccepted(s.t);
   // Tag ranges tell whether the pose is right; ranges between anchors do not.
-  if (tag_range)
+  if (tag_range) {
     health_.onUpdate(s.t, "range", cur_.network->isTag(z.a) ? z.b : z.a, r.accepted, r.nis);
-  else
+    recovery_confirmation_.noteRange(r.accepted, r.nis);
+  } else {
     health_.onUpdate(s.t, "anchor_range", 0, r.accepted, r.nis);
+  }
   for (SensorId id : {z.a, z.b}) {
     InstanceStatus& is = instance_stats_[id];
     ++(r.accepted ? is.n_updates : is.n_rejected);

@@ -77,6 +77,9 @@ TEST(RobustNode, RecoversFromACorruptedPoseWithinFiveSeconds) {
   std::cout << "back within 0.3 m and ok " << back_at - 40.0 << " s after the corruption" << std::endl;
   EXPECT_LE(back_at - 40.0, 5.0);
   EXPECT_EQ(node.health(), Health::Ok);
+  // The ranges after the re-initialization backed it (issue 36: "recovered" is a claim to check).
+  EXPECT_GE(node.diagnostics().get("recovery_confirmed"), 1);
+  EXPECT_FALSE(node.unconfirmedRecovery());
 }
 
 TEST(RobustNode, ImuGapIsDetectedOnTheImuTimeLineAndRecovered) {
