@@ -233,6 +233,25 @@ processes:
         self.assertIn('supervisor: output lost', err)
         self.assertNotIn('Traceback', err)
 
+    def test_a_full_disk_on_stdout_does_not_stop_the_supervision(self):
+        # Issue 36: with stdout on a full disk the output threads died, exit events were lost and
+        # the run hung for good. /dev/full fails every write with ENOSPC, as a full disk does.
+        with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
+            f.write('''
+processes:
+  - {name: chatty, command: "sh -c 'i=0; while [ $i -lt 2000 ]; do echo line $i; i=$((i+1)); done; sleep 60'"}
+  - {name: core, command: "sh -c 'sleep 1; exit 3'", required: true}
+''')
+        try:
+            with open('/dev/full', 'w') as full:
+                p = subprocess.run([sys.executable, SUPERVISOR, f.name], stdout=full, stderr=subprocess.PIPE,
+                                   text=True, timeout=30)
+        finally:
+            os.unlink(f.name)
+        self.assertIn('supervisor: output lost ([Errno 28]', p.stderr)
+        self.assertNotIn('Traceback', p.stderr)
+        self.assertNotEqual(p.returncode, 0, p.stderr)  # the required process's failure still counts
+
     def test_sigkill_after_stop_timeout(self):
         rc, out, _ = run_launch('''
 stop_timeout: 0.5
