@@ -15,6 +15,7 @@
 #include <memory>
 #include <optional>
 
+#include "common/atomic_file.h"
 #include "common/cli_main.h"
 #include "common/dataset.h"
 #include "common/estimate_io.h"
@@ -88,30 +89,30 @@ volatile std::sig_atomic_t g_signal = 0;
 extern "C" void onStopSignal(int sig) { g_signal = sig; }
 
 void writeTimings(const StepTimings& timings, const std::string& path) {
-  std::ofstream out(path);
-  out << "step,count,mean_us,median_us,max_us\n";
-  for (const auto& [type, s] : timings.stats())
-    out << type << ',' << s.count << ',' << s.mean_us << ',' << s.median_us << ',' << s.max_us << '\n';
-  checkedFlush(out, path);
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out << "step,count,mean_us,median_us,max_us\n";
+    for (const auto& [type, s] : timings.stats())
+      out << type << ',' << s.count << ',' << s.mean_us << ',' << s.median_us << ',' << s.max_us << '\n';
+  });
 }
 
 void writeStatus(const EstimatorStatus& st, double wall_s, double data_s, const std::string& path) {
-  std::ofstream out(path);
-  out << "complete: " << (g_signal ? "false  # interrupted by a signal" : "true") << "\n";
-  out << "strategy: " << st.strategy << "\ninitialized: " << (st.initialized ? "true" : "false")
-      << "\nhealth: " << st.health << "\nhealth_reason: \"" << st.health_reason << "\""
-      << "\nsigma_p_max_m: " << st.sigma_p_max_m << "\nsigma_yaw_deg: " << st.sigma_yaw_deg
-      << "\nuwb_clock_offset_s: " << st.uwb_clock_offset_s << "\nuwb_clock_offset_sigma_s: " << st.uwb_clock_offset_sigma_s
-      << "\nfilter_time_s: " << formatSeconds(st.t) << "\nwall_time_s: " << wall_s << "\ndata_duration_s: " << data_s
-      << "\nrealtime_factor: " << (wall_s > 0 ? data_s / wall_s : 0.0) << "\ncounters:\n";
-  for (const auto& [k, v] : st.counters) out << "  " << k << ": " << v << '\n';
-  out << "mean_step_us:\n";
-  for (const auto& [k, v] : st.mean_step_us) out << "  " << k << ": " << v << '\n';
-  out << "instances:\n";
-  for (const auto& i : st.instances)
-    out << "  - {id: " << i.id << ", type: " << i.type << ", n_updates: " << i.n_updates
-        << ", n_rejected: " << i.n_rejected << "}\n";
-  checkedFlush(out, path);
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out << "complete: " << (g_signal ? "false  # interrupted by a signal" : "true") << "\n";
+    out << "strategy: " << st.strategy << "\ninitialized: " << (st.initialized ? "true" : "false")
+        << "\nhealth: " << st.health << "\nhealth_reason: \"" << st.health_reason << "\""
+        << "\nsigma_p_max_m: " << st.sigma_p_max_m << "\nsigma_yaw_deg: " << st.sigma_yaw_deg
+        << "\nuwb_clock_offset_s: " << st.uwb_clock_offset_s << "\nuwb_clock_offset_sigma_s: " << st.uwb_clock_offset_sigma_s
+        << "\nfilter_time_s: " << formatSeconds(st.t) << "\nwall_time_s: " << wall_s << "\ndata_duration_s: " << data_s
+        << "\nrealtime_factor: " << (wall_s > 0 ? data_s / wall_s : 0.0) << "\ncounters:\n";
+    for (const auto& [k, v] : st.counters) out << "  " << k << ": " << v << '\n';
+    out << "mean_step_us:\n";
+    for (const auto& [k, v] : st.mean_step_us) out << "  " << k << ": " << v << '\n';
+    out << "instances:\n";
+    for (const auto& i : st.instances)
+      out << "  - {id: " << i.id << ", type: " << i.type << ", n_updates: " << i.n_updates
+          << ", n_rejected: " << i.n_rejected << "}\n";
+  });
 }
 
 /// Feeds every input of `inputs` (time order, each to its vehicle) to the pipeline, with a progress line every 25 %,

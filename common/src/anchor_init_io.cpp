@@ -1,5 +1,7 @@
 #include "common/anchor_init_io.h"
 
+#include "common/atomic_file.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Cholesky>
@@ -131,12 +133,7 @@ void writeAnchorInitsYaml(const std::vector<AnchorInit>& inits, const std::strin
       << YAML::Value << r.status << YAML::Key << "reason" << YAML::Value << r.reason << YAML::EndMap;
   }
   e << YAML::EndSeq << YAML::EndMap;
-  const std::filesystem::path p(path);
-  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot open for writing");
-  out << e.c_str() << "\n";
-  if (!out) throw std::runtime_error(path + ": write failed");
+  writeFileAtomically(path, [&](std::ostream& out) { out << e.c_str() << "\n"; });
 }
 
 std::vector<AnchorInit> readAnchorInitsYaml(const std::string& path) {

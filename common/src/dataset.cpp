@@ -1,4 +1,6 @@
 #include "common/dataset.h"
+
+#include "common/atomic_file.h"
 #include "common/plausibility.h"
 
 #include <spdlog/spdlog.h>
@@ -43,26 +45,19 @@ std::optional<int64_t> parseId(const std::string& s) {
   return static_cast<int64_t>(v);
 }
 
-std::ofstream openOut(const std::string& path) {
-  fs::path p(path);
-  if (p.has_parent_path()) fs::create_directories(p.parent_path());
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot write file");
-  return out;
-}
-
 constexpr size_t kCsvLineMax = 256;  ///< longest line a writer formats (an IMU row is about 110)
 
 /// Writes `header`, then for every sample the line `row(sample, buf)` formats into `buf`.
 template <typename T, typename Row>
 void writeCsv(const std::vector<T>& v, const std::string& path, const char* header, Row&& row) {
-  auto out = openOut(path);
-  out << header;
-  char buf[kCsvLineMax];
-  for (const auto& s : v) {
-    row(s, buf);
-    out << buf;
-  }
+  writeFileAtomically(path, [&](std::ostream& out) {
+    out << header;
+    char buf[kCsvLineMax];
+    for (const auto& s : v) {
+      row(s, buf);
+      out << buf;
+    }
+  });
 }
 
 /// Files `t,<column>` of one number per row; values outside [lo, hi] (or not finite) are reported

@@ -1,5 +1,7 @@
 #include "common/setup.h"
 
+#include "common/atomic_file.h"
+
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
@@ -163,11 +165,7 @@ void emitPairBiases(YAML::Emitter& e, const std::vector<PairBias>& biases) {
 }
 
 void writeText(const std::string& path, const std::string& header, const char* body) {
-  std::filesystem::path p(path);
-  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot write file");
-  out << header << body << "\n";
+  writeFileAtomically(path, [&](std::ostream& out) { out << header << body << "\n"; });
 }
 
 /// Every id names one device: a collision is an error naming both roles. imu_id, baro_id,

@@ -1,5 +1,7 @@
 #include "estimator/restart/checkpoint.h"
 
+#include "common/atomic_file.h"
+
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Cholesky>
@@ -90,14 +92,7 @@ InstanceRecord readRecord(const YAML::Node& node, const std::string& path, size_
 }
 
 void writeAtomically(const fs::path& target, const std::string& text) {
-  const fs::path tmp = target.string() + ".tmp";
-  {
-    std::ofstream f(tmp);
-    if (!f) throw std::runtime_error(tmp.string() + ": cannot write");
-    f << text;
-    if (!f) throw std::runtime_error(tmp.string() + ": write failed");
-  }
-  fs::rename(tmp, target);
+  writeFileAtomically(target.string(), [&](std::ostream& out) { out << text; });
 }
 }  // namespace
 

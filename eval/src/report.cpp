@@ -16,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/atomic_file.h"
 #include "eval/baseline_report.h"
 #include "eval/chi_square.h"
 
@@ -263,57 +264,55 @@ YAML::Node metricsNode(const RunEvaluation& ev) {
 void writeMetricsYaml(const RunEvaluation& ev, const std::string& path) {
   YAML::Emitter out;
   out << metricsNode(ev);
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot write");
-  f << out.c_str() << "\n";
+  writeFileAtomically(path, [&](std::ostream& f) { f << out.c_str() << "\n"; });
 }
 
 void writeMetricsJson(const RunEvaluation& ev, const std::string& path) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot write");
-  toJson(metricsNode(ev), f, 0);
-  f << "\n";
+  writeFileAtomically(path, [&](std::ostream& f) {
+      toJson(metricsNode(ev), f, 0);
+      f << "\n";
+  });
 }
 
 void writeErrorsCsv(const RunEvaluation& ev, const std::string& path) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot write");
-  f << "t,ep_x_m,ep_y_m,ep_z_m,sigma3_p_x_m,sigma3_p_y_m,sigma3_p_z_m,"
-       "eth_x_deg,eth_y_deg,eth_z_deg,sigma3_th_x_deg,sigma3_th_y_deg,sigma3_th_z_deg,"
-       "ep_norm_m,eth_angle_deg,nees_p,nees_theta,flying,selected\n";
-  f.setf(std::ios::fixed);
-  const double r2d = 180.0 / M_PI;
-  const Timestamp t0 = ev.errors.empty() ? Timestamp{} : ev.errors.front().t;
-  for (const auto& e : ev.errors) {
-    f.precision(6);
-    f << e.t.sec();
-    f.precision(5);
-    for (int i = 0; i < 3; ++i) f << "," << e.p_err_m[i];
-    for (int i = 0; i < 3; ++i) f << "," << 3.0 * e.sigma_p_m[i];
-    for (int i = 0; i < 3; ++i) f << "," << e.theta_err_rad[i] * r2d;
-    for (int i = 0; i < 3; ++i) f << "," << 3.0 * e.sigma_theta_rad[i] * r2d;
-    f << "," << e.positionErrorNorm() << "," << e.orientationErrorDeg();
-    f << "," << (e.nees_p ? formatNumber(*e.nees_p, 4) : "nan") << "," << (e.nees_theta ? formatNumber(*e.nees_theta, 4) : "nan");
-    f << "," << (e.flying ? 1 : 0) << "," << (isSelected(e, t0, ev.options) ? 1 : 0) << "\n";
-  }
+  writeFileAtomically(path, [&](std::ostream& f) {
+    f << "t,ep_x_m,ep_y_m,ep_z_m,sigma3_p_x_m,sigma3_p_y_m,sigma3_p_z_m,"
+         "eth_x_deg,eth_y_deg,eth_z_deg,sigma3_th_x_deg,sigma3_th_y_deg,sigma3_th_z_deg,"
+         "ep_norm_m,eth_angle_deg,nees_p,nees_theta,flying,selected\n";
+    f.setf(std::ios::fixed);
+    const double r2d = 180.0 / M_PI;
+    const Timestamp t0 = ev.errors.empty() ? Timestamp{} : ev.errors.front().t;
+    for (const auto& e : ev.errors) {
+      f.precision(6);
+      f << e.t.sec();
+      f.precision(5);
+      for (int i = 0; i < 3; ++i) f << "," << e.p_err_m[i];
+      for (int i = 0; i < 3; ++i) f << "," << 3.0 * e.sigma_p_m[i];
+      for (int i = 0; i < 3; ++i) f << "," << e.theta_err_rad[i] * r2d;
+      for (int i = 0; i < 3; ++i) f << "," << 3.0 * e.sigma_theta_rad[i] * r2d;
+      f << "," << e.positionErrorNorm() << "," << e.orientationErrorDeg();
+      f << "," << (e.nees_p ? formatNumber(*e.nees_p, 4) : "nan") << "," << (e.nees_theta ? formatNumber(*e.nees_theta, 4) : "nan");
+      f << "," << (e.flying ? 1 : 0) << "," << (isSelected(e, t0, ev.options) ? 1 : 0) << "\n";
+    }
+  });
 }
 
 void writeAnchorsEvalCsv(const RunEvaluation& ev, const std::string& path) {
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot write");
-  f << "id,known,has_truth,true_x,true_y,true_z,init_x,init_y,init_z,final_x,final_y,final_z,"
-       "init_err_m,final_err_m,init_nees,final_nees\n";
-  if (!ev.anchors) return;
-  f.setf(std::ios::fixed);
-  f.precision(5);
-  for (const auto& a : ev.anchors->anchors) {
-    f << a.id << "," << (a.known ? 1 : 0) << "," << (a.has_truth ? 1 : 0);
-    for (int i = 0; i < 3; ++i) f << "," << (a.has_truth ? a.p_true[i] : NAN);
-    for (int i = 0; i < 3; ++i) f << "," << a.initial.p_AinG[i];
-    for (int i = 0; i < 3; ++i) f << "," << a.final_est.p_AinG[i];
-    f << "," << (a.has_truth ? a.initial_error_m : NAN) << "," << (a.has_truth ? a.final_error_m : NAN) << ","
-      << (a.initial_nees ? *a.initial_nees : NAN) << "," << (a.final_nees ? *a.final_nees : NAN) << "\n";
-  }
+  writeFileAtomically(path, [&](std::ostream& f) {
+    f << "id,known,has_truth,true_x,true_y,true_z,init_x,init_y,init_z,final_x,final_y,final_z,"
+         "init_err_m,final_err_m,init_nees,final_nees\n";
+    if (!ev.anchors) return;
+    f.setf(std::ios::fixed);
+    f.precision(5);
+    for (const auto& a : ev.anchors->anchors) {
+      f << a.id << "," << (a.known ? 1 : 0) << "," << (a.has_truth ? 1 : 0);
+      for (int i = 0; i < 3; ++i) f << "," << (a.has_truth ? a.p_true[i] : NAN);
+      for (int i = 0; i < 3; ++i) f << "," << a.initial.p_AinG[i];
+      for (int i = 0; i < 3; ++i) f << "," << a.final_est.p_AinG[i];
+      f << "," << (a.has_truth ? a.initial_error_m : NAN) << "," << (a.has_truth ? a.final_error_m : NAN) << ","
+        << (a.initial_nees ? *a.initial_nees : NAN) << "," << (a.final_nees ? *a.final_nees : NAN) << "\n";
+    }
+  });
 }
 
 }  // namespace meshnav::eval

@@ -1,5 +1,7 @@
 #include "logging/run_recorder.h"
 
+#include "common/atomic_file.h"
+
 #include "common/anchor_init_io.h"
 
 #include <spdlog/fmt/fmt.h>
@@ -20,17 +22,13 @@ namespace fs = std::filesystem;
 namespace {
 
 void writeYaml(const YAML::Emitter& e, const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot write file");
-  out << e.c_str() << "\n";
+  writeFileAtomically(path, [&](std::ostream& out) { out << e.c_str() << "\n"; });
 }
 
 /// anchor_init.yaml through a temporary file renamed over it: whenever the logger is killed, the
 /// file holds every ANCHOR_INIT of the previous rewrite or of this one, never half of it.
 void writeAnchorInitsAtomically(const std::vector<AnchorInit>& inits, const fs::path& path) {
-  const fs::path tmp = path.string() + ".tmp";
-  writeAnchorInitsYaml(inits, tmp.string());
-  fs::rename(tmp, path);
+  writeAnchorInitsYaml(inits, path.string());  // through a temporary renamed over it (common/atomic_file.h)
 }
 
 }  // namespace
