@@ -188,11 +188,12 @@ int calibrate(const Cli& cli, CalibrateCli& c) {
     if (truth) f = truthFigures(*truth, id, obs, priors, opt, r);
     printRow(id, r, f);
     const TruthFigures shown = f.value_or(TruthFigures{});
-    if (summary)
+    if (!c.summary_csv.empty())  // a failed write is found by the checked flush below
       summary << c.label << "," << dir << "," << id << "," << toString(r.status) << "," << shown.err << ","
               << shown.nees << "," << shown.crb << "," << r.n_inliers << "," << r.n_outliers << "," << ms << "\n";
     results.push_back(std::move(r));
   }
+  if (!c.summary_csv.empty()) checkedFlush(summary, c.summary_csv);
   writeCalibrationYaml(results, c.out);
   if (diag.total() > 0) spdlog::info("input diagnostics: {}", diag.summary());
   spdlog::info("wrote {}", c.out);

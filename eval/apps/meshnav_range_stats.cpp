@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "common/atomic_file.h"
 #include "common/cli_main.h"
 #include "common/dataset.h"
 #include "common/setup.h"
@@ -86,9 +87,7 @@ void writeStatsYaml(const std::map<std::pair<SensorId, SensorId>, PairRangeStats
     out << YAML::EndMap;
   }
   out << YAML::EndSeq << YAML::EndMap;
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error(path + ": cannot write");
-  f << out.c_str() << "\n";
+  writeFileAtomically(path, [&](std::ostream& f) { f << out.c_str() << "\n"; });
 }
 
 int run(const RangeStatsCli& cli) {
@@ -148,15 +147,15 @@ int run(const RangeStatsCli& cli) {
     const fs::path out = cli.plots;
     fs::create_directories(out);
     const fs::path csv = out / "range_errors.csv";
-    std::ofstream f(csv);
-    f << "id1,id2,t,error_m,bias_m,std_m,lower_m,upper_m\n";
-    f.setf(std::ios::fixed);
-    f.precision(6);
-    for (const auto& [key, s] : stats)
-      for (size_t i = 0; i < s.errors_m.size(); ++i)
-        f << s.id1 << "," << s.id2 << "," << s.t_s[i] << "," << s.errors_m[i] << "," << s.estimate.bias_m << ","
-          << s.estimate.std_m << "," << s.estimate.lower_m << "," << s.estimate.upper_m << "\n";
-    f.close();
+    writeFileAtomically(csv.string(), [&](std::ostream& f) {
+      f << "id1,id2,t,error_m,bias_m,std_m,lower_m,upper_m\n";
+      f.setf(std::ios::fixed);
+      f.precision(6);
+      for (const auto& [key, s] : stats)
+        for (size_t i = 0; i < s.errors_m.size(); ++i)
+          f << s.id1 << "," << s.id2 << "," << s.t_s[i] << "," << s.errors_m[i] << "," << s.estimate.bias_m << ","
+            << s.estimate.std_m << "," << s.estimate.lower_m << "," << s.estimate.upper_m << "\n";
+    });
     if (runPlotScript("plot_range_hist.py",
                       {"--errors", csv.string(), "--out", out.string(), "--max-error", formatNumber(opt.max_error_m, 3)}))
       spdlog::info("histograms written to {}", out.string());

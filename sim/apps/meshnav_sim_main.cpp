@@ -13,6 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/atomic_file.h"
 #include "common/cli_main.h"
 #include "common/dataset.h"
 #include "sim/fleet_simulation.h"
@@ -194,19 +195,20 @@ void applyScenarioOptions(const meshnav::Cli& cli, SimCli& c) {
 int simulateFleet(const meshnav::sim::SimulationOptions& options, int n, const std::string& out) {
   const auto fleet = meshnav::sim::simulateFleet(options, n);
   std::filesystem::create_directories(out);
-  std::ofstream file(std::filesystem::path(out) / "fleet.yaml");
-  file << "# a simulated fleet (meshnav_sim --fleet " << n << " --seed " << options.seed
-       << "): one hall, one anchor map; docs/fleet.md\nvehicles:\n";
+  std::string list;
   for (size_t k = 0; k < fleet.size(); ++k) {
     const std::string name = "v" + std::to_string(k);
     const std::string dir = (std::filesystem::path(out) / name).string();
     spdlog::info("vehicle {}: {}", name, fleet[k].trajectory_description);
     meshnav::writeDataset(fleet[k].dataset, dir);
     std::cout << name << ": " << fleet[k].summary() << "\n";
-    file << "  - {name: " << name << ", dataset: " << name << "}\n";
+    list += "  - {name: " + name + ", dataset: " + name + "}\n";
   }
-  file.close();
-  if (!file) throw std::runtime_error(out + "/fleet.yaml: cannot write");
+  meshnav::writeFileAtomically((std::filesystem::path(out) / "fleet.yaml").string(), [&](std::ostream& file) {
+    file << "# a simulated fleet (meshnav_sim --fleet " << n << " --seed " << options.seed
+         << "): one hall, one anchor map; docs/fleet.md\nvehicles:\n"
+         << list;
+  });
   std::cout << "Fleet of " << n << " written to " << out << " (fleet.yaml)" << std::endl;
   return 0;
 }
