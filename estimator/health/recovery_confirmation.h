@@ -56,7 +56,6 @@ class RecoveryConfirmation {
   std::optional<Timestamp> pending() const { return pending_; }
   /// How long health has been `ok` since the pending recovery's latest interruption, at `t` [s].
   double okFor(Timestamp t) const { return ok_since_ ? (t - *ok_since_).sec() : 0.0; }
-  double window_s() const { return window_s_; }
   void reset() {
     pending_.reset();
     ok_since_.reset();

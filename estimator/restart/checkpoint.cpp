@@ -91,9 +91,6 @@ InstanceRecord readRecord(const YAML::Node& node, const std::string& path, size_
   return r;
 }
 
-void writeAtomically(const fs::path& target, const std::string& text) {
-  writeFileAtomically(target.string(), [&](std::ostream& out) { out << text; });
-}
 }  // namespace
 
 void checkInstanceRecord(const InstanceRecord& r) {
@@ -135,7 +132,7 @@ void writeCheckpoint(const EstimatorCheckpoint& c, const std::string& dir) {
   // Anchors first: a state file is only read together with the anchors written before it.
   writeAnchorInitsYaml(c.anchors, (fs::path(dir) / (std::string(kAnchorsFile) + ".tmp")).string());
   fs::rename(fs::path(dir) / (std::string(kAnchorsFile) + ".tmp"), fs::path(dir) / kAnchorsFile);
-  writeAtomically(fs::path(dir) / kStateFile, std::string(e.c_str()) + "\n");
+  writeFileAtomically((fs::path(dir) / kStateFile).string(), [&](std::ostream& out) { out << e.c_str() << "\n"; });
 }
 
 namespace {

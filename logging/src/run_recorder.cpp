@@ -25,12 +25,6 @@ void writeYaml(const YAML::Emitter& e, const std::string& path) {
   writeFileAtomically(path, [&](std::ostream& out) { out << e.c_str() << "\n"; });
 }
 
-/// anchor_init.yaml through a temporary file renamed over it: whenever the logger is killed, the
-/// file holds every ANCHOR_INIT of the previous rewrite or of this one, never half of it.
-void writeAnchorInitsAtomically(const std::vector<AnchorInit>& inits, const fs::path& path) {
-  writeAnchorInitsYaml(inits, path.string());  // through a temporary renamed over it (common/atomic_file.h)
-}
-
 }  // namespace
 
 RunRecorder::RunRecorder(const std::string& out_dir, bool append) : out_dir_(out_dir) {
@@ -77,7 +71,9 @@ void RunRecorder::onAnchors(const std::vector<AnchorEstimate>& anchors) {
 
 void RunRecorder::onAnchorInit(const AnchorInit& a) {
   anchor_inits_.push_back(a);
-  writeAnchorInitsAtomically(anchor_inits_, fs::path(out_dir_) / "anchor_init.yaml");
+  // Through a temporary renamed over it (common/atomic_file.h): whenever the logger is killed, the
+  // file holds every ANCHOR_INIT of the previous rewrite or of this one, never half of it.
+  writeAnchorInitsYaml(anchor_inits_, (fs::path(out_dir_) / "anchor_init.yaml").string());
 }
 
 void RunRecorder::onGroundTruth(const PoseSample& p) { ground_truth_.push_back(p); }
@@ -93,7 +89,7 @@ void RunRecorder::finish(const Diagnostics& process_diag) {
   flush();
   const fs::path dir(out_dir_);
 
-  if (!anchor_inits_.empty()) writeAnchorInitsAtomically(anchor_inits_, dir / "anchor_init.yaml");
+  if (!anchor_inits_.empty()) writeAnchorInitsYaml(anchor_inits_, (dir / "anchor_init.yaml").string());
   if (!ground_truth_.empty()) writeTumCsv(ground_truth_, (dir / "groundtruth.csv").string());
 
   YAML::Emitter e;

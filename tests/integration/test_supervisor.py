@@ -208,18 +208,25 @@ processes:
         self.assertEqual(rc, 0, out)
         self.assertIn('required process core exited', out)
 
-    def test_a_closed_stdout_does_not_stop_the_supervision(self):
-        # Issue 36: `./meshnav up ... | head -1` used to raise BrokenPipeError in say(): the run
-        # aborted, or an output thread died and its process's exit was never seen. Now the lines are
-        # dropped, stderr says so once, and the required process's exit still ends the run with 0.
+    @staticmethod
+    def _chatty_launch(core_exit):
+        """A launch file whose 'chatty' process writes 2000 lines, and whose required 'core' exits
+        with `core_exit` after 1 s; returns its path (the caller removes it)."""
         with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
             f.write('''
 processes:
   - {name: chatty, command: "sh -c 'i=0; while [ $i -lt 2000 ]; do echo line $i; i=$((i+1)); done; sleep 60'"}
-  - {name: core, command: "sh -c 'sleep 1; exit 0'", required: true}
-''')
+  - {name: core, command: "sh -c 'sleep 1; exit %d'", required: true}
+''' % core_exit)
+        return f.name
+
+    def test_a_closed_stdout_does_not_stop_the_supervision(self):
+        # Issue 36: `./meshnav up ... | head -1` used to raise BrokenPipeError in say(): the run
+        # aborted, or an output thread died and its process's exit was never seen. Now the lines are
+        # dropped, stderr says so once, and the required process's exit still ends the run with 0.
+        launch = self._chatty_launch(0)
         try:
-            p = subprocess.Popen([sys.executable, SUPERVISOR, f.name], stdout=subprocess.PIPE,
+            p = subprocess.Popen([sys.executable, SUPERVISOR, launch], stdout=subprocess.PIPE,
                                  stderr=subprocess.PIPE, text=True)
             first = p.stdout.readline()  # the reader takes one line and goes away, as `head -1`
             p.stdout.close()
@@ -227,7 +234,7 @@ processes:
             err = p.stderr.read()
             p.stderr.close()
         finally:
-            os.unlink(f.name)
+            os.unlink(launch)
         self.assertIn('[supervisor]', first)
         self.assertEqual(rc, 0, err)
         self.assertIn('supervisor: output lost', err)
@@ -236,18 +243,13 @@ processes:
     def test_a_full_disk_on_stdout_does_not_stop_the_supervision(self):
         # Issue 36: with stdout on a full disk the output threads died, exit events were lost and
         # the run hung for good. /dev/full fails every write with ENOSPC, as a full disk does.
-        with tempfile.NamedTemporaryFile('w', suffix='.yaml', delete=False) as f:
-            f.write('''
-processes:
-  - {name: chatty, command: "sh -c 'i=0; while [ $i -lt 2000 ]; do echo line $i; i=$((i+1)); done; sleep 60'"}
-  - {name: core, command: "sh -c 'sleep 1; exit 3'", required: true}
-''')
+        launch = self._chatty_launch(3)
         try:
             with open('/dev/full', 'w') as full:
-                p = subprocess.run([sys.executable, SUPERVISOR, f.name], stdout=full, stderr=subprocess.PIPE,
+                p = subprocess.run([sys.executable, SUPERVISOR, launch], stdout=full, stderr=subprocess.PIPE,
                                    text=True, timeout=30)
         finally:
-            os.unlink(f.name)
+            os.unlink(launch)
         self.assertIn('supervisor: output lost ([Errno 28]', p.stderr)
         self.assertNotIn('Traceback', p.stderr)
         self.assertNotEqual(p.returncode, 0, p.stderr)  # the required process's failure still counts
