@@ -38,9 +38,11 @@ the wall time [us since the Unix epoch] t0_margin seconds after the launch, so t
 started together replay in step (--t0-utime ${T0_UTIME}). Every output line of a
 process is printed as "[name] line". SIGINT/SIGTERM stop all processes (SIGTERM to each process
 group, SIGKILL after stop_timeout). A process that is not required may exit (and exhaust its
-respawns) without stopping the others. Exit code: 0 when every required process and every
-shutdown_after process exited with 0 (or was stopped cleanly by the supervisor), else 1; 2 for a
-bad launch file or arguments.
+respawns) without stopping the others. A process that exits with 7 heard another instance of
+itself on the LCM network or found its output folder in use (a second launch): it is never
+restarted, and when it is required the launch stops with exit 1. Exit code: 0 when every
+required process and every shutdown_after process exited with 0 (or was stopped cleanly by the
+supervisor), else 1; 2 for a bad launch file or arguments.
 """
 import math
 import os
@@ -57,6 +59,13 @@ import yaml
 
 class LaunchError(Exception):
     pass
+
+
+# Exit status of a meshnav process that heard another instance of itself publishing its channels
+# on the same LCM network right after its start, or found its output folder held by another
+# process (transport/process_main.h, kExitSecondInstance): a second launch of the same processes.
+# It is never restarted, and a required one stops the launch.
+EXIT_SECOND_INSTANCE = 7
 
 
 # ------------------------------------------------------------------------------------------- YAML
@@ -167,7 +176,10 @@ class ProcSpec:
         self.host = host
 
     def restarts_after(self, code):
-        """Whether an exit with `code` (negative: killed by that signal) calls for a restart."""
+        """Whether an exit with `code` (negative: killed by that signal) calls for a restart. Never
+        after EXIT_SECOND_INSTANCE: another instance runs, a restart would be refused again."""
+        if code == EXIT_SECOND_INSTANCE:
+            return False
         return self.respawn == 'always' or (self.respawn == 'on-failure' and code != 0)
 
     def respawn_wait(self, n):
@@ -349,6 +361,10 @@ class Supervisor:
         has exited for good (then it counts for required / shutdown_after)."""
         desc = ('exit code %d' % code) if code >= 0 else ('signal %d' % -code)
         self.say('supervisor', '%s exited (%s)' % (name, desc))
+        if code == EXIT_SECOND_INSTANCE and not self.stopping:
+            desc = 'another instance already runs on this LCM network or writes its folder: a second launch?'
+            self.say('supervisor', '%s refused to run: %s Stop the other launch, or give this one another LCM URL '
+                     '(LCM_DEFAULT_URL) and output folder; not restarted' % (name, desc))
         if self.stopping:
             # Stopped by us: a clean exit or death by our SIGTERM is fine; SIGKILL is counted below.
             if (spec.required or name in self.launch.shutdown_after) and code not in (0, -signal.SIGTERM, -signal.SIGKILL):

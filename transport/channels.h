@@ -58,6 +58,22 @@ inline constexpr auto kTyped =
 inline constexpr auto kAll =
     std::apply([](const auto&... c) { return std::array<const char*, sizeof...(c)>{c.name...}; }, kTyped);
 
+/// Channels that several processes publish by design: RANGE (one uwb_bridge per anchor on a
+/// multi-host launch), the commands (mission, an operator's tool) and the time-sync requests
+/// (every bridge on another host). Every other channel has one publisher, whose instance id
+/// (`sender_id`) transport/publisher_watch.h holds each receiver to.
+inline constexpr std::array<const char*, 4> kSeveralPublishers{"RANGE", "ESTIMATOR_CMD", "CALIB_CMD",
+                                                              "TIME_SYNC_REQUEST"};
+
+/// True for a channel of the list above that has one publisher (false for a name not there).
+constexpr bool hasOnePublisher(std::string_view name) {
+  for (const char* s : kSeveralPublishers)
+    if (name == s) return false;
+  for (const char* c : kAll)
+    if (name == c) return true;
+  return false;
+}
+
 /// The channel constant of message type `Msg` named `name`, found at compile time (a Channel with
 /// a null name when there is none): the estimator process subscribes every input kind of
 /// estimator/node/estimator_input.h through it, from the kind's type and channel name.

@@ -21,6 +21,7 @@
 #include "common/diagnostics.h"
 #include "transport/channels.h"
 #include "transport/convert.h"
+#include "transport/wire_versions.h"
 
 namespace meshnav::transport {
 
@@ -49,14 +50,15 @@ class InputJournal {
   static int64_t read(const std::string& path,
                       const std::function<void(const std::string& channel, const lcm::ReceiveBuffer& rbuf)>& fn);
 
-  /// Decodes `rbuf`, an event of `channel`, as the channel's LCM type and converts it; false
+  /// Decodes `rbuf`, an event of `channel`, as the channel's LCM type (or its previous version:
+  /// transport/wire_versions.h) and converts it; false
   /// (counted "<CHANNEL>:journal_bad_event" in `diag`) when it does not decode or convert.
   template <class T>
   static bool decode(const lcm::ReceiveBuffer& rbuf, channels::Channel<T> channel, std::type_identity_t<T>& out,
                      Diagnostics& diag) {
     WireType<T> msg;
     try {
-      if (msg.decode(rbuf.data, 0, static_cast<int>(rbuf.data_size)) >= 0) {
+      if (decodeAnyVersion(rbuf.data, rbuf.data_size, msg) >= 0) {  // a journal of an older build too
         out = fromWire<T>(msg);
         return true;
       }

@@ -11,7 +11,21 @@
 /// an older log — by name), "<CHANNEL>:invalid_message" (decoded, but NaN / unknown code),
 /// "<CHANNEL>:handler_error" (the callback threw), "lcm:publish_error", "<CHANNEL>:oversized"
 /// (a received message above kMaxMessageBytes, dropped before decoding) and
-/// "<CHANNEL>:oversized_publish" (a message of ours above it, not sent).
+/// "<CHANNEL>:oversized_publish" (a message of ours above it, not sent), "<CHANNEL>:older_version"
+/// (a message of the type's previous version, read with an unknown sender: transport/wire_versions.h),
+/// "<CHANNEL>:second_publisher" and "<CHANNEL>:publisher_changed" (below).
+///
+/// Publishers: every LcmNode draws a random instance id at construction and stamps it into the
+/// `sender_id` of every message it publishes. Each channel of one publisher
+/// (channels::hasOnePublisher) that the node subscribes, or publishes from inside spin(), is watched by a
+/// PublisherWatch (transport/publisher_watch.h): the messages of a second publisher are dropped
+/// before a typed handler sees them, logged and counted. On a channel the node publishes itself,
+/// another sender within kSecondInstanceWindow_s (5 s) of its first publication there means that this process is
+/// the second instance (a second launch of the same processes, or a log played back with its
+/// outputs) when the other started first (instance ids hold the start time): the node stops,
+/// and ProcessMain ends the process with kExitSecondInstance (7), leaving the channel to the
+/// other; the older one only counts it, and after the window neither is stopped (a process that
+/// has run for a while is never stopped by another one appearing).
 ///
 /// Size: meshnav's messages are small (the largest, ANCHORS or a status with many counters, is a
 /// few KiB). Over udpm, LCM itself drops a message larger than its receive ring buffer (about
@@ -25,6 +39,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -33,6 +48,9 @@
 #include "common/time.h"
 #include "transport/channels.h"
 #include "transport/convert.h"
+#include "transport/replay/clock.h"
+#include "transport/publisher_watch.h"
+#include "transport/wire_versions.h"
 
 namespace meshnav::transport {
 
@@ -59,6 +77,17 @@ class LcmNode {
 
   const std::string& name() const { return name_; }
   const std::string& url() const { return url_; }
+  /// The random instance id stamped into the `sender_id` of every message this node publishes.
+  int64_t instanceId() const { return instance_id_; }
+  /// How long after its first publication on a channel of its own (from spin()) a node that hears
+  /// an older publisher there takes itself for the second instance and stops: longer than
+  /// PublisherWatch::kConfirmMessages of the processes' wall-clock heartbeats (1 s by default), so
+  /// an idle first instance is heard.
+  static constexpr double kSecondInstanceWindow_s = 5.0;
+  /// Non-empty when the node stopped because another process already publishes one of its
+  /// channels (what it heard): ProcessMain exits with kExitSecondInstance.
+  const std::string& secondInstance() const { return second_instance_; }
+  const PublisherWatch& publishers() const { return watch_; }
   lcm::LCM& lcm() { return *lcm_; }
 
   /// Messages LCM queues per subscription before it drops (LCM's default is 30).
@@ -77,6 +106,7 @@ class LcmNode {
   /// subscription with another type does not compile.
   template <class T>
   void subscribe(channels::Channel<T> channel, std::type_identity_t<std::function<void(const T&)>> fn) {
+    watch<T>(channel.name);
     subscribeRaw(channel.name, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
       WireType<T> msg;
       if (!decode(rbuf, ch, msg)) return;
@@ -89,6 +119,7 @@ class LcmNode {
   template <class T>
   void subscribeStamped(channels::Channel<T> channel,
                         std::type_identity_t<std::function<void(const T&, int64_t recv_utime)>> fn) {
+    watch<T>(channel.name);
     subscribeRaw(channel.name, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
       WireType<T> msg;
       if (!decode(rbuf, ch, msg)) return;
@@ -100,7 +131,11 @@ class LcmNode {
   /// struct. False when it is not sent (too large: "<CHANNEL>:oversized_publish"; LCM error).
   template <class T>
   bool publish(channels::Channel<T> channel, const std::type_identity_t<T>& value) {
-    return publishWire(channel.name, toWire(value));
+    if (!second_instance_.empty()) return false;  // it yields the channel: nothing more from it
+    if (serving_ && !watch_.published(channel.name)) watchOwn<T>(channel.name);
+    auto msg = toWire(value);
+    msg.sender_id = instance_id_;
+    return publishWire(channel.name, msg);
   }
 
   /// Calls `fn` every `period` of wall time from spin() (the process heartbeat / status).
@@ -142,9 +177,10 @@ class LcmNode {
   bool decode(const lcm::ReceiveBuffer& rbuf, const std::string& ch, Msg& msg) {
     if (!sizeOk(rbuf, ch)) return false;
     int rc = -1;
+    bool older = false;
     std::string what = "not a valid " + std::string(Msg::getTypeName());
     try {
-      rc = msg.decode(rbuf.data, 0, static_cast<int>(rbuf.data_size));
+      rc = decodeAnyVersion(rbuf.data, rbuf.data_size, msg, &older);
     } catch (const std::exception& e) {  // e.g. a corrupted length field
       what += std::string(": ") + e.what();
       rc = -1;
@@ -159,9 +195,43 @@ class LcmNode {
                                              std::to_string(rbuf.data_size) + " bytes, " + what + ")");
       return false;
     }
+    if (older) diag_.count(ch + ":older_version");
+    if (!watch_.accepts(ch, msg.sender_id)) return false;  // a second publisher's: counted by the watch
     ++received_[ch];
     return true;
   }
+  /// Watches the publishers of `channel` (a channel of one publisher, once): a raw subscription,
+  /// made before any typed one of the channel, that decodes and checks each message (a malformed
+  /// or implausible one is left to the typed subscription to count) and hands its sender to the
+  /// PublisherWatch.
+  template <class T>
+  void watch(const std::string& channel) {
+    if (!channels::hasOnePublisher(channel) || !watched_.insert(channel).second) return;
+    subscribeRaw(channel, [this](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+      if (rbuf.data_size > kMaxMessageBytes) return;
+      WireType<T> msg;
+      try {
+        if (decodeAnyVersion(rbuf.data, rbuf.data_size, msg) < 0) return;
+        (void)fromWire<T>(msg);  // the plausibility checks: a corrupted message is no publisher's
+      } catch (const std::exception&) {
+        return;
+      }
+      if (!watch_.observe(ch, msg.sender_id, rbuf.recv_utime)) onSecondPublisher(ch, msg.sender_id);
+    });
+  }
+  /// A channel this node publishes, from inside spin() (a process that serves a loop; a bridge
+  /// that only publishes never handles its own messages, so it does not watch them): every other
+  /// sender on it is a second publisher. The first one starts the kSecondInstanceWindow_s.
+  template <class T>
+  void watchOwn(const std::string& channel) {
+    watch_.markPublished(channel);
+    if (announced_wall_us_ == 0) announced_wall_us_ = replay::wallUtimeNow();
+    watch<T>(channel);
+  }
+  /// A second publisher's message on `channel`: on a channel of this node, from an instance that
+  /// started before it, within kSecondInstanceWindow_s of its start, this node is the second
+  /// instance and stops.
+  void onSecondPublisher(const std::string& channel, int64_t sender);
   void guarded(const std::string& ch, const std::function<void()>& body);
   /// False (counted "<CHANNEL>:oversized") for a message above kMaxMessageBytes.
   bool sizeOk(const lcm::ReceiveBuffer& rbuf, const std::string& ch);
@@ -175,9 +245,15 @@ class LcmNode {
 
   std::string name_;
   std::string url_;
+  int64_t instance_id_;
+  int64_t announced_wall_us_ = 0;  ///< first publication on a watched channel of its own (0: none yet)
+  bool serving_ = false;           ///< spin() was called: the node handles what it receives
+  std::string second_instance_;
+  std::set<std::string> watched_;
   std::unique_ptr<lcm::LCM> lcm_;
   std::vector<std::unique_ptr<RawSub>> subs_;
   Diagnostics diag_;
+  PublisherWatch watch_{instance_id_, diag_};
   std::map<std::string, int64_t> received_;
   bool stop_ = false;
   Duration heartbeat_period_{0};

@@ -35,9 +35,15 @@ class ProcessMain {
   Cli& cli() { return cli_; }
   const std::string& name() const { return name_; }
 
+  /// Exit status of a process that stopped because another instance of it already publishes its
+  /// channels on the same LCM network (LcmNode::secondInstance), or holds its output folder
+  /// (DirLockError, common/dir_lock.h): the supervisor does not respawn it.
+  static constexpr int kExitSecondInstance = 7;
+
   /// Parses the command line (--help: exit 0; a bad one: exit 2), sets up logging (--log-level,
   /// else $MESHNAV_LOG_LEVEL) and the SIGINT/SIGTERM stop, and runs `body`, whose return value is
-  /// the exit code; an exception out of it is logged and gives exit 1.
+  /// the exit code; an exception out of it is logged and gives exit 1; kExitSecondInstance when
+  /// the LCM node stopped as a second instance.
   int run(int argc, char** argv, const std::function<int()>& body);
   /// The same with the options held here: `declare(cli(), options)` before parsing, then
   /// `body(options)`.

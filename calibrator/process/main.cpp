@@ -10,6 +10,7 @@
 
 #include "calibrator/node/calibrator_node.h"
 #include "calibrator/process/calibrator_process_config.h"
+#include "common/dir_lock.h"
 #include "common/setup.h"
 #include "transport/channels.h"
 #include "transport/input_journal.h"
@@ -89,7 +90,8 @@ class CalibratorProcess {
   void finish() {
     const CalibStatus st = process_.stamped(node_.status());
     lcm_.publish(channels::kCalibStatus, st);
-    if (results_file_.enabled()) writeResults(true);
+    // A second instance (transport/lcm_node.h) leaves the first one's results file alone.
+    if (results_file_.enabled() && lcm_.secondInstance().empty()) writeResults(true);
     spdlog::info("stopped at t = {} s; anchors: {}counters: {}", formatSeconds(st.t), anchorStates(st),
                  transport::formatCounters(st.counters));
   }
@@ -167,6 +169,9 @@ int main(int argc, char** argv) {
       std::cout << config.toString();
       return 0;
     }
+    // Its journal is this process's alone: a second calibrator on the folder is refused (exit 7).
+    std::optional<DirLock> state_lock;
+    if (!config.state_dir.empty()) state_lock.emplace(config.state_dir, "--state-dir");
     CalibratorProcess calibrator(process, config, setup);
     spdlog::info("calibrator options:\n{}", config.toString());
     calibrator.restoreFromJournal();

@@ -45,13 +45,23 @@ std::optional<Eigen::Matrix3d> upper(const CsvRow& r, const char* const names[6]
 
 }  // namespace
 
-void checkedFlush(std::ofstream& out, const std::string& path, int first_errno) {
+std::string StreamTally::lost() const {
+  const int64_t n = rows - kept_rows;
+  const std::string after = kept_until_t.empty() ? "from its first row" : "after t = " + kept_until_t + " s";
+  return "the file is incomplete: " + std::to_string(n) + " rows " + after + " (" + std::to_string(bytes - kept_bytes) +
+         " bytes), written since the last flush that succeeded, are lost or torn";
+}
+
+void checkedFlush(std::ofstream& out, const std::string& path, int first_errno, StreamTally* tally) {
   errno = 0;
   out.flush();
-  if (out) return;
+  if (out) {
+    if (tally) tally->flushed();
+    return;
+  }
   const int err = first_errno ? first_errno : errno;
   throw std::runtime_error(path + ": write failed (" + (err ? std::string(std::strerror(err)) : "stream error") +
-                           "; the file is incomplete)");
+                           "; " + (tally ? tally->lost() : std::string("the file is incomplete")) + ")");
 }
 
 EstimateCsvWriter::EstimateCsvWriter(const std::string& path, bool append)
@@ -69,9 +79,10 @@ void EstimateCsvWriter::write(const PoseEstimate& e) {
   errno = 0;
   out_ << buf;
   if (!out_ && errno_ == 0) errno_ = errno;
+  tally_.wrote(formatSeconds(e.t), std::strlen(buf));
 }
 
-void EstimateCsvWriter::flush() { checkedFlush(out_, path_, errno_); }
+void EstimateCsvWriter::flush() { checkedFlush(out_, path_, errno_, &tally_); }
 
 AnchorsCsvWriter::AnchorsCsvWriter(const std::string& path, bool append)
     : path_(path), out_(openOut(path, kAnchorsHeader, append)) {}
@@ -84,9 +95,10 @@ void AnchorsCsvWriter::write(const AnchorEstimate& a) {
   errno = 0;
   out_ << buf;
   if (!out_ && errno_ == 0) errno_ = errno;
+  tally_.wrote(formatSeconds(a.t), std::strlen(buf));
 }
 
-void AnchorsCsvWriter::flush() { checkedFlush(out_, path_, errno_); }
+void AnchorsCsvWriter::flush() { checkedFlush(out_, path_, errno_, &tally_); }
 
 std::vector<PoseEstimate> readEstimateCsv(const std::string& path, Diagnostics& diag) {
   static const char* const kP[6] = {"pxx", "pxy", "pxz", "pyy", "pyz", "pzz"};

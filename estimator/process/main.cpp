@@ -6,7 +6,9 @@
 /// --state-period seconds of data time and read back at start: a respawned estimator resumes
 /// with its anchors (and its pose after a short outage) instead of starting over.
 #include <iostream>
+#include <optional>
 
+#include "common/dir_lock.h"
 #include "common/setup.h"
 #include "estimator/filter/strategy_factory.h"
 #include "estimator/restart/checkpoint.h"
@@ -112,6 +114,7 @@ class EstimatorProcess {
   void checkpoint(Timestamp t) {
     if (o_.state_dir.empty() || !ready_ || (last_checkpoint_ && (t - *last_checkpoint_).sec() < o_.state_period_s))
       return;
+    if (!lcm_.secondInstance().empty()) return;  // a second instance leaves the first one's checkpoint alone
     last_checkpoint_ = t;
     try {
       estimator::writeCheckpoint(node_.checkpoint(), o_.state_dir);
@@ -150,6 +153,9 @@ int main(int argc, char** argv) {
     }
     process.require(!o.setup_path.empty(), "setup");
     const SystemSetup setup = loadSetup(o.setup_path);
+    // Its checkpoint is this process's alone: a second estimator on the folder is refused (exit 7).
+    std::optional<DirLock> state_lock;
+    if (!o.state_dir.empty()) state_lock.emplace(o.state_dir, "--state-dir");
     EstimatorProcess estimator(process, o, options, setup);
     estimator.resumeFromCheckpoint();
     spdlog::info("estimator options:\n{}", estimator.node().options().toString());

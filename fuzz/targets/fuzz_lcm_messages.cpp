@@ -3,10 +3,13 @@
 /// lcmtypes/ that a process subscribes to, as LcmNode does (a throwing or failing decode is a
 /// counted decode error), then converted with fromLcm (InvalidMessage: a counted invalid message).
 /// What converts must convert back: toLcm, encode, decode and fromLcm again without a refusal.
+/// Decoding goes through decodeAnyVersion (transport/wire_versions.h), so the seeds of the
+/// previous version (pre36_*.bin, and the regression seeds recorded with it) fuzz its upgrade.
 #include <vector>
 
 #include "fuzz/support/fuzz_target.h"
 #include "transport/convert.h"
+#include "transport/wire_versions.h"
 
 using namespace meshnav;
 using namespace meshnav::transport;
@@ -17,7 +20,7 @@ namespace {
 template <class Msg>
 bool decodeAs(const uint8_t* data, size_t size, Msg& msg) {
   try {
-    return msg.decode(data, 0, static_cast<int>(size)) >= 0;
+    return decodeAnyVersion(data, size, msg) >= 0;
   } catch (const std::exception&) {
     return false;
   }

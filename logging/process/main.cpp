@@ -2,11 +2,14 @@
 /// anchor_init.yaml, groundtruth.csv, summary.yaml) and optionally every message into an .lcmlog.
 #include <lcm/lcm-cpp.hpp>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 
+#include "common/dir_lock.h"
 #include "logging/run_recorder.h"
 #include "logging/torn_tail.h"
 #include "transport/channels.h"
@@ -81,12 +84,52 @@ void subscribeRunFiles(transport::LcmNode& node, logging::RunRecorder& recorder)
 
 /// Flushes the files every `period_s` of wall time (a kill -9 loses at most one period), with a
 /// progress line every 10 s.
-void flushPeriodically(transport::LcmNode& node, logging::RunRecorder& recorder, lcm::LogFile* lcmlog, double period_s) {
+/// The --lcmlog's writes: a failed write or flush is reported once with the file, and the logger
+/// exits 1 at the end naming what is lost (events after the last flush that succeeded).
+struct LcmLogWrites {
+  std::string path;
+  int64_t events = 0, bytes = 0;            ///< handed to the log
+  int64_t kept_events = 0, kept_bytes = 0;  ///< at the last successful flush
+  int failed_errno = -1;                    ///< errno of the first failure (-1: none)
+
+  void wrote(int64_t n) {
+    ++events;
+    bytes += n;
+  }
+  void fail(Diagnostics& diag, int err) {
+    if (failed_errno < 0) {
+      failed_errno = err;
+      diag.report("lcmlog:write_error", fmt::format("{}: write failed ({}); events from now on are lost", path,
+                                                    err ? std::strerror(err) : "stream error"));
+    } else {
+      diag.count("lcmlog:write_error");
+    }
+  }
+  void flush(lcm::LogFile* log, Diagnostics& diag) {
+    if (!log || failed_errno >= 0) return;
+    errno = 0;
+    if (std::fflush(log->getFilePtr()) != 0 || std::ferror(log->getFilePtr())) return fail(diag, errno);
+    kept_events = events;
+    kept_bytes = bytes;
+  }
+  /// "" when every event is in the file, else the error for the end of the run.
+  std::string lost() const {
+    if (failed_errno < 0) return "";
+    return fmt::format("{}: write failed ({}; {} of {} events, {} bytes, written since the last flush that "
+                       "succeeded are lost or torn)",
+                       path, failed_errno ? std::strerror(failed_errno) : "stream error", events - kept_events,
+                       events, bytes - kept_bytes);
+  }
+};
+
+void flushPeriodically(transport::LcmNode& node, logging::RunRecorder& recorder, lcm::LogFile* lcmlog,
+                       LcmLogWrites& writes, double period_s) {
   const int64_t progress_period_us = 10'000'000;
   node.setHeartbeat(Duration::fromSec(period_s),
-                    [&recorder, lcmlog, progress_period_us, next_progress = replay::wallUtimeNow() + progress_period_us]() mutable {
+                    [&node, &recorder, lcmlog, &writes, progress_period_us,
+                     next_progress = replay::wallUtimeNow() + progress_period_us]() mutable {
+                      writes.flush(lcmlog, node.diagnostics());
                       recorder.flush();
-                      if (lcmlog) std::fflush(lcmlog->getFilePtr());
                       const int64_t now = replay::wallUtimeNow();
                       if (now < next_progress) return;
                       int64_t total = 0;
@@ -110,6 +153,8 @@ int main(int argc, char** argv) {
       "continues the files.");
   return process.run<LoggingOptions>(argc, argv, declareOptions, [&](LoggingOptions& o) {
     process.require(!o.out.empty(), "out");
+    // The folder's files are this logger's alone: a second logger into it is refused (exit 7).
+    const DirLock out_lock(o.out, "--out");
     const std::filesystem::path id_file = std::filesystem::path(o.out) / ".logging_run_id";
     const bool append = continuesRun(id_file, o.run_id, o.out);
     logging::RunRecorder recorder(o.out, append);
@@ -117,6 +162,7 @@ int main(int argc, char** argv) {
     transport::LcmNode& node = process.lcm();
     std::unique_ptr<lcm::LogFile> lcmlog =
         o.lcmlog_path.empty() ? nullptr : openLcmLog(o.lcmlog_path, append, node.diagnostics());
+    LcmLogWrites writes{o.lcmlog_path};
     int64_t last_msg_wall = 0;
     node.subscribeRaw(o.channel_regex, [&](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
       if (ch == "LCM_SELF_TEST") return;  // udpm's own start-up probe
@@ -124,19 +170,26 @@ int main(int argc, char** argv) {
       last_msg_wall = replay::wallUtimeNow();
       if (!lcmlog) return;
       lcm::LogEvent ev{0, rbuf.recv_utime, ch, static_cast<int32_t>(rbuf.data_size), rbuf.data};
-      if (lcmlog->writeEvent(&ev) != 0) node.diagnostics().report("lcmlog:write_error", "lcmlog write failed");
+      writes.wrote(static_cast<int64_t>(rbuf.data_size));
+      errno = 0;
+      if (lcmlog->writeEvent(&ev) != 0) writes.fail(node.diagnostics(), errno);
     });
     subscribeRunFiles(node, recorder);
-    flushPeriodically(node, recorder, lcmlog.get(), o.flush_period_s);
+    flushPeriodically(node, recorder, lcmlog.get(), writes, o.flush_period_s);
     spdlog::info("LCM {}; recording into {}{}", node.url(), o.out, lcmlog ? " and " + o.lcmlog_path : std::string());
     const int rc = node.spin([&] {
       return o.idle_s > 0 && last_msg_wall > 0 && replay::wallUtimeNow() - last_msg_wall > o.idle_s * 1e6;
     });
+    writes.flush(lcmlog.get(), node.diagnostics());
     recorder.finish(node.diagnostics());
     lcmlog.reset();
     spdlog::info("{}", recorder.summaryText());
     if (node.diagnostics().total() > 0) spdlog::warn("counters: {}", node.diagnostics().summary());
     if (recorder.diagnostics().total() > 0) spdlog::warn("recorder: {}", recorder.diagnostics().summary());
+    if (const std::string lost = writes.lost(); !lost.empty()) {
+      spdlog::error("{}", lost);
+      return 1;
+    }
     return rc;
   });
 }

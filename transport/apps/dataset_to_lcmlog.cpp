@@ -15,10 +15,16 @@
 
 namespace {
 
+/// The sender_id of every message of a dataset log: one fixed id (the log is one publisher,
+/// lcm-logplayer, to the receivers' PublisherWatch, transport/publisher_watch.h), so that the same
+/// dataset gives the same log byte for byte. Its time bits say 1970: older than any process.
+constexpr int64_t kDatasetLogSenderId = 0x10617;
+
 template <class T>
 bool writeEvent(lcm::LogFile& log, meshnav::channels::Channel<T> channel, int64_t utime, const std::type_identity_t<T>& value,
                 std::vector<uint8_t>& buf) {
-  const auto msg = meshnav::transport::toWire(value);
+  auto msg = meshnav::transport::toWire(value);
+  msg.sender_id = kDatasetLogSenderId;
   const int n = msg.getEncodedSize();
   buf.resize(static_cast<size_t>(n));
   if (msg.encode(buf.data(), 0, n) != n) return false;

@@ -88,6 +88,7 @@ UwbType uwbTypeFromCode(int8_t code, const char* what) {
 
 imu_t toLcm(const ImuSample& s) {
   imu_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   put3(s.acc_m_s2, m.lin_acc);
   put3(s.gyro_rad_s, m.ang_vel);
@@ -107,12 +108,14 @@ ImuSample fromLcm(const imu_t& m) {
 
 baro_t toLcm(const BaroSample& s) {
   baro_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   m.pressure = s.pressure_pa;
   return m;
 }
 height_t toLcm(const HeightSample& s) {
   height_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   m.range = s.range_m;
   return m;
@@ -136,6 +139,7 @@ BaroSample fromLcm(const baro_t& m) {
 
 range_t toLcm(const RangeSample& s) {
   range_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   m.id_initiator = s.id_initiator;
   m.id_responder = s.id_responder;
@@ -169,6 +173,7 @@ RangeSample fromLcm(const range_t& m) {
 
 flight_state_t toLcm(const FlightStateSample& s) {
   flight_state_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   m.landed = s.landed;
   return m;
@@ -182,6 +187,7 @@ FlightStateSample fromLcm(const flight_state_t& m) {
 
 ground_truth_t toLcm(const PoseSample& s) {
   ground_truth_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   put3(s.p_IinG, m.p_IinG);
   putQ(s.q_ItoG, m.q_ItoG);
@@ -201,6 +207,7 @@ PoseSample fromLcm(const ground_truth_t& m) {
 
 pose_t toLcm(const PoseEstimate& s) {
   pose_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   put3(s.p_IinG, m.p_IinG);
   put3(s.v_IinG, m.v_IinG);
@@ -255,6 +262,7 @@ AnchorEstimate fromLcm(const anchor_estimate_t& m) {
 
 anchors_t toLcm(Timestamp t, const std::vector<AnchorEstimate>& anchors) {
   anchors_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = t.us;
   m.num_anchors = clampedCount(anchors);
   for (int i = 0; i < m.num_anchors; ++i) m.anchors.push_back(toLcm(anchors[i]));
@@ -304,6 +312,7 @@ PairBias fromLcm(const pair_bias_t& m) {
 
 anchor_init_t toLcm(const AnchorInit& s) {
   anchor_init_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   m.id = s.id;
   put3(s.p_AinG, m.p_AinG);

@@ -47,6 +47,7 @@ std::map<std::string, int64_t> countersFromLcm(const std::vector<counter_t>& v) 
 
 estimator_status_t toLcm(const EstimatorStatus& s) {
   estimator_status_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   m.wall_utime = s.wall_utime;
   m.initialized = s.initialized;
@@ -108,6 +109,7 @@ EstimatorStatus fromLcm(const estimator_status_t& m) {
 
 estimator_cmd_t toLcm(const EstimatorCommand& s) {
   estimator_cmd_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   m.action = static_cast<int8_t>(s.action);
   m.id = s.id;
@@ -140,6 +142,7 @@ EstimatorCommand fromLcm(const estimator_cmd_t& m) {
 
 calib_cmd_t toLcm(const CalibCommand& s) {
   calib_cmd_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   m.action = static_cast<int8_t>(s.action);
   m.num_anchors = clampedCount(s.anchors);
@@ -161,6 +164,7 @@ CalibCommand fromLcm(const calib_cmd_t& m) {
 
 calib_status_t toLcm(const CalibStatus& s) {
   calib_status_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   m.wall_utime = s.wall_utime;
   m.num_anchors = clampedCount(s.anchors);
@@ -197,6 +201,7 @@ CalibStatus fromLcm(const calib_status_t& m) {
 
 mission_status_t toLcm(const MissionStatus& s) {
   mission_status_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
   m.utime = s.t.us;
   m.wall_utime = s.wall_utime;
   m.step_index = s.step_index;

@@ -45,13 +45,30 @@ std::string resolveLcmUrl(const std::string& cli_value) {
   return "udpm://239.255.76.67:7667?ttl=0";
 }
 
-LcmNode::LcmNode(std::string name, const std::string& url) : name_(std::move(name)), url_(resolveLcmUrl(url)) {
+LcmNode::LcmNode(std::string name, const std::string& url)
+    : name_(std::move(name)),
+      url_(resolveLcmUrl(url)),
+      instance_id_(PublisherWatch::newInstanceId(replay::wallUtimeNow())) {
   lcm_ = std::make_unique<lcm::LCM>(url_);
   if (!lcm_->good())
     throw std::runtime_error(name_ + ": cannot initialise LCM with URL '" + url_ +
                              "' (for udpm on loopback: ip link set lo multicast on; "
                              "ip route add 224.0.0.0/4 dev lo)");
-  spdlog::debug("{}: LCM on {}", name_, url_);
+  spdlog::debug("{}: LCM on {}, instance {}", name_, url_, PublisherWatch::format(instance_id_));
+}
+
+void LcmNode::onSecondPublisher(const std::string& channel, int64_t sender) {
+  if (!second_instance_.empty() || !watch_.published(channel)) return;
+  // The one that started later yields; one that has run for a while is never stopped by another.
+  if (!PublisherWatch::startedBefore(sender, instance_id_)) return;
+  const double age_s = static_cast<double>(replay::wallUtimeNow() - announced_wall_us_) * 1e-6;
+  if (age_s > kSecondInstanceWindow_s) return;  // counted by the watch, not refused
+  second_instance_ = "channel " + channel + " is published by instance " + PublisherWatch::format(sender) +
+                     ", which started before this one (" + PublisherWatch::format(instance_id_) + ")";
+  spdlog::error("{}: another instance already runs on this LCM network ({}; {}): stopping, the other keeps the "
+                "channel. Stop the other launch first, or give this one another --lcm-url.",
+                name_, url_, second_instance_);
+  requestStop();
 }
 
 LcmNode::~LcmNode() = default;
@@ -118,6 +135,7 @@ int LcmNode::spinOnce(int timeout_ms) {
 }
 
 int LcmNode::spin(const std::function<bool()>& until) {
+  serving_ = true;
   runHeartbeatIfDue();
   while (!stopRequested()) {
     if (until && until()) break;

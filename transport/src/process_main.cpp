@@ -4,12 +4,14 @@
 
 #include <stdexcept>
 
+#include "common/dir_lock.h"
 #include "transport/stop_signal.h"
 
 namespace meshnav::transport {
 
 ProcessMain::ProcessMain(std::string name, const std::string& description)
-    : name_(std::move(name)), cli_(name_, description + "\nSIGINT / SIGTERM stop the process cleanly.") {
+    : name_(std::move(name)), cli_(name_, description + "\nSIGINT / SIGTERM stop the process cleanly. Exit 7: another instance of it already "
+                                              "publishes its channels on this LCM network (it yields to it).") {
   cli_.optional("lcm-url", lcm_url_, "LCM provider (default: $LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0)")
       ->type_name("URL");
   cli_.optional("log-level", log_level_, "log level (default: $MESHNAV_LOG_LEVEL, else info)")
@@ -35,7 +37,15 @@ int ProcessMain::run(int argc, char** argv, const std::function<int()>& body) {
   if (!log_level_.empty()) spdlog::set_level(spdlog::level::from_str(log_level_));
   StopSignal::install();
   try {
-    return body();
+    const int rc = body();
+    if (lcm_ && !lcm_->secondInstance().empty()) {
+      spdlog::error("refused to run beside another instance (exit {})", kExitSecondInstance);
+      return kExitSecondInstance;
+    }
+    return rc;
+  } catch (const DirLockError& e) {
+    spdlog::error("{}", e.what());
+    return kExitSecondInstance;
   } catch (const UsageError& e) {
     spdlog::error("{}", e.what());
     return 2;

@@ -50,10 +50,23 @@ TEST(EstimateIo, AFailedWriteIsReportedByFlushNamingTheFile) {
     FAIL() << "flush on /dev/full did not throw";
   } catch (const std::runtime_error& ex) {
     EXPECT_NE(std::string(ex.what()).find("/dev/full: write failed"), std::string::npos) << ex.what();
+    // Which rows: nothing was flushed, so all 100 (the bytes handed to the stream) are lost.
+    EXPECT_NE(std::string(ex.what()).find("100 rows from its first row ("), std::string::npos) << ex.what();
   }
   AnchorsCsvWriter a("/dev/full");
   a.write(AnchorEstimate{});
   EXPECT_THROW(a.flush(), std::runtime_error);
+}
+
+// The message of a failed write counts the rows after the last flush that succeeded.
+TEST(StreamTally, NamesTheRowsAfterTheLastGoodFlush) {
+  StreamTally t;
+  t.wrote("1.000000", 50);
+  t.wrote("2.000000", 50);
+  t.flushed();
+  t.wrote("3.000000", 40);
+  EXPECT_EQ(t.lost(), "the file is incomplete: 1 rows after t = 2.000000 s (40 bytes), written since the last flush "
+                      "that succeeded, are lost or torn");
 }
 
 // A writer whose writes succeed flushes without a word, as often as asked.

@@ -23,6 +23,7 @@
 #include "meshnav/pair_bias_t.hpp"
 #include "meshnav/pose_t.hpp"
 #include "meshnav/range_t.hpp"
+#include "meshnav/time_sync_t.hpp"
 #include "meshnav/timing_t.hpp"
 
 namespace {
@@ -46,12 +47,14 @@ Msg decode(const std::vector<uint8_t>& buf) {
 TEST(LcmTypes, ImuRoundTrip) {
   meshnav::imu_t m;
   m.utime = 1234567;
+  m.sender_id = 0x1a2b3c;
   for (int i = 0; i < 3; ++i) {
     m.lin_acc[i] = 0.1 * i - 9.81;
     m.ang_vel[i] = -0.01 * i;
   }
   const auto d = decode<meshnav::imu_t>(encode(m));
   EXPECT_EQ(d.utime, m.utime);
+  EXPECT_EQ(d.sender_id, m.sender_id);
   for (int i = 0; i < 3; ++i) {
     EXPECT_EQ(d.lin_acc[i], m.lin_acc[i]);
     EXPECT_EQ(d.ang_vel[i], m.ang_vel[i]);
@@ -150,8 +153,8 @@ TEST(LcmTypes, FingerprintsAreDistinct) {
       meshnav::mission_status_t::getHash(), meshnav::anchor_estimate_t::getHash(),
       meshnav::calib_anchor_status_t::getHash(), meshnav::counter_t::getHash(),
       meshnav::instance_status_t::getHash(), meshnav::pair_bias_t::getHash(),
-      meshnav::timing_t::getHash()};
-  ASSERT_EQ(hashes.size(), 20u);  // every type in lcmtypes/types
+      meshnav::timing_t::getHash(),          meshnav::time_sync_t::getHash()};
+  ASSERT_EQ(hashes.size(), 21u);  // every type in lcmtypes/types
   for (size_t i = 0; i < hashes.size(); ++i)
     for (size_t j = i + 1; j < hashes.size(); ++j) EXPECT_NE(hashes[i], hashes[j]) << i << " vs " << j;
 }

@@ -9,6 +9,7 @@
 
 #include "transport/channels.h"
 #include "transport/lcm_node.h"
+#include "transport/replay/clock.h"
 #include "transport/stop_signal.h"
 
 using namespace meshnav;
@@ -273,4 +274,101 @@ TEST(LcmNode, ResolveUrl) {
   EXPECT_EQ(resolveLcmUrl(""), "udpm://239.255.76.67:7700?ttl=0");
   unsetenv("LCM_DEFAULT_URL");
   EXPECT_EQ(resolveLcmUrl(""), "udpm://239.255.76.67:7667?ttl=0");
+}
+
+// ---- publishers (transport/publisher_watch.h) ------------------------------------------------
+
+namespace {
+std::vector<uint8_t> poseFrom(int64_t sender, int64_t utime) {
+  PoseEstimate e;
+  e.t = Timestamp{utime};
+  meshnav::pose_t m = toLcm(e);
+  m.sender_id = sender;
+  std::vector<uint8_t> buf(static_cast<size_t>(m.getEncodedSize()));
+  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  return buf;
+}
+}  // namespace
+
+TEST(LcmNode, PublishedMessagesCarryTheInstanceId) {
+  LcmNode node("test", "memq://");
+  LcmNode other("other", "memq://");
+  EXPECT_NE(node.instanceId(), 0);
+  EXPECT_NE(node.instanceId(), other.instanceId());
+  int64_t seen = 0;
+  node.subscribeRaw(channels::kPose.name, [&](const lcm::ReceiveBuffer& rb, const std::string&) {
+    meshnav::pose_t m;
+    ASSERT_GT(m.decode(rb.data, 0, static_cast<int>(rb.data_size)), 0);
+    seen = m.sender_id;
+  });
+  ASSERT_TRUE(node.publish(channels::kPose, PoseEstimate{}));
+  drain(node);
+  EXPECT_EQ(seen, node.instanceId());
+  EXPECT_TRUE(node.secondInstance().empty());  // its own message looped back is its own
+  EXPECT_EQ(node.diagnostics().total(), 0);
+}
+
+TEST(LcmNode, ASecondPublishersMessagesNeverReachTheHandler) {
+  LcmNode node("test", "memq://");
+  std::vector<int64_t> got;
+  node.subscribe(channels::kPose, [&](const PoseEstimate& e) { got.push_back(e.t.us); });
+  const int64_t a = 0xaaaa, b = 0xbbbb;
+  // Interleaved: each id counts from its second message; B then takes A's place (a restart, as
+  // far as the receiver can tell), A speaks again (two live publishers: A started first and keeps
+  // the channel), and B's messages are dropped from then on.
+  int64_t t = 0;
+  for (int64_t sender : {a, b, a, b, a, b, a}) publishBytes(node, channels::kPose.name, poseFrom(sender, ++t));
+  drain(node);
+  EXPECT_EQ(got, (std::vector<int64_t>{1, 2, 3, 4, 5, 7}));
+  EXPECT_EQ(node.diagnostics().get("POSE:publisher_changed"), 1);
+  EXPECT_EQ(node.diagnostics().get("POSE:second_publisher"), 2);  // the conflict, B's 6
+  EXPECT_EQ(node.publishers().secondPublishers().at("POSE"), std::set<int64_t>{b});
+  // A channel of several publishers (RANGE: one bridge per anchor) is not watched.
+  std::vector<int64_t> ranges;
+  node.subscribe(channels::kRange, [&](const RangeSample& r) { ranges.push_back(r.t.us); });
+  for (int64_t sender : {a, b, a, b}) {
+    RangeSample r;
+    r.t = Timestamp{++t};
+    r.id_initiator = 1;
+    r.id_responder = 2;
+    r.range_m = 1.0;
+    meshnav::range_t m = toLcm(r);
+    m.sender_id = sender;
+    std::vector<uint8_t> buf(static_cast<size_t>(m.getEncodedSize()));
+    m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+    publishBytes(node, channels::kRange.name, buf);
+  }
+  drain(node);
+  EXPECT_EQ(ranges.size(), 4u);
+}
+
+TEST(LcmNode, AnotherPublisherOfItsOwnChannelRightAfterItsStartStopsIt) {
+  LcmNode node("test", "memq://");
+  node.spin([] { return true; });  // a node that serves a loop (a bridge that only publishes does not watch)
+  ASSERT_TRUE(node.publish(channels::kPose, PoseEstimate{}));
+  drain(node);
+  EXPECT_FALSE(node.stopRequested());
+  publishBytes(node, channels::kPose.name, poseFrom(0xf00d, 5));  // the other instance ...
+  drain(node);
+  EXPECT_FALSE(node.stopRequested());  // ... counts from its second message (a corrupted one's id is random)
+  publishBytes(node, channels::kPose.name, poseFrom(0xf00d, 6));
+  drain(node);
+  EXPECT_TRUE(node.stopRequested());
+  EXPECT_NE(node.secondInstance().find("0x000000000000f00d"), std::string::npos) << node.secondInstance();
+  EXPECT_EQ(node.diagnostics().get("POSE:second_publisher"), 1);
+  EXPECT_FALSE(node.publish(channels::kPose, PoseEstimate{}));  // it yields the channel
+}
+
+TEST(LcmNode, AnotherPublisherThatStartedLaterOnlyCountsAndLeavesItRunning) {
+  LcmNode node("test", "memq://");
+  node.spin([] { return true; });
+  ASSERT_TRUE(node.publish(channels::kPose, PoseEstimate{}));
+  const int64_t newer = PublisherWatch::newInstanceId(replay::wallUtimeNow() + 5'000'000);  // 5 s later
+  publishBytes(node, channels::kPose.name, poseFrom(newer, 5));
+  publishBytes(node, channels::kPose.name, poseFrom(newer, 6));
+  drain(node);
+  EXPECT_FALSE(node.stopRequested());  // the newer one yields, not this one
+  EXPECT_TRUE(node.secondInstance().empty());
+  EXPECT_EQ(node.diagnostics().get("POSE:second_publisher"), 1);  // from its second message
+  EXPECT_EQ(node.publishers().secondPublishers().at("POSE"), std::set<int64_t>{newer});
 }
