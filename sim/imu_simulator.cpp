@@ -14,6 +14,7 @@ ImuNoiseOptions ImuNoiseOptions::noiseless() {
   o.acc_noise_density = o.gyro_noise_density = 0.0;
   o.acc_bias_rw = o.gyro_bias_rw = 0.0;
   o.acc_bias_initial_sigma = o.gyro_bias_initial_sigma = 0.0;
+  o.vibration_acc_m_s2 = o.vibration_gyro_rad_s = 0.0;
   return o;
 }
 
@@ -48,6 +49,9 @@ std::string ImuNoiseOptions::toString() const {
     << gyro_bias_initial_sigma << " rad/s";
   if (scale_sigma > 0.0 || misalignment_sigma_rad > 0.0)
     s << ", axis scale sigma " << scale_sigma << ", misalignment sigma " << misalignment_sigma_rad << " rad";
+  if (vibration_acc_m_s2 > 0.0 || vibration_gyro_rad_s > 0.0)
+    s << ", rotor vibration " << vibration_acc_m_s2 << " m/s^2, " << vibration_gyro_rad_s << " rad/s at "
+      << rotor_min_hz << "-" << rotor_max_hz << " Hz while airborne";
   return s.str();
 }
 
@@ -85,6 +89,32 @@ std::vector<ImuSample> ImuSimulator::simulate(const Trajectory& trajectory, doub
           (*T)(i, j) += rng_axes.gaussian(i == j ? options_.scale_sigma : options_.misalignment_sigma_rad);
   }
 
+  // Rotor vibration: tones, amplitudes and phases from a stream of their own.
+  const bool rotorcraft = !trajectory.isHandCarried() &&
+                          (options_.vibration_acc_m_s2 > 0.0 || options_.vibration_gyro_rad_s > 0.0);
+  std::array<double, 2> rotor_hz{0.0, 0.0};
+  Eigen::Matrix<double, 3, 2> phase_acc = Eigen::Matrix<double, 3, 2>::Zero(), phase_gyro = phase_acc;
+  Eigen::Vector3d amp_acc = Eigen::Vector3d::Zero(), amp_gyro = Eigen::Vector3d::Zero();
+  if (rotorcraft) {
+    RandomStream rng_vib(RandomStream::deriveSeed(seed_, "imu_vibration"));
+    for (double& f : rotor_hz) f = rng_vib.uniform(options_.rotor_min_hz, options_.rotor_max_hz);
+    for (int i = 0; i < 3; ++i) {
+      amp_acc(i) = rng_vib.uniform(0.5, 1.5) * options_.vibration_acc_m_s2;
+      amp_gyro(i) = rng_vib.uniform(0.5, 1.5) * options_.vibration_gyro_rad_s;
+      for (int j = 0; j < 2; ++j) {
+        phase_acc(i, j) = rng_vib.uniform(0.0, 2.0 * M_PI);
+        phase_gyro(i, j) = rng_vib.uniform(0.0, 2.0 * M_PI);
+      }
+    }
+  }
+  const auto vibration = [&](double t, const Eigen::Vector3d& amp, const Eigen::Matrix<double, 3, 2>& phase) {
+    Eigen::Vector3d v;
+    for (int i = 0; i < 3; ++i)
+      v(i) = amp(i) * (std::sin(2.0 * M_PI * rotor_hz[0] * t + phase(i, 0)) +
+                       std::sin(2.0 * M_PI * rotor_hz[1] * t + phase(i, 1))) / std::sqrt(2.0);
+    return v;
+  };
+
   std::vector<ImuSample> out;
   const auto n = static_cast<int64_t>(std::floor(t_end_s / dt + 1e-9)) + 1;
   out.reserve(static_cast<size_t>(n));
@@ -97,6 +127,10 @@ std::vector<ImuSample> ImuSimulator::simulate(const Trajectory& trajectory, doub
     ImuSample s = ideal(trajectory.evaluate(t));
     s.acc_m_s2 = acc_T_ * s.acc_m_s2 + bias_acc_ + rng_noise.gaussian3(sigma_acc_d);
     s.gyro_rad_s = gyro_T_ * s.gyro_rad_s + bias_gyro_ + rng_noise.gaussian3(sigma_gyro_d);
+    if (rotorcraft && !trajectory.isLanded(t)) {
+      s.acc_m_s2 += vibration(t, amp_acc, phase_acc);
+      s.gyro_rad_s += vibration(t, amp_gyro, phase_gyro);
+    }
     out.push_back(s);
   }
   return out;

@@ -7,6 +7,20 @@
 ///   f_m = R_ItoGᵀ (a_G − g_G) + b_a + n_a,   ω_m = ω_I + b_g + n_g,   g_G = [0, 0, −9.81] m/s²
 /// with discrete white noise n ~ N(0, σ_d²), σ_d = σ_c / √Δt (σ_c: noise density), and biases that
 /// start at b(0) ~ N(0, σ_b0²) and random-walk b_{k+1} = b_k + σ_w √Δt · N(0, 1) (σ_w: bias rw density).
+///
+/// Rotor vibration (issue 36 item 7): while a rotorcraft is airborne (not landed, not carried by
+/// hand), its IMU shakes with the rotors. Per axis i and sensor, two tones at the rotor frequencies
+/// f_1, f_2 ~ U(rotor_min_hz, rotor_max_hz) (drawn once per sequence; the phases per axis):
+///   f_m += A_f,i (sin(2π f_1 t + φ_1i) + sin(2π f_2 t + φ_2i)) / √2,  ω_m likewise with A_ω,i,
+/// A_i ~ U(0.5, 1.5) · vibration_acc_m_s2 (vibration_gyro_rad_s), so each axis has an RMS of about
+/// A_i / √2. Sampled at 200 Hz, rotor tones of 110–170 Hz alias to 30–90 Hz, far from 0 Hz:
+/// zero-mean over a few samples, a tone integrates to a velocity offset of at most
+/// A / (2π f_alias), a few mm/s (its phase where an integration starts; 0.09 m over 10 s at the
+/// default scale, against 2.5 m for the default accelerometer bias σ alone). It leaves the
+/// navigation solution alone, but a hover or a straight leg no longer reads like rest, as it
+/// does on real hardware. The densities written to setup.yaml stay the sensor's own (the stillness
+/// detector's thresholds scale with them). Off (0) in noiseless(); its draws come from a stream
+/// of their own, so every other draw is the same with or without it.
 
 #include <cstdint>
 #include <string>
@@ -31,6 +45,12 @@ struct ImuNoiseOptions {
   /// m_ij ~ N(0, misalignment_sigma_rad²) [rad]. 0: exact axes (the default; draws nothing).
   double scale_sigma = 0.0;
   double misalignment_sigma_rad = 0.0;
+  /// Rotor vibration while airborne (above): amplitude scale of the specific force [m/s²] and of
+  /// the angular rate [rad/s] per axis, rotor frequency range [Hz]. 0: none (`--vibration 0`).
+  double vibration_acc_m_s2 = 0.6;
+  double vibration_gyro_rad_s = 0.03;
+  double rotor_min_hz = 110.0;
+  double rotor_max_hz = 170.0;
 
   /// All noise and biases zero (ideal IMU).
   static ImuNoiseOptions noiseless();

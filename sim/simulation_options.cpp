@@ -24,6 +24,10 @@ void SimulationOptions::validate() const {
   require(imu.scale_sigma >= 0.0 && imu.scale_sigma <= 0.1 && imu.misalignment_sigma_rad >= 0.0 &&
               imu.misalignment_sigma_rad <= 0.1,
           "IMU axis scale sigma and misalignment sigma must be in [0, 0.1] (fraction, rad)");
+  require(imu.vibration_acc_m_s2 >= 0.0 && imu.vibration_acc_m_s2 <= 10.0 && imu.vibration_gyro_rad_s >= 0.0 &&
+              imu.vibration_gyro_rad_s <= 1.0,
+          "IMU vibration must be in [0, 10] m/s^2 and [0, 1] rad/s (--vibration in [0, ~16])");
+  require(imu.rotor_min_hz > 0.0 && imu.rotor_max_hz >= imu.rotor_min_hz, "rotor frequencies must be > 0 and ordered");
   require(ground_truth_rate_hz > 0.0 && flight_state_rate_hz > 0.0, "output rates must be > 0");
   require(initial_pose_sigma_p_m >= 0.0 && initial_pose_sigma_yaw_deg >= 0.0, "initial pose sigmas must be >= 0");
   if (trajectory) trajectory->validate();

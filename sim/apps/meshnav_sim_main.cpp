@@ -36,7 +36,7 @@ struct SimCli {
   double duration_s = 0.0;
   double bias_max_m = 0.0;
   double uncertain_sigma_m = 0.0;
-  double imu_scale_sigma = 0.0, imu_misalignment_deg = 0.0;
+  double imu_scale_sigma = 0.0, imu_misalignment_deg = 0.0, vibration = 1.0;
   int fleet = 0;
   bool no_initial_pose = false, uncertain_known = false;
 };
@@ -122,6 +122,11 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
              "sigma of each off-diagonal term of the IMU's axis matrices (axes not orthogonal to the body's), both "
              "sensors, drawn once (consumer MEMS: about 0.5 deg); 0 = exact [deg]")
       ->type_name("DEG")->check(cli_checks::nonNegative())->group("Sensors");
+  cli.option("vibration", c.vibration,
+             "scale of the rotor vibration of the IMU while a rotorcraft is airborne (1: per axis about 0.4 m/s^2 "
+             "and 0.02 rad/s RMS at 110-170 Hz rotor tones; 0: none, the IMU of a still body in hover and cruise) "
+             "[-]")
+      ->type_name("F")->check(cli_checks::nonNegative())->group("Sensors");
   cli.flag("no-initial-pose", c.no_initial_pose,
            "do not write the take-off pad prior to setup.yaml (never written for hover and walk)")
       ->group("Sensors");
@@ -175,6 +180,8 @@ void applyScenarioOptions(const meshnav::Cli& cli, SimCli& c) {
   }
   o.imu.scale_sigma = c.imu_scale_sigma;  // after the grade, which sets the noise figures only
   o.imu.misalignment_sigma_rad = c.imu_misalignment_deg * M_PI / 180.0;
+  o.imu.vibration_acc_m_s2 *= c.vibration;  // scales the grade's (the default) amplitudes
+  o.imu.vibration_gyro_rad_s *= c.vibration;
   if (cli.given("bias-max")) {
     if (!(c.bias_max_m > 0.0 && c.bias_max_m <= 2.0)) throw std::invalid_argument("--bias-max must be in (0, 2] m");
     o.hardware.gamma_sigma_m = 0.375 * c.bias_max_m;  // the default 0.15 m for 0.4 m

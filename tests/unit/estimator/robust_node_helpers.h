@@ -59,6 +59,9 @@ struct SweepScenario {
   double sigma_range_m = 0.15, outliers = 0.0, drop = 0.0;
   std::string imu_grade = "fc";
   double duration_s = 90.0;
+  /// Scale of the IMU's rotor vibration (meshnav_sim --vibration): 0 for the incidents of sweeps
+  /// drawn before the simulator had it (an airborne IMU that read like rest).
+  double vibration = 1.0;
 };
 
 inline sim::SimulationOptions simulationOptions(const SweepScenario& c) {
@@ -74,6 +77,8 @@ inline sim::SimulationOptions simulationOptions(const SweepScenario& c) {
   so.uwb.outlier_fraction = c.outliers;
   so.uwb.drop_fraction = c.drop;
   so.imu = sim::ImuNoiseOptions::forGrade(c.imu_grade);
+  so.imu.vibration_acc_m_s2 *= c.vibration;
+  so.imu.vibration_gyro_rad_s *= c.vibration;
   so.duration_s = c.duration_s;
   return so;
 }

@@ -38,6 +38,7 @@ struct Flight {
     o.gyro_noise_density = gyro_noise;
     o.acc_bias_rw = o.gyro_bias_rw = 0.0;
     o.acc_bias_initial_sigma = o.gyro_bias_initial_sigma = 0.0;
+    o.vibration_acc_m_s2 = o.vibration_gyro_rad_s = 0.0;  // white noise only: the aligner's own model
     imu = sim::ImuSimulator(o, 3).simulate(trajectory, trajectory.duration());
   }
 };

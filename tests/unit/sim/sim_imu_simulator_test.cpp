@@ -4,7 +4,9 @@
 #include <cmath>
 
 #include "sim/imu_simulator.h"
+#include "sim/hall.h"
 #include "sim/spiral_trajectory.h"
+#include "sim/walk_trajectory.h"
 #include "trajectory_checks.h"
 
 using namespace meshnav::sim;
@@ -116,4 +118,75 @@ TEST(SimImuSimulator, AxisErrorsScaleAndTiltTheReadingsAndLeaveTheOtherDrawsAsTh
   EXPECT_EQ(plain.initialAccBias(), axes.initialAccBias());
   EXPECT_EQ(plain.finalGyroBias(), axes.finalGyroBias());
   EXPECT_TRUE(plain.accAxes().isIdentity());
+}
+
+// Rotor vibration (issue 36 item 7): an airborne rotorcraft's IMU shakes, on the pad it does not,
+// a hand-carried rig never does; the tones alias far from 0 Hz, so they average out over a
+// fraction of a second and integrate to nothing a filter would notice.
+TEST(SimImuSimulator, RotorVibrationShakesAnAirborneImuOnlyAndAveragesOut) {
+  const SpiralTrajectory tr(TrajectoryOptions::randomized(1));
+  ImuNoiseOptions opt = ImuNoiseOptions::noiseless();
+  opt.vibration_acc_m_s2 = 0.6;
+  opt.vibration_gyro_rad_s = 0.03;
+  ImuSimulator sim(opt, 3);
+  const auto imu = sim.simulate(tr, tr.duration());
+  const auto error = [&](size_t k) {
+    const auto ideal = ImuSimulator::ideal(tr.evaluate(imu[k].t.sec()));
+    return std::pair<Eigen::Vector3d, Eigen::Vector3d>(imu[k].acc_m_s2 - ideal.acc_m_s2,
+                                                       imu[k].gyro_rad_s - ideal.gyro_rad_s);
+  };
+  ASSERT_GT(tr.takeoffTime(), 1.0);
+  for (size_t k = 0; imu[k].t.sec() < tr.takeoffTime() - 0.1; ++k) {  // on the pad: motors off
+    EXPECT_LT(error(k).first.norm(), 1e-12);
+    EXPECT_LT(error(k).second.norm(), 1e-12);
+  }
+  // In the air, 40-45 s: per-axis RMS A_i/√2 with A_i in [0.5, 1.5] × the amplitude scale, and a
+  // mean over every 0.5 s window near zero (the tones alias to 30-90 Hz).
+  const size_t k0 = 40 * 200, k1 = 45 * 200;
+  Eigen::Vector3d ss_acc = Eigen::Vector3d::Zero(), ss_gyro = Eigen::Vector3d::Zero();
+  for (size_t w = k0; w < k1; w += 100) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (size_t k = w; k < w + 100; ++k) {
+      const auto [ea, eg] = error(k);
+      ss_acc += ea.cwiseAbs2();
+      ss_gyro += eg.cwiseAbs2();
+      mean += ea / 100.0;
+    }
+    EXPECT_LT(mean.cwiseAbs().maxCoeff(), 0.05) << "window at " << imu[w].t.sec() << " s";
+  }
+  const Eigen::Vector3d rms_acc = (ss_acc / static_cast<double>(k1 - k0)).cwiseSqrt();
+  const Eigen::Vector3d rms_gyro = (ss_gyro / static_cast<double>(k1 - k0)).cwiseSqrt();
+  EXPECT_GT(rms_acc.minCoeff(), 0.5 * 0.6 / std::sqrt(2.0) * 0.8);
+  EXPECT_LT(rms_acc.maxCoeff(), 1.5 * 0.6 / std::sqrt(2.0) * 1.2);
+  EXPECT_GT(rms_gyro.minCoeff(), 0.5 * 0.03 / std::sqrt(2.0) * 0.8);
+  EXPECT_LT(rms_gyro.maxCoeff(), 1.5 * 0.03 / std::sqrt(2.0) * 1.2);
+  // Integrated over 10 s of flight: a tone's integral leaves a velocity offset of at most
+  // A/(2π f_alias) (its starting phase), millimetres per second; far below what the IMU's own bias
+  // does (the default σ 0.05 m/s² alone: 0.5 m/s and 2.5 m in 10 s), so a tenth of that bounds it.
+  const size_t j0 = 60 * 200, j1 = 70 * 200;
+  const NavState x = integrate(imu, j0, j1, trueState(tr.evaluate(imu[j0].t.sec())));
+  const auto truth = tr.evaluate(imu[j1].t.sec());
+  EXPECT_LT((x.p - truth.p_IinG).norm(), 0.25);
+  EXPECT_LT((x.v - truth.v_IinG).norm(), 0.05);
+  EXPECT_LT(toQuat(x.q).angularDistance(truth.q_ItoG), 1e-3);
+}
+
+TEST(SimImuSimulator, AHandCarriedRigDoesNotVibrateAndVibrationLeavesTheOtherDrawsAsTheyWere) {
+  const WalkTrajectory walk(Hall::paper(), 30.0, 2);
+  ImuNoiseOptions opt = ImuNoiseOptions::noiseless();
+  opt.vibration_acc_m_s2 = 0.6;
+  opt.vibration_gyro_rad_s = 0.03;
+  ImuSimulator sim(opt, 3);
+  const auto imu = sim.simulate(walk, 10.0);
+  for (size_t k = 0; k < imu.size(); k += 50)
+    EXPECT_LT((imu[k].acc_m_s2 - ImuSimulator::ideal(walk.evaluate(imu[k].t.sec())).acc_m_s2).norm(), 1e-12);
+  // With the default noise: the same biases and the same readings on the pad, with or without.
+  const SpiralTrajectory tr(TrajectoryOptions::randomized(1));
+  ImuNoiseOptions still = ImuNoiseOptions{};
+  still.vibration_acc_m_s2 = still.vibration_gyro_rad_s = 0.0;
+  ImuSimulator a(ImuNoiseOptions{}, 7), b(still, 7);
+  const auto sa = a.simulate(tr, 10.0), sb = b.simulate(tr, 10.0);
+  EXPECT_EQ(a.finalAccBias(), b.finalAccBias());
+  EXPECT_EQ(sa[10].acc_m_s2, sb[10].acc_m_s2);
+  EXPECT_NE(sa.back().acc_m_s2, sb.back().acc_m_s2);  // airborne at 10 s
 }
