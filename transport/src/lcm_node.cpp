@@ -25,9 +25,7 @@ const std::vector<RetiredFingerprint>& retiredFingerprints() {
 
 std::string fingerprintMismatch(const lcm::ReceiveBuffer& rbuf, int64_t expected, const char* type_name) {
   if (rbuf.data_size < 8) return "";
-  uint64_t found = 0;
-  const auto* b = static_cast<const uint8_t*>(rbuf.data);
-  for (int i = 0; i < 8; ++i) found = (found << 8) | b[i];  // big endian, as LCM encodes it
+  const auto found = static_cast<uint64_t>(encodedFingerprint(rbuf.data, rbuf.data_size));
   if (static_cast<int64_t>(found) == expected) return "";
   for (const RetiredFingerprint& r : retiredFingerprints())
     if (static_cast<int64_t>(found) == r.hash)
