@@ -94,6 +94,7 @@ const Field kFields[] = {
 /// sets one is refused with this list's key, so an old config fails loudly instead of being ignored.
 const Field kModelParameters[] = {
     {"joseph_form", field<&EstimatorOptions::joseph_form>, "Joseph covariance update (false: P - K S K^T, symmetrized)"},
+    {"imu.hold_for_next_sample", field<&EstimatorOptions::imu, &ImuNoiseOptions::hold_for_next_sample>, "a measurement after the last IMU sample waits for the next one and is propagated on readings interpolated between the two (false: extrapolated at once)"},
     {"imu.extrapolate_max_period_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::extrapolate_max_period_s>, "readings between samples extrapolated when the last two are at most this far apart, else held; 0 = always held [s]"},
     {"imu.gap_sigma_acc_m_s2", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_sigma_acc_m_s2>, "error of the readings a gap is propagated on [m/s^2/sqrt(s)]"},
     {"imu.gap_sigma_gyro_rad_s", field<&EstimatorOptions::imu, &ImuNoiseOptions::gap_sigma_gyro_rad_s>, "error of the readings a gap is propagated on [rad/s/sqrt(s)]"},

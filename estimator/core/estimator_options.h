@@ -27,6 +27,14 @@ struct ImuNoiseOptions {
   /// samples when these are at most this far apart, else on the last one held (imu_readings.h):
   /// a slope over a longer span says nothing about the next few ms. 0: always held [s]
   double extrapolate_max_period_s = 0.02;
+  /// A measurement stamped after the last IMU sample waits for the next sample, so that its
+  /// propagation interpolates between known samples (EstimatorNode::holdForNextImu); false: it is
+  /// processed at once on extrapolated readings. Off by default for now: it removes the
+  /// rectification of a rotor's vibration (widened run001 0.098 → 0.061 m), but two robustness
+  /// cases (RobustNode.TheFirstRangesAfterARangeGap…, …OneTagLawnmowerOffTheMirrorImage) fail
+  /// with it and MILUV ifo002 goes 1.006 → 1.074 m (docs/modular_estimator.md, "Held for the
+  /// next sample").
+  bool hold_for_next_sample = false;
   /// Beyond `max_dt_s` after the last IMU sample the filter runs on the readings `gap_readings`
   /// says; their error is modelled as white noise of these densities (docs/robustness.md, "IMU gaps").
   double gap_sigma_acc_m_s2 = 1.0;    ///< [m/s²/√s]

@@ -33,6 +33,11 @@ void ImuPropagation::toSample(FusionStrategy& f, const ImuSample& s, const Input
 }
 
 void ImuPropagation::toTime(FusionStrategy& f, Timestamp t, const Inputs& in) const {
+  if (in.next_imu && in.last_imu && in.next_imu->t >= t &&
+      (in.next_imu->t - in.last_imu->t).sec() <= options_.max_dt_s) {
+    propagate(f, readingBetween(*in.last_imu, *in.next_imu, f.state().t, t), t, in);
+    return;
+  }
   propagate(f, readingPast(*in.last_imu, in.prev_imu, f.state().t, t, options_.extrapolate_max_period_s), t, in);
 }
 

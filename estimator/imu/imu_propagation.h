@@ -4,8 +4,13 @@
 /// (ImuNoiseOptions, docs/robustness.md "IMU gaps").
 ///
 /// Models:
-///  - **Between samples**: the readings interpolated to the middle of the step (readingBetween);
-///    to a measurement's time past the last sample, extrapolated along the last two samples
+///  - **Between samples**: the readings interpolated to the middle of the step (readingBetween),
+///    also to a measurement's time when the sample after it is known (`next_imu`: with
+///    `imu.hold_for_next_sample` the node holds a measurement until that sample comes). The two
+///    parts of a step cut at a measurement then integrate the samples' linear interpolant
+///    exactly, as the uncut step does.
+///  - **Past the last sample** (the default; with the hold only without a next sample within
+///    `imu.max_dt_s`: an IMU gap, the end of a stream): extrapolated along the last two samples
 ///    (readingPast, at most `imu.extrapolate_max_period_s`, its extra noise scale with it).
 ///  - **Extra white noise**: the innovation-driven scale λ of the stated densities
 ///    (ProcessNoiseAdapter) adds (λ − 1 + λ s_u) σ² to the discrete noise of the step, s_u the
@@ -42,10 +47,15 @@ class ImuPropagation {
     const std::optional<ImuReading>& mean_reading;
     Eigen::Vector3d g_G;
     double lambda = 1.0;
+    /// The sample after a measurement's time, when known: the readings up to the measurement are
+    /// interpolated towards it instead of extrapolated past last_imu.
+    const ImuSample* next_imu = nullptr;
   };
   /// Propagates `f` to IMU sample `s` (readings interpolated between the last sample and `s`).
   void toSample(FusionStrategy& f, const ImuSample& s, const Inputs& in) const;
-  /// Propagates `f` to a measurement time `t` past the last IMU sample (readings extrapolated).
+  /// Propagates `f` to a measurement time `t` past the last IMU sample: readings interpolated
+  /// towards `in.next_imu` when it is at or after `t` and at most `imu.max_dt_s` after the last
+  /// sample, else extrapolated (readingPast).
   void toTime(FusionStrategy& f, Timestamp t, const Inputs& in) const;
   /// Propagates on readings `u` held over [filter time, t], with the gap model beyond
   /// `imu.max_dt_s` after the last sample.

@@ -6,7 +6,9 @@
 /// step's middle t_m = (t₀ + t₁)/2 for the step to be second-order accurate:
 /// - between two samples a, b (an IMU step, possibly cut by an earlier update at t₀ > t_a):
 ///     u(t_m) = u_a + (u_b − u_a) (t_m − t_a) / (t_b − t_a)                  (interpolated)
-/// - past the last sample k (a range or baro update before sample k+1 has come):
+/// - past the last sample k (a range or baro update before sample k+1 has come; with
+///   `imu.hold_for_next_sample` the node waits for k+1 and interpolates instead, and this is
+///   left for gaps and a stream's end):
 ///     u = u_k + w (u_k − u_{k−1}),  w = (min(t₀ − t_k, T) + min(t₁ − t_k, T)) / (2T),
 ///     T = t_k − t_{k−1}
 ///   (the middle of the step, each end taken at most one period T past t_k) when T is at most

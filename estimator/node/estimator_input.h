@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <iterator>
+#include <optional>
 #include <type_traits>
 #include <utility>
 #include <variant>
@@ -99,6 +100,31 @@ inline InputOrder inputOrder(const EstimatorInput& in) {
       },
       in);
   return o;
+}
+
+/// A measurement (range, baro, height): propagated to its own time, which may fall between two IMU
+/// samples (EstimatorNode holds it until the sample after it has come).
+inline bool isMeasurement(const EstimatorInput& in) {
+  return std::holds_alternative<RangeSample>(in) || std::holds_alternative<BaroSample>(in) ||
+         std::holds_alternative<HeightSample>(in);
+}
+
+/// The IMU sample after input `i` of a sequence in the canonical order (`at(j)` the j-th input,
+/// `n` inputs) when input `i` is a measurement and that sample comes at most `max_dt_s` after it;
+/// nullopt otherwise. It is what a measurement between two samples is propagated on
+/// (ImuPropagation::toTime), found the same way in every replay of a stored sequence as when the
+/// node held the measurement until that sample came.
+template <class At>
+std::optional<ImuSample> nextImuSample(size_t i, size_t n, At&& at, double max_dt_s) {
+  const EstimatorInput& in = at(i);
+  if (!isMeasurement(in)) return std::nullopt;
+  const Timestamp until = inputTime(in) + Duration::fromSec(max_dt_s);
+  for (size_t j = i + 1; j < n; ++j) {
+    const EstimatorInput& next = at(j);
+    if (inputTime(next) > until) break;
+    if (const auto* s = std::get_if<ImuSample>(&next)) return *s;
+  }
+  return std::nullopt;
 }
 
 /// All samples of a dataset (every input kind with a `kDataset`) merged into the canonical order

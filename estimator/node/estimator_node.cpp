@@ -118,6 +118,9 @@ void EstimatorNode::resetAll() {
   sensors_.baro.setReference(std::nullopt);
   instance_stats_.clear();
   outputs_.resetPose();
+  held_for_imu_.clear();
+  next_imu_.reset();
+  pending_next_imu_.reset();
 }
 
 void EstimatorNode::event(bool first, const std::string& kind, const std::string& message) {
@@ -159,7 +162,46 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     }
   }
   if (!imu_units_.fault().empty()) return;
+  // A measurement between two IMU samples waits for the second (heldForNextImu); an IMU sample
+  // releases the ones before it, with itself as their next sample.
+  if (holdForNextImu(in)) return;
+  if (const auto* s = std::get_if<ImuSample>(&in))
+    releaseHeld(*s);
+  else if (!held_for_imu_.empty() && cur_.last_imu &&
+           inputTime(in) > cur_.last_imu->t + Duration::fromSec(options_.imu.max_dt_s))
+    releaseHeld(std::nullopt);  // the IMU is in a gap: they are propagated on the gap's readings
+  accept(in);
+}
+
+bool EstimatorNode::holdForNextImu(const EstimatorInput& in) {
+  // Past imu.max_dt_s after the last sample the IMU is in a gap: no sample is due.
+  if (!options_.imu.hold_for_next_sample || !initialized() || !cur_.last_imu || !isMeasurement(in) ||
+      inputTime(in) <= cur_.last_imu->t || inputTime(in) > cur_.last_imu->t + Duration::fromSec(options_.imu.max_dt_s))
+    return false;
+  held_for_imu_.push_back(in);
+  return true;
+}
+
+void EstimatorNode::releaseHeld(const std::optional<ImuSample>& next) {
+  if (held_for_imu_.empty()) return;
+  std::deque<EstimatorInput> held;
+  held.swap(held_for_imu_);
+  for (const EstimatorInput& h : held) {
+    if (next && inputTime(h) > next->t) {
+      held_for_imu_.push_back(h);  // after this sample too: it waits for the next one
+      continue;
+    }
+    pending_next_imu_ = next;
+    accept(h);
+    pending_next_imu_.reset();
+  }
+}
+
+void EstimatorNode::flushHeld() { releaseHeld(std::nullopt); }
+
+void EstimatorNode::accept(const EstimatorInput& in) {
   const Timestamp t = inputTime(in);
+  const std::optional<Timestamp>& newest = timeline_.newest();
   init_.feed(in, *cur_.network, cur_.filter.get());
   if (std::holds_alternative<ImuSample>(in)) init_.pruneStillness(timeline_.oldestReplayUs(t.us));
   if (!initialized()) {
@@ -195,7 +237,9 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   if (pos == window.end()) {
     e.before = std::make_shared<const FilterContext>(cur_.copy());
     window.push_back(std::move(e));
+    next_imu_ = pending_next_imu_;
     process(window.back().input, true);
+    next_imu_.reset();
   } else {
     // Out of sequence: rewind to the snapshot before its place, re-process in order.
     diag_.count("out_of_sequence");
@@ -204,8 +248,9 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     cur_ = pos->before->copy();
     e.before = pos->before;
     auto it = window.insert(pos, std::move(e));
+    next_imu_ = nextImuInWindow(it);
     process(it->input, true);
-    replayAfter(it);
+    replayAfter(it);  // resets next_imu_
   }
   timeline_.advance(t);
   releaseReentryIfDue();
@@ -220,8 +265,21 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
 void EstimatorNode::replayAfter(InputTimeline::Window::iterator it) {
   for (++it; it != timeline_.window().end(); ++it) {
     it->before = std::make_shared<const FilterContext>(cur_.copy());
+    next_imu_ = nextImuInWindow(it);
     process(it->input, false);
   }
+  next_imu_.reset();
+}
+
+std::optional<ImuSample> EstimatorNode::nextImuInWindow(InputTimeline::Window::iterator it) const {
+  if (!options_.imu.hold_for_next_sample) return std::nullopt;  // first processing extrapolated: so do replays
+  const InputTimeline::Window& w = timeline_.window();
+  const size_t i = static_cast<size_t>(it - timeline_.window().begin());
+  std::optional<ImuSample> next = nextImuSample(i, w.size(), [&](size_t j) -> const EstimatorInput& { return w[j].input; },
+                                                options_.imu.max_dt_s);
+  // The last stored input: its next sample is the one being released (releaseHeld), if any.
+  if (!next && i + 1 == w.size() && isMeasurement(it->input)) next = pending_next_imu_;
+  return next;
 }
 
 void EstimatorNode::process(const EstimatorInput& in, bool first) {
@@ -254,7 +312,8 @@ void EstimatorNode::propagateTo(Timestamp t) {
 }
 
 ImuPropagation::Inputs EstimatorNode::propagationInputs() const {
-  return {cur_.last_imu, cur_.prev_imu, cur_.mean_reading, gravityG(), cur_.noise_adapter.scale()};
+  return {cur_.last_imu, cur_.prev_imu, cur_.mean_reading, gravityG(), cur_.noise_adapter.scale(),
+          next_imu_ ? &*next_imu_ : nullptr};
 }
 
 void EstimatorNode::processImu(const ImuSample& s, bool first) {

@@ -22,9 +22,12 @@
 /// - An input that comes a second time (same kind, time and ids: a network that duplicates
 ///   datagrams, a sender that retransmits) is dropped and counted ("RANGE:duplicate", ...), so a
 ///   range is never fused twice; keys are kept over the out-of-sequence window.
-/// - IMU samples propagate (inputs interpolated to the middle of the step); baro and range
+/// - IMU samples propagate (inputs interpolated to the middle of the step); baro, height and range
 ///   updates propagate to their own time with the readings extrapolated along the last two
-///   samples (propagateTo). While landed a
+///   samples (propagateTo), or, with `imu.hold_for_next_sample` (off by default), interpolated
+///   towards the IMU sample after them, for which a measurement past the last sample waits
+///   (holdForNextImu; not through a gap of `imu.max_dt_s`, nor past the stream's end: flushHeld).
+///   While landed a
 ///   zero-velocity update runs at `zupt.rate_hz` with the latest IMU reading.
 /// - ANCHOR_INIT and ESTIMATOR_CMD apply at max(their time, newest time).
 /// - Re-run on an anchor join (AnchorRerun, estimator/refine/anchor_rerun.h): inputs that leave the
@@ -115,6 +118,9 @@ class EstimatorNode : private RerunReplayer {
   void onAnchorInit(const AnchorInit& a) { onInput(a); }
   void onCommand(const EstimatorCommand& c) { onInput(c); }
   void onInput(const EstimatorInput& in);
+  /// Processes the measurements held for their next IMU sample on extrapolated readings (the end
+  /// of a stream: no sample will come). finishRerun does it first.
+  void flushHeld();
 
   bool initialized() const { return filter() != nullptr; }
   /// The current estimate (at the newest processed input), when initialized.
@@ -191,7 +197,8 @@ class EstimatorNode : private RerunReplayer {
   void applyAnchorInit(const AnchorInit& a, bool first);
   void applyCommand(const EstimatorCommand& c, bool first);
   /// Propagates to a measurement's time `t` past the last IMU sample, with the readings
-  /// extrapolated along the last two samples to the step's middle (readingPast, imu_readings.h).
+  /// interpolated towards next_imu_ when known, else extrapolated along the last two samples to
+  /// the step's middle (ImuPropagation::toTime, imu_readings.h).
   void propagateTo(Timestamp t);
   /// What ImuPropagation reads besides the filter (cur_'s samples, mean reading, g, λ).
   ImuPropagation::Inputs propagationInputs() const;
@@ -228,13 +235,34 @@ class EstimatorNode : private RerunReplayer {
   void applyHeldAnchors(Timestamp t);
   /// Re-processes the entries after `it` on cur_ (refreshing their snapshots), as replays do.
   void replayAfter(InputTimeline::Window::iterator it);
+  /// The next IMU sample of the stored input at `it` (nextImuSample), or for the newest one the
+  /// sample releasing it (releaseHeld).
+  std::optional<ImuSample> nextImuInWindow(InputTimeline::Window::iterator it) const;
+  /// With `imu.hold_for_next_sample`, a measurement stamped after the last IMU sample (by at most
+  /// `imu.max_dt_s`) is held until the sample after it has come (true: held). The two parts of the IMU step it cuts are then propagated on readings
+  /// interpolated between known samples, which integrate to the uncut step's: extrapolating the
+  /// first part instead integrates −(Δt/8)(u_{k+1} − 2u_k + u_{k−1}) more per cut step, and ranges
+  /// at a fixed phase of the IMU's period rectify a rotor's vibration into a steady drift
+  /// (docs/modular_estimator.md "Readings between IMU samples"). POSE is published at IMU samples,
+  /// so the wait delays no output.
+  bool holdForNextImu(const EstimatorInput& in);
+  /// Processes the held measurements up to `next`'s time with `next` as their next sample (all of
+  /// them on extrapolated readings when nullopt: an IMU gap, the end of the stream).
+  void releaseHeld(const std::optional<ImuSample>& next);
+  /// The input after the gates (time, duplicates, units) and the hold: initializers, window, filter.
+  void accept(const EstimatorInput& in);
   /// Every re-initialization of the pose (initialize, replaceImu): the timeline forgets what a
   /// rewind or a re-run could restore from before `t`, a running re-run is dropped, the health
   /// window restarts.
   void onReinitialized(Timestamp t);
   // RerunReplayer: the node re-processing stored inputs for AnchorRerun.
   FilterContext& replayContext() override { return cur_; }
-  void replay(const EstimatorInput& in) override { process(in, false); }
+  void replay(const EstimatorInput& in, const std::optional<ImuSample>& next_imu) override {
+    if (options_.imu.hold_for_next_sample) next_imu_ = next_imu;  // else extrapolated, as the first time
+    process(in, false);
+    next_imu_.reset();
+  }
+  double imuMaxStep_s() const override { return options_.imu.max_dt_s; }
   void replayAnchor(const AnchorInit& a) override { applyAnchorInit(a, false); }
   /// Releases the ranges held after a gap once uwb.reentry_hold_s passed (ReentryGate decides),
   /// then the node rewinds to the first held range and re-processes from there.
@@ -274,6 +302,12 @@ class EstimatorNode : private RerunReplayer {
   Resume resume_;  ///< resumeFrom's checkpoint, until the initialization
 
   FilterContext cur_;
+  /// Measurements waiting for the IMU sample after them (holdForNextImu), in arrival order.
+  std::deque<EstimatorInput> held_for_imu_;
+  /// The IMU sample after the input being processed, when known (propagateTo); set around process().
+  std::optional<ImuSample> next_imu_;
+  /// The sample releasing the held measurements (releaseHeld), while it does.
+  std::optional<ImuSample> pending_next_imu_;
   InputTimeline timeline_;
   AnchorRerun rerun_;
   std::map<SensorId, InstanceStatus> instance_stats_;

@@ -145,7 +145,9 @@ RerunResult AnchorRerun::compute(RerunJob job, RerunReplayer& replayer, const st
       break;
     }
     if (job.keep_before[i]) r.before.emplace(job.keys[i], std::make_shared<const FilterContext>(cur.copy()));
-    replayer.replay(job.inputs[i]);
+    replayer.replay(job.inputs[i], nextImuSample(i, job.inputs.size(), [&](size_t j) -> const EstimatorInput& {
+      return job.inputs[j];
+    }, replayer.imuMaxStep_s()));
   }
   r.t_end = cur.filter->state().t;
   r.state = std::move(cur);
@@ -186,15 +188,20 @@ std::optional<int64_t> AnchorRerun::apply(RerunResult& r, std::optional<InputOrd
   for (size_t i = 0; i < h; ++i) window[i].before = std::move(window_snap[i]);
   FilterContext& cur = live.replayContext();
   cur = resume ? resume->copy() : std::move(r.state);
+  // The stored inputs as one sequence (archive, then window): a measurement's next IMU sample may be
+  // the window's first.
+  const size_t na = archive.size(), n_all = na + window.size();
+  auto at = [&](size_t j) -> const EstimatorInput& { return j < na ? archive[j].input : window[j - na].input; };
+  auto next = [&](size_t j) { return nextImuSample(j, n_all, at, live.imuMaxStep_s()); };
   int64_t n = 0;
-  for (size_t i = a; i < archive.size(); ++i, ++n) {
+  for (size_t i = a; i < na; ++i, ++n) {
     if (archive[i].checkpoint && archive[i].key != r.base_key)
       archive[i].checkpoint = std::make_shared<const FilterContext>(cur.copy());
-    live.replay(archive[i].input);
+    live.replay(archive[i].input, next(i));
   }
   for (size_t i = h; i < window.size(); ++i, ++n) {
     window[i].before = std::make_shared<const FilterContext>(cur.copy());
-    live.replay(window[i].input);
+    live.replay(window[i].input, next(na + i));
   }
   return n;
 }

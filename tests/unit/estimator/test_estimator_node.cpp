@@ -221,6 +221,7 @@ TEST(EstimatorNode, AnchorInitAddsAnEstimatedAnchorThatIsRefined) {
   EXPECT_EQ(node.filter()->state().values<AnchorKind>().count(106), 0u);
   RangeSample r{node.filter()->state().t + Duration::fromMs(1), 100, 106, UwbType::Tag, UwbType::Anchor, 4.0, 4.0, 0.01, true};
   node.onRange(r);
+  node.flushHeld();  // stamped after the last IMU sample, it waits for the next one until then
   EXPECT_EQ(node.diagnostics().get("unknown_id"), unknown_before + 1);
 }
 
@@ -398,4 +399,60 @@ TEST(EstimatorNode, ACorrectedRangeFarFromTheRawOneIsBadInputWhenUsed) {
   r.range_corr_m = 3.85;  // a correction of 0.15 m
   node.onRange(r);
   EXPECT_EQ(node.diagnostics().get("bad_input"), 1);
+}
+
+TEST(EstimatorNode, AMeasurementAfterTheLastImuSampleWaitsForTheNextOneButNotThroughAGap) {
+  const Dataset ds = synthetic::makeSyntheticDataset(test::shortNoisyFlight(1));
+  const auto inputs = mergeInTimeOrder(ds);
+  EstimatorOptions opt = test::testOptions();
+  opt.imu.hold_for_next_sample = true;
+  EstimatorNode node(opt, ds.setup);
+  // Up to the first range after 6 s that falls between two IMU samples.
+  size_t i = 0;
+  for (; i < inputs.size(); ++i) {
+    const auto* r = std::get_if<RangeSample>(&inputs[i]);
+    if (r && r->t.sec() > 6.0 && node.initialized() && r->t > node.filter()->state().t) break;
+    node.onInput(inputs[i]);
+  }
+  ASSERT_LT(i, inputs.size());
+  ASSERT_TRUE(node.initialized());
+  const Timestamp last_imu_t = node.filter()->state().t;
+  const Timestamp range_t = inputTime(inputs[i]);
+  node.onInput(inputs[i]);
+  // Held: the filter stays at the last sample until the next one has come.
+  EXPECT_EQ(node.filter()->state().t, last_imu_t);
+  size_t j = i + 1;
+  for (; !std::holds_alternative<ImuSample>(inputs[j]); ++j) node.onInput(inputs[j]);
+  auto updates = [&node] {
+    int64_t n = 0;
+    for (const auto& s : node.status().instances) n += s.n_updates;
+    return n;
+  };
+  const int64_t updates_before = updates();
+  node.onInput(inputs[j]);  // the next sample releases it, then propagates to itself
+  EXPECT_EQ(node.filter()->state().t, inputTime(inputs[j]));
+  EXPECT_GT(updates(), updates_before);
+  EXPECT_GT(inputTime(inputs[j]), range_t);
+
+  // The end of a stream: flushHeld processes what waits.
+  size_t k = j + 1;
+  for (; !std::holds_alternative<RangeSample>(inputs[k]); ++k) node.onInput(inputs[k]);
+  ASSERT_GT(inputTime(inputs[k]), node.filter()->state().t);
+  node.onInput(inputs[k]);
+  EXPECT_LT(node.filter()->state().t, inputTime(inputs[k]));
+  node.flushHeld();
+  EXPECT_EQ(node.filter()->state().t, inputTime(inputs[k]));
+  j = k;
+
+  // The IMU stops: the ranges after it wait at most imu.max_dt_s, then go on the gap's readings.
+  const Timestamp imu_end = node.filter()->state().t;
+  Timestamp last_range_t = imu_end;
+  for (size_t k = j + 1; k < inputs.size() && inputTime(inputs[k]) < imu_end + Duration::fromSec(0.3); ++k)
+    if (const auto* r = std::get_if<RangeSample>(&inputs[k])) {
+      node.onInput(*r);
+      last_range_t = r->t;
+    }
+  ASSERT_GT((last_range_t - imu_end).sec(), 0.25);
+  // No sample is due in a gap: the ranges past imu.max_dt_s are processed at once.
+  EXPECT_EQ(node.filter()->state().t, last_range_t);
 }

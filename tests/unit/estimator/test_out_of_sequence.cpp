@@ -24,10 +24,14 @@ synthetic::SyntheticOptions scenario() {
 
 }  // namespace
 
-TEST(OutOfSequence, DelayedInputsEqualInOrderProcessing) {
+/// Delayed arrival against in-order processing; `hold`: measurements wait for the IMU sample after
+/// them (imu.hold_for_next_sample), which a rewind finds again in the stored inputs.
+void expectDelayedInputsEqualInOrderProcessing(bool hold) {
   const Dataset ds = synthetic::makeSyntheticDataset(scenario());
   const auto inputs = mergeInTimeOrder(ds);
-  EstimatorNode in_order(test::testOptions(), ds.setup);
+  EstimatorOptions options = test::testOptions();
+  options.imu.hold_for_next_sample = hold;
+  EstimatorNode in_order(options, ds.setup);
   for (const auto& in : inputs) in_order.onInput(in);
   ASSERT_TRUE(in_order.initialized());
 
@@ -44,7 +48,7 @@ TEST(OutOfSequence, DelayedInputsEqualInOrderProcessing) {
     arrivals.emplace_back(inputTime(in).sec() + d, in);
   }
   std::stable_sort(arrivals.begin(), arrivals.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  EstimatorNode delayed(test::testOptions(), ds.setup);
+  EstimatorNode delayed(options, ds.setup);
   for (const auto& [t, in] : arrivals) delayed.onInput(in);
 
   ASSERT_TRUE(delayed.initialized());
@@ -62,6 +66,12 @@ TEST(OutOfSequence, DelayedInputsEqualInOrderProcessing) {
     fused += a[i].n_updates;
   }
   EXPECT_GT(fused, 100);
+}
+
+TEST(OutOfSequence, DelayedInputsEqualInOrderProcessing) { expectDelayedInputsEqualInOrderProcessing(false); }
+
+TEST(OutOfSequence, DelayedInputsEqualInOrderProcessingWithMeasurementsHeldForTheNextImuSample) {
+  expectDelayedInputsEqualInOrderProcessing(true);
 }
 
 TEST(OutOfSequence, TooOldInputIsRejectedAndCounted) {
