@@ -17,8 +17,9 @@ void EstimatorNode::releaseReentryIfDue() {
     diag_.count("range_reentry_lost");  // cannot happen with reentry_hold_s <= window_s; counted if it does
   } else {
     cur_ = it->before->copy();
+    next_imu_ = nextImuInWindow(it);
     process(it->input, false);
-    replayAfter(it);
+    replayAfter(it);  // resets next_imu_
   }
   // Fates are needed while a rewind or a re-run may replay their range; rejected ones as long as a re-run.
   const double keep_s = std::max(options_.window_s, rerun_.enabled() ? options_.refine.max_history_s : 0.0);
