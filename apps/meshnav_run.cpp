@@ -332,6 +332,7 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
   int code = 0;
   for (size_t v = 0; v < runs.size(); ++v) {
     EstimatorNode& node = pipe.estimator(v);
+    node.flushHeld();    // the end of the stream: no IMU sample will come for what waits for one
     node.finishRerun();  // refine.rerun_mode async: a re-run still on its worker comes in before the final anchors
     if (node.initialized())
       for (const auto& a : node.anchors()) runs[v].anchors->write(a);

@@ -165,11 +165,15 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
   // A measurement between two IMU samples waits for the second (heldForNextImu); an IMU sample
   // releases the ones before it, with itself as their next sample.
   if (holdForNextImu(in)) return;
-  if (const auto* s = std::get_if<ImuSample>(&in))
-    releaseHeld(*s);
-  else if (!held_for_imu_.empty() && cur_.last_imu &&
-           inputTime(in) > cur_.last_imu->t + Duration::fromSec(options_.imu.max_dt_s))
-    releaseHeld(std::nullopt);  // the IMU is in a gap: they are propagated on the gap's readings
+  if (const auto* s = std::get_if<ImuSample>(&in)) {
+    releaseHeld(*s, false);  // those before it, with it as their next sample
+    accept(in);
+    releaseHeld(*s, true);  // those at its time come after it in the canonical order
+    return;
+  }
+  if (!held_for_imu_.empty() && cur_.last_imu &&
+      inputTime(in) > cur_.last_imu->t + Duration::fromSec(options_.imu.max_dt_s))
+    releaseHeld(std::nullopt, true);  // the IMU is in a gap: they are propagated on the gap's readings
   accept(in);
 }
 
@@ -182,22 +186,36 @@ bool EstimatorNode::holdForNextImu(const EstimatorInput& in) {
   return true;
 }
 
-void EstimatorNode::releaseHeld(const std::optional<ImuSample>& next) {
+void EstimatorNode::releaseHeld(const std::optional<ImuSample>& next, bool at_its_time) {
   if (held_for_imu_.empty()) return;
   std::deque<EstimatorInput> held;
   held.swap(held_for_imu_);
+  // In the canonical order, as they would have come in order (arrival may have swapped two).
+  std::stable_sort(held.begin(), held.end(),
+                   [](const EstimatorInput& a, const EstimatorInput& b) { return inputOrder(a) < inputOrder(b); });
   for (const EstimatorInput& h : held) {
-    if (next && inputTime(h) > next->t) {
-      held_for_imu_.push_back(h);  // after this sample too: it waits for the next one
+    if (next && (inputTime(h) > next->t || (inputTime(h) == next->t) != at_its_time)) {
+      held_for_imu_.push_back(h);  // not released by this call: it waits
       continue;
     }
-    pending_next_imu_ = next;
+    // At the sample's own time the sample is the last one: nothing to interpolate towards.
+    pending_next_imu_ = at_its_time ? std::nullopt : next;
     accept(h);
     pending_next_imu_.reset();
   }
 }
 
-void EstimatorNode::flushHeld() { releaseHeld(std::nullopt); }
+void EstimatorNode::flushHeld() { releaseHeld(std::nullopt, true); }
+
+std::optional<ImuSample> EstimatorNode::orReleasingSample(const EstimatorInput& in,
+                                                          std::optional<ImuSample> next) const {
+  if (next || !pending_next_imu_ || !isMeasurement(in)) return next;
+  // Nothing stored after `in` up to imu.max_dt_s: the sample being released, when it is after `in`.
+  const Timestamp t = inputTime(in);
+  if (pending_next_imu_->t >= t && pending_next_imu_->t <= t + Duration::fromSec(options_.imu.max_dt_s))
+    return pending_next_imu_;
+  return std::nullopt;
+}
 
 void EstimatorNode::accept(const EstimatorInput& in) {
   const Timestamp t = inputTime(in);
@@ -255,7 +273,9 @@ void EstimatorNode::accept(const EstimatorInput& in) {
   timeline_.advance(t);
   releaseReentryIfDue();
   // Anchors calibrated together arrive as consecutive ANCHOR_INITs: one re-run for all of them.
-  if (rerun_.pending() && !rerun_.running() && !std::holds_alternative<AnchorInit>(in)) startRerun();
+  // Not from a measurement being released: the re-run would end with it but without its sample.
+  if (rerun_.pending() && !rerun_.running() && !std::holds_alternative<AnchorInit>(in) && !pending_next_imu_)
+    startRerun();
   timeline_.retire(*newest - Duration::fromSec(options_.window_s));
   init_.pruneStillness(timeline_.oldestReplayUs(newest->us));
   updateHealth(*newest);
@@ -275,11 +295,10 @@ std::optional<ImuSample> EstimatorNode::nextImuInWindow(InputTimeline::Window::i
   if (!options_.imu.hold_for_next_sample) return std::nullopt;  // first processing extrapolated: so do replays
   const InputTimeline::Window& w = timeline_.window();
   const size_t i = static_cast<size_t>(it - timeline_.window().begin());
-  std::optional<ImuSample> next = nextImuSample(i, w.size(), [&](size_t j) -> const EstimatorInput& { return w[j].input; },
-                                                options_.imu.max_dt_s);
-  // The last stored input: its next sample is the one being released (releaseHeld), if any.
-  if (!next && i + 1 == w.size() && isMeasurement(it->input)) next = pending_next_imu_;
-  return next;
+  // After the stored inputs comes the sample being released (releaseHeld), if any.
+  return orReleasingSample(it->input, nextImuSample(i, w.size(), [&](size_t j) -> const EstimatorInput& {
+    return w[j].input;
+  }, options_.imu.max_dt_s));
 }
 
 void EstimatorNode::process(const EstimatorInput& in, bool first) {

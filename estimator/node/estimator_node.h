@@ -118,8 +118,8 @@ class EstimatorNode : private RerunReplayer {
   void onAnchorInit(const AnchorInit& a) { onInput(a); }
   void onCommand(const EstimatorCommand& c) { onInput(c); }
   void onInput(const EstimatorInput& in);
-  /// Processes the measurements held for their next IMU sample on extrapolated readings (the end
-  /// of a stream: no sample will come). finishRerun does it first.
+  /// Processes the measurements held for their next IMU sample on extrapolated readings: the end
+  /// of a stream, when no sample will come (meshnav_run and the process call it at their end).
   void flushHeld();
 
   bool initialized() const { return filter() != nullptr; }
@@ -246,9 +246,14 @@ class EstimatorNode : private RerunReplayer {
   /// (docs/modular_estimator.md "Readings between IMU samples"). POSE is published at IMU samples,
   /// so the wait delays no output.
   bool holdForNextImu(const EstimatorInput& in);
-  /// Processes the held measurements up to `next`'s time with `next` as their next sample (all of
-  /// them on extrapolated readings when nullopt: an IMU gap, the end of the stream).
-  void releaseHeld(const std::optional<ImuSample>& next);
+  /// Processes the held measurements, in the canonical order: before `next`'s time with `next` as
+  /// their next sample (`at_its_time` false, before `next` itself is processed), or at its time
+  /// (true, after it); all of them on extrapolated readings when `next` is nullopt (an IMU gap,
+  /// the end of the stream).
+  void releaseHeld(const std::optional<ImuSample>& next, bool at_its_time);
+  /// `next`, or when it is empty and `in` a measurement, the sample being released (releaseHeld)
+  /// if it comes at most imu.max_dt_s after `in`: what follows the stored inputs.
+  std::optional<ImuSample> orReleasingSample(const EstimatorInput& in, std::optional<ImuSample> next) const;
   /// The input after the gates (time, duplicates, units) and the hold: initializers, window, filter.
   void accept(const EstimatorInput& in);
   /// Every re-initialization of the pose (initialize, replaceImu): the timeline forgets what a
@@ -258,7 +263,7 @@ class EstimatorNode : private RerunReplayer {
   // RerunReplayer: the node re-processing stored inputs for AnchorRerun.
   FilterContext& replayContext() override { return cur_; }
   void replay(const EstimatorInput& in, const std::optional<ImuSample>& next_imu) override {
-    if (options_.imu.hold_for_next_sample) next_imu_ = next_imu;  // else extrapolated, as the first time
+    if (options_.imu.hold_for_next_sample) next_imu_ = orReleasingSample(in, next_imu);  // else extrapolated, as the first time
     process(in, false);
     next_imu_.reset();
   }

@@ -40,7 +40,6 @@ void EstimatorNode::applyHeldAnchors(Timestamp t) {
 }
 
 void EstimatorNode::finishRerun() {
-  flushHeld();
   while (rerun_.running()) {
     rerun_.poll(true, timeline_, *this);
     if (rerun_.pending() && initialized()) startRerun();  // the re-run queued behind it

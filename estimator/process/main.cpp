@@ -89,6 +89,7 @@ class EstimatorProcess {
   void finish() {
     // A re-run done on its worker comes in before the final anchors; one still running is dropped
     // (waiting could outlast the supervisor's stop timeout under a sanitizer).
+    node_.flushHeld();  // measurements waiting for an IMU sample that will not come
     node_.stopRerun();
     if (node_.initialized()) lcm_.publish(channels::kAnchors, node_.anchors());
     const EstimatorStatus st = process_.stamped(node_.status());

@@ -416,43 +416,53 @@ TEST(EstimatorNode, AMeasurementAfterTheLastImuSampleWaitsForTheNextOneButNotThr
   }
   ASSERT_LT(i, inputs.size());
   ASSERT_TRUE(node.initialized());
+  // Measurements fused or gated so far, over every instance.
+  auto fates = [&node] {
+    int64_t n = 0;
+    for (const auto& s : node.status().instances) n += s.n_updates + s.n_rejected;
+    return n;
+  };
   const Timestamp last_imu_t = node.filter()->state().t;
   const Timestamp range_t = inputTime(inputs[i]);
+  const int64_t fates_before = fates();
   node.onInput(inputs[i]);
-  // Held: the filter stays at the last sample until the next one has come.
+  // Held: the filter stays at the last sample until the next one has come, the range undecided.
   EXPECT_EQ(node.filter()->state().t, last_imu_t);
   size_t j = i + 1;
   for (; !std::holds_alternative<ImuSample>(inputs[j]); ++j) node.onInput(inputs[j]);
-  auto updates = [&node] {
-    int64_t n = 0;
-    for (const auto& s : node.status().instances) n += s.n_updates;
-    return n;
-  };
-  const int64_t updates_before = updates();
+  EXPECT_EQ(fates(), fates_before);
   node.onInput(inputs[j]);  // the next sample releases it, then propagates to itself
   EXPECT_EQ(node.filter()->state().t, inputTime(inputs[j]));
-  EXPECT_GT(updates(), updates_before);
+  EXPECT_GT(fates(), fates_before);
   EXPECT_GT(inputTime(inputs[j]), range_t);
 
   // The end of a stream: flushHeld processes what waits.
   size_t k = j + 1;
   for (; !std::holds_alternative<RangeSample>(inputs[k]); ++k) node.onInput(inputs[k]);
   ASSERT_GT(inputTime(inputs[k]), node.filter()->state().t);
+  const int64_t fates_before_flush = fates();
   node.onInput(inputs[k]);
   EXPECT_LT(node.filter()->state().t, inputTime(inputs[k]));
   node.flushHeld();
   EXPECT_EQ(node.filter()->state().t, inputTime(inputs[k]));
+  EXPECT_GT(fates(), fates_before_flush);
   j = k;
 
   // The IMU stops: the ranges after it wait at most imu.max_dt_s, then go on the gap's readings.
   const Timestamp imu_end = node.filter()->state().t;
   Timestamp last_range_t = imu_end;
+  const int64_t fates_before_gap = fates();
+  int tag_ranges = 0;
   for (size_t k = j + 1; k < inputs.size() && inputTime(inputs[k]) < imu_end + Duration::fromSec(0.3); ++k)
     if (const auto* r = std::get_if<RangeSample>(&inputs[k])) {
       node.onInput(*r);
       last_range_t = r->t;
+      tag_ranges += ds.setup.isTag(r->id_initiator) != ds.setup.isTag(r->id_responder);
     }
   ASSERT_GT((last_range_t - imu_end).sec(), 0.25);
-  // No sample is due in a gap: the ranges past imu.max_dt_s are processed at once.
+  ASSERT_GE(tag_ranges, 5);
+  // No sample is due in a gap: the ranges past imu.max_dt_s are processed at once, and those
+  // held before it was clear have been released: every tag range has its fate.
   EXPECT_EQ(node.filter()->state().t, last_range_t);
+  EXPECT_GE(fates() - fates_before_gap, tag_ranges);
 }
