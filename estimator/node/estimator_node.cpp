@@ -12,6 +12,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <iterator>
 #include <chrono>
 #include <cmath>
 
@@ -255,7 +256,7 @@ void EstimatorNode::accept(const EstimatorInput& in) {
   if (pos == window.end()) {
     e.before = std::make_shared<const FilterContext>(cur_.copy());
     window.push_back(std::move(e));
-    next_imu_ = pending_next_imu_;
+    next_imu_ = nextImuInWindow(std::prev(window.end()));
     process(window.back().input, true);
     next_imu_.reset();
   } else {

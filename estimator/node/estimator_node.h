@@ -267,7 +267,9 @@ class EstimatorNode : private RerunReplayer {
     process(in, false);
     next_imu_.reset();
   }
-  double imuMaxStep_s() const override { return options_.imu.max_dt_s; }
+  std::optional<double> nextImuSpan_s() const override {
+    return options_.imu.hold_for_next_sample ? std::optional<double>(options_.imu.max_dt_s) : std::nullopt;
+  }
   void replayAnchor(const AnchorInit& a) override { applyAnchorInit(a, false); }
   /// Releases the ranges held after a gap once uwb.reentry_hold_s passed (ReentryGate decides),
   /// then the node rewinds to the first held range and re-processes from there.

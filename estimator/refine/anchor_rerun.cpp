@@ -139,15 +139,16 @@ RerunResult AnchorRerun::compute(RerunJob job, RerunReplayer& replayer, const st
     replayer.replayAnchor(a);
     r.ids += (r.ids.empty() ? "" : ", ") + std::to_string(a.id);
   }
+  const std::optional<double> span_s = replayer.nextImuSpan_s();
   for (size_t i = 0; i < job.inputs.size(); ++i) {
     if (cancel.load(std::memory_order_relaxed)) {
       r.cancelled = true;
       break;
     }
     if (job.keep_before[i]) r.before.emplace(job.keys[i], std::make_shared<const FilterContext>(cur.copy()));
-    replayer.replay(job.inputs[i], nextImuSample(i, job.inputs.size(), [&](size_t j) -> const EstimatorInput& {
+    replayer.replay(job.inputs[i], span_s ? nextImuSample(i, job.inputs.size(), [&](size_t j) -> const EstimatorInput& {
       return job.inputs[j];
-    }, replayer.imuMaxStep_s()));
+    }, *span_s) : std::nullopt);
   }
   r.t_end = cur.filter->state().t;
   r.state = std::move(cur);
@@ -192,7 +193,8 @@ std::optional<int64_t> AnchorRerun::apply(RerunResult& r, std::optional<InputOrd
   // the window's first.
   const size_t na = archive.size(), n_all = na + window.size();
   auto at = [&](size_t j) -> const EstimatorInput& { return j < na ? archive[j].input : window[j - na].input; };
-  auto next = [&](size_t j) { return nextImuSample(j, n_all, at, live.imuMaxStep_s()); };
+  const std::optional<double> span_s = live.nextImuSpan_s();
+  auto next = [&](size_t j) { return span_s ? nextImuSample(j, n_all, at, *span_s) : std::nullopt; };
   int64_t n = 0;
   for (size_t i = a; i < na; ++i, ++n) {
     if (archive[i].checkpoint && archive[i].key != r.base_key)

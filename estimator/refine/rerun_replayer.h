@@ -19,8 +19,9 @@ class RerunReplayer {
   /// Processes a stored input again (not counted, nothing published); `next_imu`: the IMU sample
   /// after it when it is a measurement (nextImuSample), which its propagation interpolates towards.
   virtual void replay(const EstimatorInput& in, const std::optional<ImuSample>& next_imu) = 0;
-  /// How far after a measurement its next IMU sample may come (`imu.max_dt_s`) [s].
-  virtual double imuMaxStep_s() const = 0;
+  /// How far after a measurement its next IMU sample is looked for (`imu.max_dt_s`) [s]; nullopt
+  /// when measurements are not propagated towards it (`imu.hold_for_next_sample` off).
+  virtual std::optional<double> nextImuSpan_s() const = 0;
   /// Adds a calibrated anchor with its loose prior at the re-run's start.
   virtual void replayAnchor(const AnchorInit& a) = 0;
 };

@@ -49,7 +49,7 @@ struct FakeReplayer final : RerunReplayer {
   std::vector<double> replayed_s;
   std::vector<AnchorInit> anchors;
   FilterContext& replayContext() override { return ctx; }
-  double imuMaxStep_s() const override { return 0.1; }
+  std::optional<double> nextImuSpan_s() const override { return std::nullopt; }
   void replay(const EstimatorInput& in, const std::optional<ImuSample>&) override {
     replayed_s.push_back(inputTime(in).sec());
     ctx.last_zupt = inputTime(in);

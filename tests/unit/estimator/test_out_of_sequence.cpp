@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <memory>
 #include <random>
 
 #include "node_test_helpers.h"
@@ -22,6 +23,30 @@ synthetic::SyntheticOptions scenario() {
   return o;
 }
 
+/// A node with `options` that has processed `inputs` in their order.
+std::unique_ptr<EstimatorNode> processedInOrder(const Dataset& ds, const EstimatorOptions& options,
+                                                const std::vector<EstimatorInput>& inputs) {
+  auto node = std::make_unique<EstimatorNode>(options, ds.setup);
+  for (const auto& in : inputs) node->onInput(in);
+  return node;
+}
+
+/// The same state (≤ 1e-9) and the same per-instance counts of first processing (the same
+/// measurements fused and gated); returns the number fused.
+int64_t expectSameEstimateAndCounts(const EstimatorNode& expected, const EstimatorNode& actual) {
+  EXPECT_LE(test::stateDifference(*expected.filter(), *actual.filter()), 1e-9);
+  const auto a = expected.status().instances, b = actual.status().instances;
+  EXPECT_EQ(a.size(), b.size());
+  int64_t fused = 0;
+  for (size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    EXPECT_EQ(a[i].id, b[i].id);
+    EXPECT_EQ(a[i].n_updates, b[i].n_updates) << "instance " << a[i].id;
+    EXPECT_EQ(a[i].n_rejected, b[i].n_rejected) << "instance " << a[i].id;
+    fused += a[i].n_updates;
+  }
+  return fused;
+}
+
 }  // namespace
 
 /// Delayed arrival against in-order processing; `hold`: measurements wait for the IMU sample after
@@ -31,9 +56,8 @@ void expectDelayedInputsEqualInOrderProcessing(bool hold) {
   const auto inputs = mergeInTimeOrder(ds);
   EstimatorOptions options = test::testOptions();
   options.imu.hold_for_next_sample = hold;
-  EstimatorNode in_order(options, ds.setup);
-  for (const auto& in : inputs) in_order.onInput(in);
-  ASSERT_TRUE(in_order.initialized());
+  const auto in_order = processedInOrder(ds, options, inputs);
+  ASSERT_TRUE(in_order->initialized());
 
   // Arrival = time + a random delay of up to 0.4 s for ranges and baro (other processes),
   // IMU and flight state on time: many inputs arrive after newer ones. The first 2 s (the static
@@ -54,18 +78,8 @@ void expectDelayedInputsEqualInOrderProcessing(bool hold) {
   ASSERT_TRUE(delayed.initialized());
   EXPECT_GT(delayed.diagnostics().get("out_of_sequence"), 100);
   EXPECT_EQ(delayed.diagnostics().get("rejected_too_old"), 0);
-  EXPECT_LE(test::stateDifference(*in_order.filter(), *delayed.filter()), 1e-9);
   // Both fused (and gated) the same measurements: per-instance counts of first processing agree.
-  const auto a = in_order.status().instances, b = delayed.status().instances;
-  ASSERT_EQ(a.size(), b.size());
-  int64_t fused = 0;
-  for (size_t i = 0; i < a.size(); ++i) {
-    EXPECT_EQ(a[i].id, b[i].id);
-    EXPECT_EQ(a[i].n_updates, b[i].n_updates) << "instance " << a[i].id;
-    EXPECT_EQ(a[i].n_rejected, b[i].n_rejected) << "instance " << a[i].id;
-    fused += a[i].n_updates;
-  }
-  EXPECT_GT(fused, 100);
+  EXPECT_GT(expectSameEstimateAndCounts(*in_order, delayed), 100);
 }
 
 TEST(OutOfSequence, DelayedInputsEqualInOrderProcessing) { expectDelayedInputsEqualInOrderProcessing(false); }
@@ -78,9 +92,8 @@ TEST(OutOfSequence, MeasurementsHeldForTheNextImuSampleAreProcessedInOrderWhatev
   const auto inputs = mergeInTimeOrder(ds);
   EstimatorOptions options = test::testOptions();
   options.imu.hold_for_next_sample = true;
-  EstimatorNode in_order(options, ds.setup);
-  for (const auto& in : inputs) in_order.onInput(in);
-  ASSERT_TRUE(in_order.initialized());
+  const auto in_order = processedInOrder(ds, options, inputs);
+  ASSERT_TRUE(in_order->initialized());
 
   std::vector<EstimatorInput> arrivals;
   std::vector<EstimatorInput> between;  // the inputs after the last IMU sample, reversed at the next
@@ -103,18 +116,11 @@ TEST(OutOfSequence, MeasurementsHeldForTheNextImuSampleAreProcessedInOrderWhatev
   for (const auto& in : between) arrivals.push_back(in);
   ASSERT_GT(reversed, 50);
   ASSERT_GT(flight_states_between, 100);
-  EstimatorNode delayed(options, ds.setup);
-  for (const auto& in : arrivals) delayed.onInput(in);
-  ASSERT_TRUE(delayed.initialized());
+  const auto delayed = processedInOrder(ds, options, arrivals);
+  ASSERT_TRUE(delayed->initialized());
   // Flight states are not measurements: they join the in-order run's result only through `landed`,
   // which the added ones (airborne, after 3.5 s, as the flight is) leave as it is.
-  EXPECT_LE(test::stateDifference(*in_order.filter(), *delayed.filter()), 1e-9);
-  const auto a = in_order.status().instances, b = delayed.status().instances;
-  ASSERT_EQ(a.size(), b.size());
-  for (size_t i = 0; i < a.size(); ++i) {
-    EXPECT_EQ(a[i].n_updates, b[i].n_updates) << "instance " << a[i].id;
-    EXPECT_EQ(a[i].n_rejected, b[i].n_rejected) << "instance " << a[i].id;
-  }
+  expectSameEstimateAndCounts(*in_order, *delayed);
 }
 
 TEST(OutOfSequence, DelayedInputsEqualInOrderProcessingWithMeasurementsHeldForTheNextImuSample) {
