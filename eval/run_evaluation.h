@@ -15,6 +15,15 @@
 
 namespace meshnav::eval {
 
+/// The smoother's estimate of the same run (estimate_smoothed.csv, meshnav smooth), scored as the
+/// filter's is (its own alignment fit when the mode aligns).
+struct SmoothedEvaluation {
+  std::vector<PoseEstimate> estimates;
+  std::optional<RigidTransform> alignment_transform;
+  std::vector<PoseError> errors;
+  TrajectoryMetrics trajectory;
+};
+
 struct RunEvaluation {
   std::string dataset_dir;
   std::string run_dir;
@@ -32,6 +41,7 @@ struct RunEvaluation {
   std::vector<PoseError> errors;   ///< every associated estimate (selection flags via isSelected)
   TrajectoryMetrics trajectory;
   std::optional<AnchorMetrics> anchors;  ///< nullopt without anchors.csv or truth.yaml
+  std::optional<SmoothedEvaluation> smoothed;  ///< when the run folder holds estimate_smoothed.csv
   std::map<std::string, int64_t> diagnostics;  ///< counters of bad input (Diagnostics::snapshot)
 };
 

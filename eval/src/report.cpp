@@ -154,6 +154,10 @@ std::string formatRunReport(const RunEvaluation& ev) {
     };
     row("position [m]", m.position, 3);
     row("orientation [deg]", m.orientation, 2);
+    if (ev.smoothed && ev.smoothed->trajectory.n_selected > 0) {
+      row("position [m], smoothed", ev.smoothed->trajectory.position, 3);
+      row("orientation [deg], smoothed", ev.smoothed->trajectory.orientation, 2);
+    }
     os << t.plain();
     os << "  (RMSE = √mean‖e‖², ARMSE = mean‖e‖ as cnspy's ARMSE; NEES is χ²(3) if consistent;\n"
        << "   ANEES over " << m.position.n_nees << " samples with covariance)\n\n";
@@ -206,10 +210,8 @@ YAML::Node metricsNode(const RunEvaluation& ev) {
       "rmse = sqrt(mean(|e|^2)); armse = mean(|e|) (cnspy ARMSE); nees = e^T P^-1 e (3 dof); "
       "anees_bounds = two-sided chi2(3n)/n interval at the given confidence";
   addAlignmentAndBaseline(root, ev);
-  const auto& m = ev.trajectory;
-  if (m.n_selected == 0) {
-    root["pose"] = YAML::Node(YAML::NodeType::Null);
-  } else {
+  auto poseNode = [](const TrajectoryMetrics& m) {
+    if (m.n_selected == 0) return YAML::Node(YAML::NodeType::Null);
     YAML::Node p;
     p["n_associated"] = m.n_associated;
     p["n_evaluated"] = m.n_selected;
@@ -217,8 +219,11 @@ YAML::Node metricsNode(const RunEvaluation& ev) {
     p["t_last_s"] = timeNum(m.t_last_s);
     p["position"] = statsNode(m.position, "m");
     p["orientation"] = statsNode(m.orientation, "deg");
-    root["pose"] = p;
-  }
+    return p;
+  };
+  root["pose"] = poseNode(ev.trajectory);
+  // The smoother's estimate of the same run (estimate_smoothed.csv), when there is one.
+  if (ev.smoothed && ev.smoothed->trajectory.n_selected > 0) root["pose_smoothed"] = poseNode(ev.smoothed->trajectory);
   if (!ev.anchors) {
     root["anchors"] = YAML::Node(YAML::NodeType::Null);
   } else {

@@ -249,6 +249,24 @@ RunEvaluation evaluateRun(const std::string& dataset_dir, const std::string& run
   if (eff.skip_first_s > 0.0 && ev.trajectory.n_selected == 0 && !ev.errors.empty())
     note(ev, "--skip " + std::to_string(eff.skip_first_s) + " s leaves no sample");
 
+  if (!run_dir.empty() && ev.has_ground_truth && fs::exists(run / "estimate_smoothed.csv")) {
+    try {
+      SmoothedEvaluation sm;
+      sm.estimates = readEstimateCsv((run / "estimate_smoothed.csv").string(), diag);
+      std::stable_sort(sm.estimates.begin(), sm.estimates.end(),
+                       [](const PoseEstimate& a, const PoseEstimate& b) { return a.t < b.t; });
+      if (!sm.estimates.empty()) {
+        sm.alignment_transform = alignToGroundTruth(sm.estimates, ev.ground_truth, ev.alignment, options.max_gt_gap_s);
+        sm.errors = associate(sm.estimates, ev.ground_truth, flight, options, diag);
+        sm.trajectory = computeTrajectoryMetrics(sm.errors, eff);
+        ev.smoothed = std::move(sm);
+      } else {
+        note(ev, (run / "estimate_smoothed.csv").string() + ": no valid rows");
+      }
+    } catch (const std::exception& ex) {
+      note(ev, std::string("cannot read the smoothed estimate: ") + ex.what());
+    }
+  }
   if (!run_dir.empty()) evaluateAnchors(ev, run, calibration_yaml, truth, known, diag);
   ev.diagnostics = diag.snapshot();
   return ev;

@@ -1,0 +1,177 @@
+/// @file test_batch_smoother.cpp
+/// @brief The whole-recording smoother on the analytic scenario (estimator/testing): exact answers
+/// from noise-free data and a poor start, outliers under the robust loss, an anchor frame with z
+/// down, a filter that re-initialized, and the consistency of its covariance on noisy data.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "estimator/core/so3.h"
+#include "estimator/testing/synthetic_scenario.h"
+#include "smoother/run_smoother.h"
+
+using namespace meshnav;
+using namespace meshnav::smoother;
+using estimator::so3::expMap;
+using estimator::so3::logMap;
+namespace syn = meshnav::estimator::synthetic;
+
+namespace {
+
+/// A filter run made of the truth with slow errors (a drifting offset and tilt), as a filter's
+/// poses look, with a covariance that covers them.
+FilterRun perturbedRun(const Dataset& ds, double offset_m, double angle_deg) {
+  FilterRun run;
+  for (size_t i = 0; i < ds.ground_truth.size(); i += 2) {
+    const auto& g = ds.ground_truth[i];
+    const double t = g.t.sec();
+    PoseEstimate e;
+    e.t = g.t;
+    e.p_IinG = g.p_IinG + offset_m * Eigen::Vector3d(std::sin(0.3 * t), std::cos(0.2 * t), 0.5 * std::sin(0.1 * t));
+    const Eigen::Vector3d tilt = angle_deg * M_PI / 180.0 * Eigen::Vector3d(std::cos(0.25 * t), 0.5, std::sin(0.15 * t)).normalized();
+    e.q_ItoG = Eigen::Quaterniond(g.q_ItoG.toRotationMatrix() * expMap(tilt));
+    e.cov_p_m2 = Eigen::Matrix3d::Identity() * std::pow(std::max(offset_m, 0.01), 2);
+    e.cov_theta_rad2 = Eigen::Matrix3d::Identity() * std::pow(std::max(angle_deg, 0.5) * M_PI / 180.0, 2);
+    run.poses.push_back(e);
+  }
+  return run;
+}
+
+struct Errors {
+  double pos_rms_m = 0.0, ori_rms_deg = 0.0, anees_p = 0.0;
+};
+
+Errors errorsAgainstTruth(const Dataset& ds, const SmoothedRun& sm) {
+  Errors e;
+  size_t j = 0;
+  int n = 0;
+  for (const auto& p : sm.poses) {
+    while (j < ds.ground_truth.size() && ds.ground_truth[j].t < p.t) ++j;
+    if (j >= ds.ground_truth.size() || ds.ground_truth[j].t != p.t) continue;
+    const auto& g = ds.ground_truth[j];
+    const Eigen::Vector3d dp = p.p_IinG - g.p_IinG;
+    e.pos_rms_m += dp.squaredNorm();
+    e.ori_rms_deg += logMap(Eigen::Matrix3d(g.q_ItoG.toRotationMatrix().transpose() * p.q_ItoG.toRotationMatrix())).squaredNorm();
+    e.anees_p += dp.dot(p.cov_p_m2.inverse() * dp);
+    ++n;
+  }
+  EXPECT_GT(n, 100);
+  e.pos_rms_m = std::sqrt(e.pos_rms_m / n);
+  e.ori_rms_deg = std::sqrt(e.ori_rms_deg / n) * 180.0 / M_PI;
+  e.anees_p /= n;
+  return e;
+}
+
+/// Noise-free data: the smoothed trajectory is the true one (to the solver's tolerance).
+void expectExact(const Dataset& ds, const SmoothedRun& sm) {
+  const Errors e = errorsAgainstTruth(ds, sm);
+  EXPECT_LT(e.pos_rms_m, 0.005);
+  EXPECT_LT(e.ori_rms_deg, 0.05);
+}
+
+syn::SyntheticOptions scenario(bool noise) {
+  syn::SyntheticOptions o;
+  o.duration_s = 30.0;
+  o.pair_rate_hz = 5.0;
+  o.anchor_to_anchor = false;
+  o.noise = noise;
+  o.seed = 3;
+  return o;
+}
+
+}  // namespace
+
+TEST(BatchSmoother, RecoversTheTrajectoryExactlyFromNoiseFreeDataAndAPoorStart) {
+  const Dataset ds = syn::makeSyntheticDataset(scenario(false));
+  const FilterRun run = perturbedRun(ds, 0.3, 5.0);
+  const SmoothedRun sm = smoothRun(ds, run, RunSmootherOptions{});
+  ASSERT_EQ(sm.chunks.size(), 1u);
+  EXPECT_TRUE(sm.chunks[0].result.converged) << sm.chunks[0].result.message;
+  EXPECT_TRUE(sm.chunks[0].result.covariance_ok);
+  EXPECT_EQ(sm.chunks[0].gravity_z_sign, -1.0);
+  expectExact(ds, sm);
+  EXPECT_EQ(sm.chunks[0].result.n_range_outliers, 0);
+}
+
+TEST(BatchSmoother, ChunksGiveTheSameTrajectoryAsOneSolve) {
+  const Dataset ds = syn::makeSyntheticDataset(scenario(false));
+  // Each chunk after the first starts from the filter's belief there: exact poses (σ 1 cm, 0.5°),
+  // so that the chunks' answer is the exact one too.
+  const FilterRun run = perturbedRun(ds, 0.0, 0.0);
+  RunSmootherOptions o;
+  o.chunk_s = 12.0;
+  o.overlap_s = 4.0;
+  const SmoothedRun sm = smoothRun(ds, run, o);
+  EXPECT_GE(sm.chunks.size(), 3u);
+  expectExact(ds, sm);
+  // Each output pose once, in order.
+  for (size_t i = 1; i < sm.poses.size(); ++i) EXPECT_LT(sm.poses[i - 1].t, sm.poses[i].t);
+  EXPECT_EQ(sm.poses.size(), run.poses.size());
+}
+
+TEST(BatchSmoother, HeavyTailedRangesDoNotPullTheTrajectory) {
+  Dataset ds = syn::makeSyntheticDataset(scenario(true));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  int n_out = 0;
+  for (auto& r : ds.ranges)
+    if (u01(rng) < 0.08) {  // NLOS excess: positive, 0.3–3 m
+      r.range_m += 0.3 + 2.7 * u01(rng);
+      ++n_out;
+    }
+  ASSERT_GT(n_out, 100);
+  const FilterRun run = perturbedRun(ds, 0.1, 2.0);
+  RunSmootherOptions robust;
+  const Errors e_robust = errorsAgainstTruth(ds, smoothRun(ds, run, robust));
+  RunSmootherOptions squared;  // a Huber loss whose corner no residual reaches: least squares
+  squared.solver.range_loss = BatchSmootherOptions::Loss::Huber;
+  squared.solver.loss_scale_sigmas = 1e6;
+  const Errors e_squared = errorsAgainstTruth(ds, smoothRun(ds, run, squared));
+  EXPECT_LT(e_robust.pos_rms_m, 0.04);
+  EXPECT_GT(e_squared.pos_rms_m, 2.0 * e_robust.pos_rms_m);
+}
+
+TEST(BatchSmoother, TheCovarianceIsConsistentOnNoisyData) {
+  const Dataset ds = syn::makeSyntheticDataset(scenario(true));
+  const Errors e = errorsAgainstTruth(ds, smoothRun(ds, perturbedRun(ds, 0.1, 2.0), RunSmootherOptions{}));
+  EXPECT_LT(e.pos_rms_m, 0.05);
+  // 3 if consistent; one 30 s trajectory's errors are correlated in time, so allow a wide band.
+  EXPECT_GT(e.anees_p, 1.0);
+  EXPECT_LT(e.anees_p, 6.0);
+}
+
+TEST(BatchSmoother, FindsGravityAlongPlusZInAnAnchorFrameWithZDown) {
+  Dataset ds = syn::makeSyntheticDataset(scenario(false));
+  // The same scene in a frame turned 180° about x: gravity along +z of it.
+  const Eigen::Matrix3d F = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+  for (auto& [id, p] : ds.setup.abs_anchor_positions) p = F * p;
+  for (auto& g : ds.ground_truth) {
+    g.p_IinG = F * g.p_IinG;
+    g.q_ItoG = Eigen::Quaterniond(F * g.q_ItoG.toRotationMatrix());
+  }
+  const SmoothedRun sm = smoothRun(ds, perturbedRun(ds, 0.2, 3.0), RunSmootherOptions{});
+  EXPECT_EQ(sm.chunks[0].gravity_z_sign, 1.0);
+  expectExact(ds, sm);
+}
+
+TEST(BatchSmoother, StartsFromTheGyroBeforeTheFiltersLastReinitialization) {
+  const Dataset ds = syn::makeSyntheticDataset(scenario(false));
+  FilterRun run = perturbedRun(ds, 0.1, 1.0);
+  // Until 15 s the filter's attitude was upside down (the wrong gravity), then it re-initialized.
+  const Eigen::Matrix3d flip = expMap(Eigen::Vector3d(M_PI, 0.0, 0.0));
+  for (auto& p : run.poses)
+    if (p.t.sec() < 15.0) p.q_ItoG = Eigen::Quaterniond(flip * p.q_ItoG.toRotationMatrix());
+  const SmoothedRun sm = smoothRun(ds, run, RunSmootherOptions{});
+  EXPECT_EQ(sm.chunks[0].reinit_jumps, 1);
+  expectExact(ds, sm);
+}
+
+TEST(BatchSmoother, RefusesARunWithoutPosesAndAProblemWithoutIMU) {
+  const Dataset ds = syn::makeSyntheticDataset(scenario(false));
+  EXPECT_THROW(smoothRun(ds, FilterRun{}, RunSmootherOptions{}), std::runtime_error);
+  Dataset no_imu = ds;
+  no_imu.imu.clear();
+  EXPECT_THROW(smoothRun(no_imu, perturbedRun(ds, 0.1, 1.0), RunSmootherOptions{}), std::runtime_error);
+}
