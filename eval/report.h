@@ -44,6 +44,8 @@ void writeMetricsJson(const RunEvaluation& ev, const std::string& path);
 /// errors.csv: t, position error xyz [m], its ±3σ [m], orientation error xyz [deg], its ±3σ
 /// [deg], NEES, and whether the sample entered the metrics.
 void writeErrorsCsv(const RunEvaluation& ev, const std::string& path);
+/// The same rows for the smoothed estimate (errors_smoothed.csv); nothing when there is none.
+void writeSmoothedErrorsCsv(const RunEvaluation& ev, const std::string& path);
 
 /// anchors_eval.csv: per anchor true, initial and final position, errors, NEES (for the plots).
 void writeAnchorsEvalCsv(const RunEvaluation& ev, const std::string& path);

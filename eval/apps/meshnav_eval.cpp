@@ -131,6 +131,7 @@ void writeOutputs(const RunEvaluation& ev, const fs::path& out, bool plots, cons
   fs::create_directories(out);
   writeMetricsYaml(ev, (out / "metrics.yaml").string());
   writeErrorsCsv(ev, (out / "errors.csv").string());
+  if (ev.smoothed) writeSmoothedErrorsCsv(ev, (out / "errors_smoothed.csv").string());
   writeAnchorsEvalCsv(ev, (out / "anchors_eval.csv").string());
   spdlog::info("wrote {}, errors.csv, anchors_eval.csv", (out / "metrics.yaml").string());
   if (!plots) return;
@@ -140,6 +141,9 @@ void writeOutputs(const RunEvaluation& ev, const fs::path& out, bool plots, cons
   const fs::path est = fs::path(ev.run_dir) / "estimate.csv";
   if (fs::exists(gt)) args.insert(args.end(), {"--groundtruth", gt.string()});
   if (fs::exists(est)) args.insert(args.end(), {"--estimate", est.string()});
+  if (ev.smoothed)
+    args.insert(args.end(), {"--smoothed", (fs::path(ev.run_dir) / "estimate_smoothed.csv").string(),
+                             "--smoothed-errors", (out / "errors_smoothed.csv").string()});
   const fs::path track = fs::path(ev.run_dir) / "anchors.csv";
   if (fs::exists(track)) args.insert(args.end(), {"--anchor-track", track.string()});
   // Truth in another frame: the plot draws it mapped into the estimate's frame with the fitted (R, t).

@@ -2,7 +2,8 @@
 """Plots of one evaluated meshnav run (called by meshnav_eval; usable alone).
 
 Writes into --out:
-  trajectory_xy.png      top view: true (blue) and estimated (purple) trajectory, anchors as in the
+  trajectory_xy.png      top view: true (blue) and estimated (purple) trajectory (with --smoothed the
+                         smoothed estimate of the same run in green), anchors as in the
                          paper's figures: true = black stars, initial estimate = blue triangles,
                          final estimate = green diamonds. With --alignment (the truth lives in
                          another frame) the truth is drawn mapped into the estimate's frame G,
@@ -11,6 +12,7 @@ Writes into --out:
   position_error.png     position error x/y/z (truth - estimate) [m] with +-3 sigma bounds
   orientation_error.png  orientation error x/y/z (local, Log(R_est^T R_true)) [deg] with +-3 sigma
   nees.png               NEES of position and orientation with the 95 % chi2(3) interval
+  position_error_smoothed.png  with --smoothed-errors: the smoothed estimate's position error
   anchor_errors.png      per estimated anchor with a true position: error norm [m] and NEES (3 dof,
                          log scale, 95 % interval and 99.7 % threshold) over time, from anchors.csv
   range_residuals.png    per anchor: tag-anchor range residual z - |p_IinG + R_ItoG p_TinI - p_AinG| [m]
@@ -245,8 +247,9 @@ def plot_anchors(ax, anchors, three_d=False):
             ax.annotate("%d" % int(aid), (x, y), textcoords="offset points", xytext=(6, 6), fontsize=8)
 
 
-def plot_trajectories(out, gt, est, anchors, aligned=None):
-    """`aligned`: the alignment mode when `gt` was mapped into the estimate's frame (legend)."""
+def plot_trajectories(out, gt, est, anchors, aligned=None, smoothed=None):
+    """`aligned`: the alignment mode when `gt` was mapped into the estimate's frame (legend);
+    `smoothed`: estimate_smoothed.csv of the same run (meshnav smooth), drawn beside the filter's."""
     true_label = "true" if not aligned else "true (%s-aligned)" % aligned
     fig, ax = plt.subplots(figsize=(7, 8))
     if gt is not None:
@@ -255,6 +258,9 @@ def plot_trajectories(out, gt, est, anchors, aligned=None):
     if est is not None:
         s = thin(len(est["t"]))
         ax.plot(est["tx"][s], est["ty"][s], color="tab:purple", lw=1.0, alpha=0.85, label="estimate")
+    if smoothed is not None:
+        s = thin(len(smoothed["t"]))
+        ax.plot(smoothed["tx"][s], smoothed["ty"][s], color="tab:green", lw=1.0, alpha=0.85, label="smoothed")
     plot_anchors(ax, anchors)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
@@ -275,6 +281,10 @@ def plot_trajectories(out, gt, est, anchors, aligned=None):
         s = thin(len(est["t"]))
         ax.plot(est["tx"][s], est["ty"][s], est["tz"][s], color="tab:purple", lw=0.9, alpha=0.85,
                 label="estimate")
+    if smoothed is not None:
+        s = thin(len(smoothed["t"]))
+        ax.plot(smoothed["tx"][s], smoothed["ty"][s], smoothed["tz"][s], color="tab:green", lw=0.9, alpha=0.85,
+                label="smoothed")
     plot_anchors(ax, anchors, three_d=True)
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
@@ -398,17 +408,20 @@ def main():
     ap.add_argument("--alignment-mode", default="se3", help="name of the alignment for the legend")
     ap.add_argument("--ranges", help="ranges.csv of the dataset (range residuals)")
     ap.add_argument("--setup", help="setup.yaml of the dataset (tag lever arms, known anchors)")
+    ap.add_argument("--smoothed", help="estimate_smoothed.csv of the run (meshnav smooth): drawn beside the estimate")
+    ap.add_argument("--smoothed-errors", help="errors_smoothed.csv from meshnav_eval: position_error_smoothed.png")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     gt = read_csv(args.groundtruth)
     est = read_csv(args.estimate)
     anchors = read_csv(args.anchors)
     err = read_csv(args.errors)
+    smoothed = read_csv(args.smoothed)
     written = []
     alignment = read_alignment(args.alignment) if args.alignment else None
     if gt is not None or est is not None:
         plot_trajectories(args.out, truth_in_estimate_frame(gt, alignment), est, anchors,
-                          args.alignment_mode if alignment is not None else None)
+                          args.alignment_mode if alignment is not None else None, smoothed)
         written += ["trajectory_xy.png", "trajectory_3d.png"]
     if err is not None:
         plot_errors(args.out, err, "ep", "sigma3_p", "m", "position_error.png",
@@ -417,6 +430,11 @@ def main():
                     "Orientation error Log(R_est^T R_true) (body frame) with ±3σ")
         plot_nees(args.out, err)
         written += ["position_error.png", "orientation_error.png", "nees.png"]
+    err_smoothed = read_csv(args.smoothed_errors)
+    if err_smoothed is not None:
+        plot_errors(args.out, err_smoothed, "ep", "sigma3_p", "m", "position_error_smoothed.png",
+                    "Position error of the smoothed estimate (truth − estimate) with ±3σ")
+        written.append("position_error_smoothed.png")
     track = read_csv(args.anchor_track)
     tracks = anchor_tracks(track, anchors)
     if tracks:

@@ -279,15 +279,17 @@ void writeMetricsJson(const RunEvaluation& ev, const std::string& path) {
   });
 }
 
-void writeErrorsCsv(const RunEvaluation& ev, const std::string& path) {
+namespace {
+
+void writePoseErrorsCsv(const std::vector<PoseError>& errors, const EvalOptions& options, const std::string& path) {
   writeFileAtomically(path, [&](std::ostream& f) {
     f << "t,ep_x_m,ep_y_m,ep_z_m,sigma3_p_x_m,sigma3_p_y_m,sigma3_p_z_m,"
          "eth_x_deg,eth_y_deg,eth_z_deg,sigma3_th_x_deg,sigma3_th_y_deg,sigma3_th_z_deg,"
          "ep_norm_m,eth_angle_deg,nees_p,nees_theta,flying,selected\n";
     f.setf(std::ios::fixed);
     const double r2d = 180.0 / M_PI;
-    const Timestamp t0 = ev.errors.empty() ? Timestamp{} : ev.errors.front().t;
-    for (const auto& e : ev.errors) {
+    const Timestamp t0 = errors.empty() ? Timestamp{} : errors.front().t;
+    for (const auto& e : errors) {
       f.precision(6);
       f << e.t.sec();
       f.precision(5);
@@ -297,9 +299,17 @@ void writeErrorsCsv(const RunEvaluation& ev, const std::string& path) {
       for (int i = 0; i < 3; ++i) f << "," << 3.0 * e.sigma_theta_rad[i] * r2d;
       f << "," << e.positionErrorNorm() << "," << e.orientationErrorDeg();
       f << "," << (e.nees_p ? formatNumber(*e.nees_p, 4) : "nan") << "," << (e.nees_theta ? formatNumber(*e.nees_theta, 4) : "nan");
-      f << "," << (e.flying ? 1 : 0) << "," << (isSelected(e, t0, ev.options) ? 1 : 0) << "\n";
+      f << "," << (e.flying ? 1 : 0) << "," << (isSelected(e, t0, options) ? 1 : 0) << "\n";
     }
   });
+}
+
+}  // namespace
+
+void writeErrorsCsv(const RunEvaluation& ev, const std::string& path) { writePoseErrorsCsv(ev.errors, ev.options, path); }
+
+void writeSmoothedErrorsCsv(const RunEvaluation& ev, const std::string& path) {
+  if (ev.smoothed) writePoseErrorsCsv(ev.smoothed->errors, ev.options, path);
 }
 
 void writeAnchorsEvalCsv(const RunEvaluation& ev, const std::string& path) {

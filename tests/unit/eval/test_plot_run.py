@@ -127,3 +127,35 @@ class RangeResiduals(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class SmoothedBesideTheFilter(unittest.TestCase):
+    """meshnav_eval passes --smoothed and --smoothed-errors when the run has estimate_smoothed.csv:
+    the trajectory plots draw it beside the filter's and its position error gets a figure."""
+
+    def test_smoothed_plots_written(self):
+        tmp = tempfile.TemporaryDirectory(prefix="meshnav_plot_run_")
+        self.addCleanup(tmp.cleanup)
+        d = tmp.name
+        header = "t,tx,ty,tz,qx,qy,qz,qw,pxx,pxy,pxz,pyy,pyz,pzz,qrr,qrp,qry,qpp,qpy,qyy\n"
+        rows = "".join("%d,%g,%g,1,0,0,0,1,0.01,0,0,0.01,0,0.01,0.001,0,0,0.001,0,0.001\n" % (k, 0.1 * k, 0.2 * k)
+                       for k in range(20))
+        write(os.path.join(d, "estimate.csv"), header + rows)
+        write(os.path.join(d, "estimate_smoothed.csv"), header + rows)
+        err_header = ("t,ep_x_m,ep_y_m,ep_z_m,sigma3_p_x_m,sigma3_p_y_m,sigma3_p_z_m,eth_x_deg,eth_y_deg,eth_z_deg,"
+                      "sigma3_th_x_deg,sigma3_th_y_deg,sigma3_th_z_deg,ep_norm_m,eth_angle_deg,nees_p,nees_theta,"
+                      "flying,selected\n")
+        err_rows = "".join("%d,0.01,0,0,0.3,0.3,0.3,0.1,0,0,1,1,1,0.01,0.1,0.01,0.03,1,1\n" % k for k in range(20))
+        write(os.path.join(d, "errors.csv"), err_header + err_rows)
+        write(os.path.join(d, "errors_smoothed.csv"), err_header + err_rows)
+        out = os.path.join(d, "png")
+        argv = sys.argv
+        sys.argv = ["plot_run.py", "--out", out, "--estimate", os.path.join(d, "estimate.csv"), "--errors",
+                    os.path.join(d, "errors.csv"), "--smoothed", os.path.join(d, "estimate_smoothed.csv"),
+                    "--smoothed-errors", os.path.join(d, "errors_smoothed.csv")]
+        try:
+            self.assertEqual(plot_run.main(), 0)
+        finally:
+            sys.argv = argv
+        for png in ("trajectory_xy.png", "trajectory_3d.png", "position_error.png", "position_error_smoothed.png"):
+            self.assertTrue(os.path.exists(os.path.join(out, png)), png)

@@ -195,6 +195,45 @@ TEST_F(RunEvaluationTest, MetricsTablesAndFiles) {
   EXPECT_EQ(lines, 200);
 }
 
+TEST_F(RunEvaluationTest, ASmoothedEstimateIsScoredBesideTheFilter) {
+  writeAll();
+  EvalOptions opt;
+  EXPECT_FALSE(evaluateRun(ds_.string(), run_.string(), opt).smoothed);  // none without the file
+  {
+    // The smoother's poses at the filter's times: 0.05 m off in y, σ 0.05 m (NEES 1 per sample).
+    EstimateCsvWriter w((run_ / "estimate_smoothed.csv").string());
+    for (int k = 0; k < 200; ++k) {
+      const double t = 0.025 + k * 0.05;
+      PoseEstimate e;
+      e.t = Timestamp::fromSec(t);
+      e.p_IinG = Eigen::Vector3d(std::cos(t), std::sin(t) + 0.05, 2.0);
+      e.q_ItoG = Eigen::Quaterniond(Eigen::AngleAxisd(t, Eigen::Vector3d::UnitZ()));
+      e.cov_p_m2 = Eigen::Matrix3d::Identity() * 0.0025;
+      e.cov_theta_rad2 = Eigen::Matrix3d::Identity() * 1e-4;
+      w.write(e);
+    }
+    w.flush();
+  }
+  const RunEvaluation ev = evaluateRun(ds_.string(), run_.string(), opt);
+  ASSERT_TRUE(ev.smoothed);
+  EXPECT_NEAR(ev.trajectory.position.rmse, 0.2, 1e-4);  // the filter's figures unchanged
+  EXPECT_EQ(ev.smoothed->trajectory.n_selected, 200);
+  EXPECT_NEAR(ev.smoothed->trajectory.position.rmse, 0.05, 1e-4);
+  EXPECT_NEAR(ev.smoothed->trajectory.position.anees, 1.0, 5e-3);
+  EXPECT_NE(formatRunReport(ev).find("position [m], smoothed"), std::string::npos);
+  writeMetricsYaml(ev, (run_ / "metrics.yaml").string());
+  const YAML::Node m = YAML::LoadFile((run_ / "metrics.yaml").string());
+  EXPECT_NEAR(m["pose_smoothed"]["position"]["rmse_m"].as<double>(), 0.05, 1e-4);
+  EXPECT_NEAR(m["pose"]["position"]["rmse_m"].as<double>(), 0.2, 1e-4);
+  writeSmoothedErrorsCsv(ev, (run_ / "errors_smoothed.csv").string());
+  std::ifstream f(run_ / "errors_smoothed.csv");
+  std::string header, first;
+  std::getline(f, header);
+  std::getline(f, first);
+  EXPECT_EQ(first.rfind("0.025000,", 0), 0u) << first;
+  EXPECT_NE(first.find(",-0.05"), std::string::npos) << first;  // truth − estimate in y
+}
+
 TEST_F(RunEvaluationTest, MetricsKeepUnixTimesToTheMicrosecond) {
   // Real recordings are stamped in Unix seconds: metrics.yaml once said t_first_s: 1.66496e+09.
   RunEvaluation ev;

@@ -11,33 +11,16 @@
 #include "estimator/core/so3.h"
 #include "estimator/testing/synthetic_scenario.h"
 #include "smoother/run_smoother.h"
+#include "smoother/testing/perturbed_run.h"
 
 using namespace meshnav;
 using namespace meshnav::smoother;
 using estimator::so3::expMap;
 using estimator::so3::logMap;
 namespace syn = meshnav::estimator::synthetic;
+using meshnav::smoother::testing::perturbedRun;
 
 namespace {
-
-/// A filter run made of the truth with slow errors (a drifting offset and tilt), as a filter's
-/// poses look, with a covariance that covers them.
-FilterRun perturbedRun(const Dataset& ds, double offset_m, double angle_deg) {
-  FilterRun run;
-  for (size_t i = 0; i < ds.ground_truth.size(); i += 2) {
-    const auto& g = ds.ground_truth[i];
-    const double t = g.t.sec();
-    PoseEstimate e;
-    e.t = g.t;
-    e.p_IinG = g.p_IinG + offset_m * Eigen::Vector3d(std::sin(0.3 * t), std::cos(0.2 * t), 0.5 * std::sin(0.1 * t));
-    const Eigen::Vector3d tilt = angle_deg * M_PI / 180.0 * Eigen::Vector3d(std::cos(0.25 * t), 0.5, std::sin(0.15 * t)).normalized();
-    e.q_ItoG = Eigen::Quaterniond(g.q_ItoG.toRotationMatrix() * expMap(tilt));
-    e.cov_p_m2 = Eigen::Matrix3d::Identity() * std::pow(std::max(offset_m, 0.01), 2);
-    e.cov_theta_rad2 = Eigen::Matrix3d::Identity() * std::pow(std::max(angle_deg, 0.5) * M_PI / 180.0, 2);
-    run.poses.push_back(e);
-  }
-  return run;
-}
 
 struct Errors {
   double pos_rms_m = 0.0, ori_rms_deg = 0.0, anees_p = 0.0;
