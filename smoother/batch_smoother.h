@@ -19,7 +19,8 @@
 ///  * a downward rangefinder's reading (SmootherHeight) like a range, under the same loss, with one
 ///    bias b_H ~ N(0, σ_bH²) per problem;
 ///  * landed knots: v = 0, and no turn between two of them (the ZUPT model);
-///  * range biases: N(prior mean, prior σ²); the first knot's pose: the optional prior.
+///  * range biases: N(prior mean, prior σ²); the first knot's pose: the optional prior;
+///  * anchors the problem lists as unknowns: their positions, without a prior (bundle adjustment).
 /// The increments are integrated again at the solved biases between passes.
 
 #include <Eigen/Core>
@@ -48,8 +49,16 @@ struct SmoothedKnot {
   Eigen::Matrix3d cov_theta_rad2 = Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
+/// An estimated anchor's position and its marginal covariance.
+struct SmoothedAnchor {
+  SensorId id = 0;
+  Eigen::Vector3d p_AinG = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d cov_p_m2 = Eigen::Matrix3d::Constant(std::numeric_limits<double>::quiet_NaN());
+};
+
 struct SmootherResult {
   std::vector<SmoothedKnot> knots;
+  std::vector<SmoothedAnchor> anchors;  ///< the problem's anchor unknowns
   std::vector<double> range_biases_m;  ///< solved values of the problem's range biases
   double imu_chi2_per_dof = 0.0;       ///< mean whitened IMU residual² per degree of freedom [-]
   double height_bias_m = 0.0;          ///< b_H of the rangefinder (0 without heights) [m]

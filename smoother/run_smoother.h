@@ -39,6 +39,13 @@ struct RunSmootherOptions {
   double chunk_s = 300.0;       ///< data solved at once [s] (about 70 MB at 222 ranges/s)
   double overlap_s = 10.0;      ///< future data each chunk's last output pose has seen [s]
   bool use_corrected_range = false;  ///< range_corr instead of range_raw (as uwb.use_corrected_range)
+  /// Ranges to the anchors the run estimated (anchors.csv, calibrated or uncertain ones) are used
+  /// with their final position; false: only the setup's known anchors (a smoothed path for
+  /// calibrating those anchors must not already hold them)
+  bool use_run_anchors = true;
+  /// The anchors the run estimated (and the setup's uncertain ones) are unknowns of the fit, a
+  /// bundle adjustment of trajectory and anchors (AnchorUnknown); false: taken as the run left them
+  bool estimate_anchors = false;
   /// A filter pose that turns by more than this against the gyro within one output step is a
   /// re-initialization (a gravity flip, a recovery); the knots before it take their initial
   /// attitude from the gyro, back from the pose after it [rad]
@@ -56,6 +63,7 @@ struct ChunkReport {
 
 struct SmoothedRun {
   std::vector<PoseEstimate> poses;  ///< at the filter's times within the smoothed span
+  std::vector<AnchorEstimate> anchors;  ///< with `estimate_anchors`: the last chunk's estimate of each
   std::vector<ChunkReport> chunks;
   int n_ranges_used = 0, n_ranges_skipped = 0;  ///< skipped: anchor unknown, tag–tag, anchor–anchor
 };

@@ -38,12 +38,18 @@ struct RangeBiasUnknown {
   double prior_sigma_m = 0.1;
 };
 
-/// One tag–anchor range, z = β ‖p_A − p_T(t)‖ + γ + ν, γ = γ_fixed + Σ (unknowns listed).
+/// One tag–anchor range, z = β ‖p_A − p_T(t)‖ + γ + ν, γ = γ_fixed + Σ (unknowns listed); or,
+/// with `tag` 0, an anchor–anchor range z = β ‖p_A − p_B‖ + γ + ν (the mesh), which informs only
+/// anchors that are unknowns of the fit.
 struct SmootherRange {
   Timestamp t;                                       ///< instant of the measurement, IMU clock
   SensorId tag = 0, anchor = 0;
+  SensorId anchor_b = 0;                             ///< the other anchor of an anchor–anchor range
+  Eigen::Vector3d p_BinG = Eigen::Vector3d::Zero();  ///< its position (initial value when estimated) [m]
+  int anchor_b_unknown = -1;                         ///< its index into `anchors`, −1: known
   Eigen::Vector3d p_TinI = Eigen::Vector3d::Zero();  ///< [m]
-  Eigen::Vector3d p_AinG = Eigen::Vector3d::Zero();  ///< [m]
+  Eigen::Vector3d p_AinG = Eigen::Vector3d::Zero();  ///< [m] (the initial value when `anchor_unknown` ≥ 0)
+  int anchor_unknown = -1; ///< index into `anchors` when the anchor's position is estimated, −1: known
   double z_m = 0.0;                                  ///< measured range [m]
   double beta = 1.0;                                 ///< [-]
   double gamma_fixed_m = 0.0;                        ///< known part of γ [m]
@@ -60,11 +66,22 @@ struct SmootherHeight {
   double sigma_m = 0.05; ///< [m]
 };
 
+/// An anchor whose position is estimated with the trajectory (a bundle adjustment). A calibrated
+/// anchor has no prior, so that no range counts twice (its calibration came from these ranges); a
+/// known-but-uncertain one (setup `abs_anchor_sigmas`) has the setup's. The known anchors fix the frame.
+struct AnchorUnknown {
+  SensorId id = 0;
+  Eigen::Vector3d p_AinG = Eigen::Vector3d::Zero();  ///< initial value [m]
+  Eigen::Vector3d prior_mean_m = Eigen::Vector3d::Zero();
+  double prior_sigma_m = 0.0;                        ///< per axis [m]; 0: no prior
+};
+
 struct SmoothingProblem {
   std::vector<ImuSample> imu;             ///< covers the knots' span, sorted
   std::vector<NavState> knots;            ///< initial values, strictly increasing times
   std::vector<SmootherRange> ranges;      ///< within [first knot, last knot]
   std::vector<RangeBiasUnknown> range_biases;
+  std::vector<AnchorUnknown> anchors;           ///< estimated anchor positions
   std::vector<SmootherHeight> heights;          ///< within [first knot, last knot]
   Eigen::Vector3d p_IH = Eigen::Vector3d::Zero();  ///< rangefinder in I [m]
   bool height_tilt_correction = true;

@@ -33,6 +33,7 @@ struct SmoothCli {
   std::string dataset, run, out;
   RunSmootherOptions o;
   std::string loss = "cauchy";
+  bool known_anchors_only = false;
 };
 
 void declareOptions(Cli& cli, SmoothCli& c) {
@@ -48,10 +49,17 @@ void declareOptions(Cli& cli, SmoothCli& c) {
   cli.option("loss-scale", c.o.solver.loss_scale_sigmas, "scale of the loss in range sigma [-]")->check(cli::positive());
   cli.option("passes", c.o.solver.passes, "solves per chunk, re-integrated at the solved biases")->check(CLI::Range(1, 20));
   cli.flag("corrected-range", c.o.use_corrected_range, "fit range_corr instead of range_raw");
+  cli.flag("estimate-anchors", c.o.estimate_anchors,
+           "estimate the anchors the run estimated (calibrated, uncertain) with the trajectory, a bundle "
+           "adjustment; writes RUN/anchors_smoothed.csv");
+  cli.flag("known-anchors-only", c.known_anchors_only,
+           "use only the setup's known anchors, not the ones the run estimated (for calibrating those on the "
+           "smoothed path)");
   cli.option("threads", c.o.solver.threads, "solver threads")->check(CLI::Range(1, 64));
 }
 
 int run(SmoothCli& c) {
+  c.o.use_run_anchors = !c.known_anchors_only;
   c.o.solver.range_loss = c.loss == "huber" ? BatchSmootherOptions::Loss::Huber : BatchSmootherOptions::Loss::Cauchy;
   Diagnostics diag;
   const Dataset ds = readDataset(c.dataset, diag);
@@ -64,6 +72,13 @@ int run(SmoothCli& c) {
     EstimateCsvWriter w(out);
     for (const auto& p : sm.poses) w.write(p);
     w.flush();
+  }
+  if (!sm.anchors.empty()) {
+    const std::string path = (fs::path(c.run) / "anchors_smoothed.csv").string();
+    AnchorsCsvWriter w(path);
+    for (const auto& a : sm.anchors) w.write(a);
+    w.flush();
+    spdlog::info("wrote {} ({} anchors)", path, sm.anchors.size());
   }
   bool ok = true;
   YAML::Emitter y;

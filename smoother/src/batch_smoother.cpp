@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -131,16 +132,16 @@ struct BiasWalkCost {
 /// A range between knots (file comment of batch_smoother.h).
 struct RangeCost {
   ImuIncrement inc;  ///< over [t_k, t]
-  Eigen::Vector3d g, p_TinI, p_AinG;
+  Eigen::Vector3d g, p_TinI;
   double z, beta, gamma_fixed, inv_sigma;
   template <class T>
   bool operator()(const T* pk, const T* qk, const T* vk, const T* bgk, const T* bak, const T* gu, const T* cu,
-                  T* res) const {
+                  const T* pa, T* res) const {
     Vec3<T> p_t;
     Quat<T> R_t;
     poseFromKnot(inc, g, pk, qk, vk, bgk, bak, &p_t, &R_t);
     const Vec3<T> p_T = p_t + R_t * p_TinI.cast<T>();
-    const T d = (p_AinG.cast<T>() - p_T).norm();
+    const T d = (Eigen::Map<const Vec3<T>>(pa) - p_T).norm();
     res[0] = (T(z) - T(gamma_fixed) - gu[0] - cu[0] - T(beta) * d) * T(inv_sigma);
     return true;
   }
@@ -160,6 +161,17 @@ struct HeightCost {
     const Vec3<T> s = p_t + R_t * p_IH.cast<T>();
     const T c = tilt_correction ? (R_t * Vec3<T>(T(0), T(0), T(1)))[2] : T(1);
     res[0] = (T(h) - s[2] / c - bh[0]) * T(inv_sigma);
+    return true;
+  }
+};
+
+/// An anchor–anchor range (the mesh): both positions are parameter blocks, one may be constant.
+struct AnchorRangeCost {
+  double z, beta, gamma_fixed, inv_sigma;
+  template <class T>
+  bool operator()(const T* pa, const T* pb, const T* gu, T* res) const {
+    const T d = (Eigen::Map<const Vec3<T>>(pa) - Eigen::Map<const Vec3<T>>(pb)).norm();
+    res[0] = (T(z) - T(gamma_fixed) - gu[0] - T(beta) * d) * T(inv_sigma);
     return true;
   }
 };
@@ -250,6 +262,9 @@ void checkProblem(const SmoothingProblem& pr) {
   if (pr.imu.empty() || pr.imu.front().t > pr.knots.front().t || pr.imu.back().t < pr.knots.back().t)
     throw std::invalid_argument("smoother: the IMU samples do not cover the knots");
   for (const auto& r : pr.ranges) {
+    if (r.anchor_unknown >= static_cast<int>(pr.anchors.size()) ||
+        r.anchor_b_unknown >= static_cast<int>(pr.anchors.size()))
+      throw std::invalid_argument("smoother: a range refers to an anchor that is not in the problem");
     if (r.gamma_unknown >= static_cast<int>(pr.range_biases.size()) ||
         r.common_unknown >= static_cast<int>(pr.range_biases.size()))
       throw std::invalid_argument("smoother: a range refers to a bias that is not in the problem");
@@ -269,6 +284,8 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
   std::vector<double> biases;
   for (const auto& b : pr.range_biases) biases.push_back(b.prior_mean_m);
   double zero_gamma = 0.0, zero_common = 0.0, height_bias = 0.0;
+  std::vector<std::array<double, 3>> anchor_blocks;
+  for (const auto& a : pr.anchors) anchor_blocks.push_back({a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z()});
   SmootherResult result;
   const double k_loss = options_.loss_scale_sigmas;
   auto robustLoss = [&]() -> ceres::LossFunction* {
@@ -381,28 +398,57 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
                                  b.p.data(), b.q.data(), b.v.data(), b.bg.data(), b.ba.data(), &height_bias);
       }
     }
+    // Anchors: an estimated one's block is shared by its ranges, a known one's is constant.
+    std::map<SensorId, size_t> known_index;
+    for (size_t i = 0; i < anchor_blocks.size(); ++i) {
+      problem.AddParameterBlock(anchor_blocks[i].data(), 3);
+      if (pr.anchors[i].prior_sigma_m > 0.0)
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<VectorPriorCost<3>, 3, 3>(new VectorPriorCost<3>{
+                                     pr.anchors[i].prior_mean_m, 1.0 / pr.anchors[i].prior_sigma_m}),
+                                 nullptr, anchor_blocks[i].data());
+    }
+    std::vector<std::array<double, 3>> known_blocks;
+    known_blocks.reserve(2 * pr.ranges.size());
+    auto anchorBlock = [&](SensorId id, const Eigen::Vector3d& p, int unknown) -> double* {
+      if (unknown >= 0) return anchor_blocks[static_cast<size_t>(unknown)].data();
+      auto [it, fresh] = known_index.emplace(id, known_blocks.size());
+      if (fresh) {
+        known_blocks.push_back({p.x(), p.y(), p.z()});
+        problem.AddParameterBlock(known_blocks.back().data(), 3);
+        problem.SetParameterBlockConstant(known_blocks.back().data());
+      }
+      return known_blocks[it->second].data();
+    };
     // Ranges.
     std::vector<ceres::ResidualBlockId> range_ids;
     std::vector<double> range_sigma;
     for (const auto& r : pr.ranges) {
       if (r.t < pr.knots.front().t || r.t > pr.knots.back().t) continue;
+      double* gu = r.gamma_unknown >= 0 ? &biases[static_cast<size_t>(r.gamma_unknown)] : &zero_gamma;
+      if (r.tag == 0) {  // anchor–anchor
+        auto* cost = new AnchorRangeCost{r.z_m, r.beta, r.gamma_fixed_m, 1.0 / r.sigma_m};
+        range_ids.push_back(problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<AnchorRangeCost, 1, 3, 3, 1>(cost), robustLoss(),
+            anchorBlock(r.anchor, r.p_AinG, r.anchor_unknown), anchorBlock(r.anchor_b, r.p_BinG, r.anchor_b_unknown),
+            gu));
+        range_sigma.push_back(r.sigma_m);
+        continue;
+      }
       size_t k = 0;
       auto* cost = new RangeCost;
       cost->inc = incrementTo(r.t, &k);
       cost->g = pr.gravity_G;
       cost->p_TinI = r.p_TinI;
-      cost->p_AinG = r.p_AinG;
       cost->z = r.z_m;
       cost->beta = r.beta;
       cost->gamma_fixed = r.gamma_fixed_m;
       cost->inv_sigma = 1.0 / r.sigma_m;
       ceres::LossFunction* loss = robustLoss();
-      double* gu = r.gamma_unknown >= 0 ? &biases[static_cast<size_t>(r.gamma_unknown)] : &zero_gamma;
       double* cu = r.common_unknown >= 0 ? &biases[static_cast<size_t>(r.common_unknown)] : &zero_common;
       KnotBlocks& b = blocks[k];
       range_ids.push_back(problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<RangeCost, 1, 3, 4, 3, 3, 3, 1, 1>(cost), loss, b.p.data(), b.q.data(),
-          b.v.data(), b.bg.data(), b.ba.data(), gu, cu));
+          new ceres::AutoDiffCostFunction<RangeCost, 1, 3, 4, 3, 3, 3, 1, 1, 3>(cost), loss, b.p.data(), b.q.data(),
+          b.v.data(), b.bg.data(), b.ba.data(), gu, cu, anchorBlock(r.anchor, r.p_AinG, r.anchor_unknown)));
       range_sigma.push_back(r.sigma_m);
     }
 
@@ -454,6 +500,8 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
       result.knots.resize(n);
       for (size_t k = 0; k < n; ++k) result.knots[k].x = fromBlocks(blocks[k], pr.knots[k].t);
       result.range_biases_m = biases;
+      for (size_t i = 0; i < anchor_blocks.size(); ++i)
+        result.anchors.push_back(SmoothedAnchor{pr.anchors[i].id, Eigen::Vector3d(anchor_blocks[i].data())});
       result.height_bias_m = height_bias;
       result.n_heights = static_cast<int>(pr.heights.size());
       if (options_.covariance) {
@@ -466,6 +514,7 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
           want.emplace_back(b.p.data(), b.p.data());
           want.emplace_back(b.q.data(), b.q.data());
         }
+        for (auto& a : anchor_blocks) want.emplace_back(a.data(), a.data());
         result.covariance_ok = cov.Compute(want, &problem);
         if (result.covariance_ok) {
           for (size_t k = 0; k < n; ++k) {
@@ -474,6 +523,11 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
             cov.GetCovarianceBlockInTangentSpace(blocks[k].q.data(), blocks[k].q.data(), Cq.data());
             result.knots[k].cov_p_m2 = Cp;
             result.knots[k].cov_theta_rad2 = Cq;
+          }
+          for (size_t i = 0; i < anchor_blocks.size(); ++i) {
+            Eigen::Matrix<double, 3, 3, Eigen::RowMajor> Ca;
+            cov.GetCovarianceBlockInTangentSpace(anchor_blocks[i].data(), anchor_blocks[i].data(), Ca.data());
+            result.anchors[i].cov_p_m2 = Ca;
           }
         } else {
           result.message += "; covariance: rank deficient (a direction the data does not fix)";

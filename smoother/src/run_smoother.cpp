@@ -223,39 +223,84 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
       }
     }
     // Ranges of the chunk.
+    std::map<SensorId, int> anchor_unknown_index;
     std::map<std::pair<SensorId, SensorId>, int> pair_unknown;
     std::map<SensorId, int> common_unknown;
     std::map<std::pair<SensorId, SensorId>, Timestamp> previous;
     auto r0 = std::lower_bound(ranges.begin(), ranges.end(), s, [](const RangeSample& r, Timestamp t) { return r.t < t; });
+    // An anchor's position: exactly known (setup), else an unknown of the fit (estimate_anchors),
+    // else the run's final estimate of it (a calibrated or a known-but-uncertain one), else an
+    // uncertain one's setup position, its σ per axis added to the range's noise.
+    struct AnchorRef {
+      Eigen::Vector3d p = Eigen::Vector3d::Zero();
+      int unknown = -1;
+      double sigma_m = 0.0;
+    };
+    auto anchorRef = [&](SensorId id) -> std::optional<AnchorRef> {
+      const auto f = ds.setup.abs_anchor_positions.find(id);
+      const auto g = run.anchors.find(id);
+      const auto u = ds.setup.abs_anchor_sigmas_m.find(id);
+      const bool uncertain = u != ds.setup.abs_anchor_sigmas_m.end();
+      if (f != ds.setup.abs_anchor_positions.end() && !uncertain) return AnchorRef{f->second};
+      if (o.estimate_anchors && o.use_run_anchors && (g != run.anchors.end() || uncertain)) {
+        AnchorRef a{g != run.anchors.end() ? g->second : f->second};
+        auto [it, fresh] = anchor_unknown_index.emplace(id, static_cast<int>(pr.anchors.size()));
+        if (fresh)
+          pr.anchors.push_back(AnchorUnknown{id, a.p, uncertain ? f->second : Eigen::Vector3d::Zero(),
+                                             uncertain ? u->second : 0.0});
+        a.unknown = it->second;
+        return a;
+      }
+      if (o.use_run_anchors && g != run.anchors.end()) return AnchorRef{g->second};
+      if (f != ds.setup.abs_anchor_positions.end()) return AnchorRef{f->second, -1, u->second};
+      return std::nullopt;
+    };
     for (auto it = r0; it != ranges.end() && it->t <= e; ++it) {
       const RangeSample& r = *it;
       const bool i_tag = ds.setup.rel_tag_positions.count(r.id_initiator) > 0;
       const bool r_tag = ds.setup.rel_tag_positions.count(r.id_responder) > 0;
-      if (i_tag == r_tag) {
-        ++out.n_ranges_skipped;
-        continue;
-      }
-      const SensorId tag = i_tag ? r.id_initiator : r.id_responder;
-      const SensorId anchor = i_tag ? r.id_responder : r.id_initiator;
-      std::optional<Eigen::Vector3d> p_A;
-      if (auto f = ds.setup.abs_anchor_positions.find(anchor); f != ds.setup.abs_anchor_positions.end()) p_A = f->second;
-      else if (auto g = run.anchors.find(anchor); g != run.anchors.end()) p_A = g->second;
       const double z = o.use_corrected_range ? r.range_corr_m : r.range_m;
-      if (!p_A || !std::isfinite(z)) {
+      if ((i_tag && r_tag) || !std::isfinite(z)) {
         ++out.n_ranges_skipped;
         continue;
       }
       SmootherRange sr;
       sr.t = r.t;
-      sr.tag = tag;
-      sr.anchor = anchor;
-      sr.p_TinI = ds.setup.rel_tag_positions.at(tag);
-      sr.p_AinG = *p_A;
       sr.z_m = z;
+      double sigma_anchors2 = 0.0;
+      if (!i_tag && !r_tag) {
+        // Anchor–anchor (the mesh): information only about anchors that are unknowns of the fit.
+        const auto a = anchorRef(r.id_initiator), b = anchorRef(r.id_responder);
+        if (!o.estimate_anchors || !a || !b || (a->unknown < 0 && b->unknown < 0)) {
+          ++out.n_ranges_skipped;
+          continue;
+        }
+        sr.anchor = r.id_initiator;
+        sr.p_AinG = a->p;
+        sr.anchor_unknown = a->unknown;
+        sr.anchor_b = r.id_responder;
+        sr.p_BinG = b->p;
+        sr.anchor_b_unknown = b->unknown;
+        sigma_anchors2 = a->sigma_m * a->sigma_m + b->sigma_m * b->sigma_m;
+      } else {
+        sr.tag = i_tag ? r.id_initiator : r.id_responder;
+        sr.anchor = i_tag ? r.id_responder : r.id_initiator;
+        const auto a = anchorRef(sr.anchor);
+        if (!a) {
+          ++out.n_ranges_skipped;
+          continue;
+        }
+        sr.p_TinI = ds.setup.rel_tag_positions.at(sr.tag);
+        sr.p_AinG = a->p;
+        sr.anchor_unknown = a->unknown;
+        sigma_anchors2 = a->sigma_m * a->sigma_m;
+      }
+      const SensorId a_id = sr.tag != 0 ? sr.tag : sr.anchor_b;
       double sigma = ds.setup.noise.sigma_range_m.value_or(r.R_m2 > 0.0 ? std::sqrt(r.R_m2) : model.sigma_fallback);
-      const auto key = pairKey(tag, anchor);
-      std::optional<PairBias> pb = ds.setup.findPairBias(tag, anchor);
-      if (!pb) pb = model.calibrated(tag, anchor);
+      const auto key = pairKey(a_id, sr.anchor);
+      std::optional<PairBias> pb = ds.setup.findPairBias(a_id, sr.anchor);
+      if (!pb) pb = model.calibrated(a_id, sr.anchor);
+      if (!pb) pb = model.calibrated(sr.anchor, a_id);
       if (pb) {
         sr.beta = pb->beta;
         sigma = pb->sigma_m;
@@ -270,9 +315,11 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
         auto [f, fresh] = pair_unknown.emplace(key, static_cast<int>(pr.range_biases.size()));
         if (fresh) pr.range_biases.push_back(RangeBiasUnknown{0.0, model.sigma_gamma_unlisted});
         sr.gamma_unknown = f->second;
-        auto [c, cfresh] = common_unknown.emplace(tag, static_cast<int>(pr.range_biases.size()));
-        if (cfresh) pr.range_biases.push_back(RangeBiasUnknown{0.0, model.sigma_common});
-        sr.common_unknown = c->second;
+        if (sr.tag != 0) {  // a tag's pairs share its common offset (docs/uwb_bias_model.md)
+          auto [c, cfresh] = common_unknown.emplace(sr.tag, static_cast<int>(pr.range_biases.size()));
+          if (cfresh) pr.range_biases.push_back(RangeBiasUnknown{0.0, model.sigma_common});
+          sr.common_unknown = c->second;
+        }
       }
       // A pair's errors are correlated over τ: a range Δt after the pair's previous one carries
       // (1 − ρ)/(1 + ρ) of an independent one's information, ρ = exp(−Δt/τ).
@@ -281,7 +328,7 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
         sigma *= std::sqrt((1.0 + rho) / std::max(1.0 - rho, 1e-6));
       }
       previous[key] = r.t;
-      sr.sigma_m = sigma;
+      sr.sigma_m = std::sqrt(sigma * sigma + sigma_anchors2);
       pr.ranges.push_back(sr);
     }
     out.n_ranges_used += static_cast<int>(pr.ranges.size());
@@ -313,6 +360,16 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
       out.poses.push_back(pe);
     }
     res.knots.clear();
+    for (const auto& a : res.anchors) {
+      AnchorEstimate ae;
+      ae.t = e;
+      ae.id = a.id;
+      ae.p_AinG = a.p_AinG;
+      ae.cov_p_m2 = a.cov_p_m2;
+      auto it = std::find_if(out.anchors.begin(), out.anchors.end(), [&](const AnchorEstimate& x) { return x.id == a.id; });
+      if (it == out.anchors.end()) out.anchors.push_back(ae);
+      else *it = ae;
+    }
     report.result = std::move(res);
     out.chunks.push_back(std::move(report));
     if (final_chunk) break;

@@ -158,3 +158,25 @@ TEST(BatchSmoother, RefusesARunWithoutPosesAndAProblemWithoutIMU) {
   no_imu.imu.clear();
   EXPECT_THROW(smoothRun(no_imu, perturbedRun(ds, 0.1, 1.0), RunSmootherOptions{}), std::runtime_error);
 }
+
+TEST(BatchSmoother, EstimatesAnUncertainAnchorWithTheTrajectory) {
+  syn::SyntheticOptions o = scenario(false);
+  o.n_estimated_anchors = 1;   // 106, given in setup.yaml with a σ
+  o.anchor_to_anchor = true;   // the mesh: 106 ranges to the known anchors too
+  Dataset ds = syn::makeSyntheticDataset(o);
+  const Eigen::Vector3d p_true = ds.setup.abs_anchor_positions.at(106);
+  ds.setup.abs_anchor_positions[106] = p_true + Eigen::Vector3d(0.3, -0.2, 0.1);  // a poor guess
+  ds.setup.abs_anchor_sigmas_m[106] = 0.5;
+  const FilterRun run = perturbedRun(ds, 0.05, 1.0);
+  RunSmootherOptions with;
+  with.estimate_anchors = true;
+  const SmoothedRun sm = smoothRun(ds, run, with);
+  ASSERT_EQ(sm.anchors.size(), 1u);
+  EXPECT_EQ(sm.anchors[0].id, 106);
+  EXPECT_LT((sm.anchors[0].p_AinG - p_true).norm(), 0.01);
+  EXPECT_TRUE(sm.anchors[0].cov_p_m2.allFinite());
+  expectExact(ds, sm);
+  // Taken at its guess (its σ in the range noise), the anchor pulls the trajectory.
+  const Errors e_fixed = errorsAgainstTruth(ds, smoothRun(ds, run, RunSmootherOptions{}));
+  EXPECT_GT(e_fixed.pos_rms_m, 0.02);
+}
