@@ -30,6 +30,7 @@ hold (reported, not failed). Usage:
 
 import argparse
 import csv
+import json
 import os
 import random
 import shutil
@@ -150,8 +151,9 @@ def evaluate(bin_dir, data, run, out, log, status, extra=()):
     return m["pos_rmse_m"], m["max_err_after_10s_m"]
 
 
-def run_case(case, dataset, out, bin_dir, t0, seed, anchor, config=None):
-    """Perturb, run, evaluate one case; returns a result dict (a failed run is a result, not an exception)."""
+def run_case(case, dataset, out, bin_dir, t0, seed, anchor, config=None, smooth=False):
+    """Perturb, run, evaluate one case; returns a result dict (a failed run is a result, not an exception).
+    `smooth`: also `meshnav_smooth` the run; meshnav_eval then scores it beside the filter (whole run)."""
     base = os.path.join(out, case)
     if os.path.exists(base):
         shutil.rmtree(base)
@@ -159,7 +161,8 @@ def run_case(case, dataset, out, bin_dir, t0, seed, anchor, config=None):
     data, run = os.path.join(base, "dataset"), os.path.join(base, "run")
     perturb(case, dataset, data, t0, seed, anchor)
     res = {"case": case, "run_rc": None, "initialized": False, "ate_m": float("nan"), "max_late_m": float("nan"),
-           "ate_with_outage_m": float("nan"), "gated": 0, "recoveries": 0, "health": "", "error": ""}
+           "ate_with_outage_m": float("nan"), "gated": 0, "recoveries": 0, "health": "", "error": "",
+           "smoothed_ate_m": float("nan")}
     res["run_rc"] = robustness.run_command(
         [os.path.join(bin_dir, "meshnav_run"), "--dataset", data, "--out", run] + (["--config", config] if config else []),
         os.path.join(base, "meshnav_run.log"))
@@ -178,9 +181,18 @@ def run_case(case, dataset, out, bin_dir, t0, seed, anchor, config=None):
     if refusal is not None:
         res["error"] = "never initialized: " + refusal
         return res
+    if smooth:
+        rc = robustness.run_command([os.path.join(bin_dir, "meshnav_smooth"), "--dataset", data, "--run", run],
+                                    os.path.join(base, "meshnav_smooth.log"))
+        if rc != 0:
+            res["error"] = "meshnav_smooth exited %d (see %s)" % (rc, os.path.join(base, "meshnav_smooth.log"))
+            return res
     try:
         res["ate_m"], res["max_late_m"] = evaluate(bin_dir, data, run, run, os.path.join(base, "meshnav_eval.log"),
                                                    status)
+        if smooth:
+            with open(os.path.join(run, "metrics.json")) as f:
+                res["smoothed_ate_m"] = json.load(f)["pose_smoothed"]["position"]["rmse_m"]
         if case in RANGE_GAPS_S:
             # Scored without the outage and its settling time (module docstring); the whole run beside it.
             res["ate_with_outage_m"] = res["ate_m"]
@@ -221,6 +233,8 @@ def main():
     ap.add_argument("--anchor", help="anchor id of anchor_out (default: the one with the most ranges)")
     ap.add_argument("--config", help="estimator options file given to every meshnav_run (default: none, the defaults)")
     ap.add_argument("--expect-fail", default="", help="comma-separated cases known not to hold (not failed)")
+    ap.add_argument("--smooth", action="store_true",
+                    help="also smooth every run (meshnav_smooth, docs/smoother.md): column 'smoothed ATE', whole run")
     a = ap.parse_args()
     cases = [c for c in a.cases.split(",") if c]
     unknown = [c for c in cases if c not in CASES]
@@ -228,7 +242,7 @@ def main():
         sys.exit("realdata_stress: unknown case(s) %s (known: %s)" % (", ".join(unknown), ", ".join(CASES)))
     if not os.path.isfile(os.path.join(a.dataset, "ranges.csv")):
         sys.exit("realdata_stress: %s is not a dataset folder (no ranges.csv)" % a.dataset)
-    for b in ("meshnav_run", "meshnav_eval"):
+    for b in ("meshnav_run", "meshnav_eval") + (("meshnav_smooth",) if a.smooth else ()):
         if not os.access(os.path.join(a.bin, b), os.X_OK):
             sys.exit("realdata_stress: %s not found in %s (build first, or give --bin)" % (b, a.bin))
     cases = ["clean"] + [c for c in cases if c != "clean"]  # the reference comes first
@@ -239,7 +253,7 @@ def main():
     results = []
     for case in cases:
         print("[realdata_stress] %s ..." % case, file=sys.stderr, flush=True)
-        results.append(run_case(case, a.dataset, a.out, a.bin, t0, a.seed, anchor, a.config))
+        results.append(run_case(case, a.dataset, a.out, a.bin, t0, a.seed, anchor, a.config, a.smooth))
     clean = results[0]
     write_csv(os.path.join(a.out, "stress.csv"), results, clean)
     if not holds(clean, clean["ate_m"]):
@@ -248,8 +262,8 @@ def main():
     print("dataset %s (anchor_out: %s); holds: exit 0, initialized, ATE <= max(%.0f x clean, clean + %.2f m)"
           % (a.dataset, anchor, HOLD_FACTOR, HOLD_SLACK_M))
     print("| case | meshnav_run exit | ATE [m] | max error after 10 s [m] | ATE with the outage [m] | ranges gated | "
-          "recoveries | health at end | holds |")
-    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |")
+          "recoveries | health at end | holds |" + (" smoothed ATE, whole run [m] |" if a.smooth else ""))
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |" + (" ---: |" if a.smooth else ""))
     failed = []
     for r in results:
         ok = holds(r, clean["ate_m"])
@@ -259,7 +273,8 @@ def main():
         print("| %s | %s | %s | %s | %s | %d | %d | %s | %s |" % (
             r["case"], r["run_rc"], robustness.fmt(r["ate_m"], 3), robustness.fmt(r["max_late_m"], 3),
             robustness.fmt(r["ate_with_outage_m"], 3) if r["case"] in RANGE_GAPS_S else "-", r["gated"],
-            r["recoveries"], r["health"] or "-", verdict + (" " + r["error"] if r["error"] else "")))
+            r["recoveries"], r["health"] or "-", verdict + (" " + r["error"] if r["error"] else ""))
+            + (" %s |" % robustness.fmt(r["smoothed_ate_m"], 3) if a.smooth else ""))
     if failed:
         print("realdata_stress: %d case(s) do not hold: %s" % (len(failed), ", ".join(failed)))
         return 1

@@ -43,10 +43,16 @@ struct ImuIncrement {
   Eigen::Vector3d ba_lin = Eigen::Vector3d::Zero();         ///< b̄_a [m/s²]
 };
 
-/// IMU noise densities of the increments' covariance.
+/// IMU noise densities of the increments' covariance. A sub-step between two samples more than
+/// `max_dt_s` apart (an IMU gap) runs on readings interpolated across the gap, whose error is
+/// modelled as white noise of the gap densities (the estimator's imu.gap_sigma_*; docs/robustness.md,
+/// "IMU gaps") on top of the sensor's.
 struct ImuNoiseDensities {
-  double acc = 0.02;    ///< σ_a [m/s²/√Hz]
-  double gyro = 0.002;  ///< σ_ω [rad/s/√Hz]
+  double acc = 0.02;         ///< σ_a [m/s²/√Hz]
+  double gyro = 0.002;       ///< σ_ω [rad/s/√Hz]
+  double max_dt_s = 0.0;     ///< samples farther apart are a gap [s]; 0: no gap model
+  double gap_acc = 1.0;      ///< [m/s²/√s]
+  double gap_gyro = 0.0;     ///< [rad/s/√s]
 };
 
 /// Integrates `imu` (sorted by time, covering [t0, t1]) from t0 to t1 at the given biases.

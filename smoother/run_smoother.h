@@ -59,6 +59,7 @@ struct ChunkReport {
   SmootherResult result;           ///< knots left out (only the statistics)
   double gravity_z_sign = -1.0;    ///< gravity along −z (−1) or +z (+1) of G, by the data
   int reinit_jumps = 0;            ///< filter re-initializations inside the chunk
+  int imu_gaps = 0;                ///< IMU gaps (> imu.max_dt_s) inside the chunk, bridged by the gap model
 };
 
 struct SmoothedRun {

@@ -94,10 +94,13 @@ int run(SmoothCli& c) {
       << "covariance_ok" << YAML::Value << r.covariance_ok << YAML::Key << "imu_chi2_per_dof" << YAML::Value
       << r.imu_chi2_per_dof << YAML::Key << "height_bias_m" << YAML::Value << r.height_bias_m << YAML::Key
       << "heights" << YAML::Value << r.n_heights << YAML::Key << "gravity_z_sign" << YAML::Value << ch.gravity_z_sign << YAML::Key
-      << "filter_reinitializations" << YAML::Value << ch.reinit_jumps << YAML::Key << "ranges" << YAML::Value
+      << "filter_reinitializations" << YAML::Value << ch.reinit_jumps << YAML::Key << "imu_gaps" << YAML::Value
+      << ch.imu_gaps << YAML::Key << "ranges" << YAML::Value
       << r.n_ranges << YAML::Key << "range_outliers" << YAML::Value << r.n_range_outliers << YAML::Key
       << "range_rms_inliers_m" << YAML::Value << r.range_rms_inliers_m << YAML::Key << "message" << YAML::Value
       << r.message << YAML::EndMap;
+    if (ch.imu_gaps > 0)
+      spdlog::warn("chunk [{}, {}] s: {} IMU gap(s), bridged by the gap noise model", ch.t0_s, ch.t1_s, ch.imu_gaps);
     if (!r.converged) spdlog::error("chunk [{}, {}] s did not converge: {}", ch.t0_s, ch.t1_s, r.message);
     if (!r.covariance_ok) spdlog::warn("chunk [{}, {}] s: no covariance ({}); its rows carry NaN", ch.t0_s, ch.t1_s, r.message);
   }

@@ -59,6 +59,16 @@ ImuIncrement preintegrate(const std::vector<ImuSample>& imu, Timestamp t0, Times
       prev = next;
       continue;
     }
+    // Inside an IMU gap (the samples around this sub-step farther apart than max_dt_s) the
+    // interpolated readings carry the gap's noise as well.
+    double vg = var_g, va = var_a;
+    if (noise.max_dt_s > 0.0) {
+      const size_t r = firstAtOrAfter(imu, next.t);
+      if (r > 0 && r < imu.size() && (imu[r].t - imu[r - 1].t).sec() > noise.max_dt_s) {
+        vg += noise.gap_gyro * noise.gap_gyro;
+        va += noise.gap_acc * noise.gap_acc;
+      }
+    }
     const Eigen::Vector3d w = 0.5 * (prev.gyro_rad_s + next.gyro_rad_s) - bg;
     const Eigen::Vector3d a = 0.5 * (prev.acc_m_s2 + next.acc_m_s2) - ba;
     const Eigen::Matrix3d E = expMap(w * d);
@@ -75,7 +85,7 @@ ImuIncrement preintegrate(const std::vector<ImuSample>& imu, Timestamp t0, Times
     Bg.block<3, 3>(0, 0) = Jr * d;
     Ba.block<3, 3>(3, 0) = inc.dR * d;
     Ba.block<3, 3>(6, 0) = 0.5 * inc.dR * d * d;
-    inc.cov = A * inc.cov * A.transpose() + Bg * (var_g / d) * Bg.transpose() + Ba * (var_a / d) * Ba.transpose();
+    inc.cov = A * inc.cov * A.transpose() + Bg * (vg / d) * Bg.transpose() + Ba * (va / d) * Ba.transpose();
     // Sensitivities (p before v before R, each with the old values).
     inc.dp_dba += inc.dv_dba * d - 0.5 * Rm * d * d;
     inc.dp_dbg += inc.dv_dbg * d - 0.5 * Ra * inc.dR_dbg * d * d;

@@ -120,7 +120,10 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
       if (hi != ds.imu.end()) ++hi;
       pr.imu.assign(lo, hi);
     }
-    pr.imu_noise = ImuNoiseDensities{est.imu.acc_noise_density, est.imu.gyro_noise_density};
+    pr.imu_noise = ImuNoiseDensities{est.imu.acc_noise_density, est.imu.gyro_noise_density, est.imu.max_dt_s,
+                                     est.imu.gap_sigma_acc_m_s2, est.imu.gap_sigma_gyro_rad_s};
+    for (size_t i = 1; i < pr.imu.size(); ++i)
+      if ((pr.imu[i].t - pr.imu[i - 1].t).sec() > est.imu.max_dt_s) ++report.imu_gaps;
     pr.acc_bias_rw = est.imu.acc_bias_rw;
     pr.gyro_bias_rw = est.imu.gyro_bias_rw;
     pr.acc_bias_sigma = ds.setup.noise.imu_acc_bias_sigma.value_or(est.init.sigma_bias_acc_m_s2);
