@@ -301,6 +301,11 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
 
   for (auto& r : runs) {
     std::filesystem::create_directories(r.out);
+    // A smoother's output of an earlier run in this folder belongs to that run: meshnav_eval would
+    // score it beside this one (docs/smoother.md).
+    for (const char* stale : {"estimate_smoothed.csv", "anchors_smoothed.csv", "smoother.yaml", "errors_smoothed.csv"})
+      if (std::filesystem::remove(r.out / stale))
+        spdlog::info("removed {} of an earlier run (meshnav smooth it again)", (r.out / stale).string());
     r.estimates = std::make_unique<EstimateCsvWriter>((r.out / "estimate.csv").string());
     r.anchors = std::make_unique<AnchorsCsvWriter>((r.out / "anchors.csv").string());
   }

@@ -47,7 +47,9 @@ for ((s = first; s <= last; s++)); do
   [[ -n "$run_args_extra" ]] && run_args+=($run_args_extra)
   "$BIN/meshnav_run" "${run_args[@]}" > "$d/run.log" 2>&1 || { cat "$d/run.log"; exit 1; }
   if [[ $smooth == 1 ]]; then
-    "$BIN/meshnav_smooth" --dataset "$d/dataset" --run "$d/run" > "$d/smooth.log" 2>&1 || { cat "$d/smooth.log"; exit 1; }
+    smooth_args=(--dataset "$d/dataset" --run "$d/run")
+    [[ -n "$config" ]] && smooth_args+=(--config "$config")
+    "$BIN/meshnav_smooth" "${smooth_args[@]}" > "$d/smooth.log" 2>&1 || { cat "$d/smooth.log"; exit 1; }
   fi
   "$BIN/meshnav_eval" --dataset "$d/dataset" --run "$d/run" --no-plots --only-flying > "$d/eval.log" 2>&1 \
     || { cat "$d/eval.log"; exit 1; }

@@ -56,6 +56,9 @@ struct SmootherRange {
   int gamma_unknown = -1;  ///< index into `range_biases` of the pair's own γ part, −1: none
   int common_unknown = -1; ///< index of the tag's common offset, −1: none
   double sigma_m = 0.15;   ///< noise σ of this range (correlation with its pair's previous one included) [m]
+  /// σ_m over the range's own σ (the correlation's √((1 + ρ)/(1 − ρ))): the robust loss's scale
+  /// stays at its multiple of the range's own σ [-]
+  double noise_inflation = 1.0;
 };
 
 /// One downward rangefinder reading: h = (p_IinG + R p_IH)_z / c + b_H + ν, c = (R e_z)_z with

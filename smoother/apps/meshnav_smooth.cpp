@@ -26,14 +26,15 @@ constexpr char kDescription[] =
     "least-squares fit of knots tied by preintegrated IMU increments, ranges under a robust loss, the unknown range "
     "biases), chunk by chunk with the filter's belief as each chunk's prior. Reads --dataset and --run (a meshnav run "
     "folder: estimate.csv, anchors.csv, status.txt), writes RUN/estimate_smoothed.csv (the columns of estimate.csv) "
-    "and RUN/smoother.yaml. Exit status 0: done; 1: an input or output failed or a chunk did not converge; 2: bad "
-    "command line.";
+    "and RUN/smoother.yaml. Exit status 0: done; 1: an input or output failed, or a chunk did not converge or has no "
+    "covariance (a direction the data does not fix); 2: bad command line.";
 
 struct SmoothCli {
   std::string dataset, run, out;
   RunSmootherOptions o;
   std::string loss = "cauchy";
   bool known_anchors_only = false;
+  bool keep_run_anchors = false;
 };
 
 void declareOptions(Cli& cli, SmoothCli& c) {
@@ -49,9 +50,13 @@ void declareOptions(Cli& cli, SmoothCli& c) {
   cli.option("loss-scale", c.o.solver.loss_scale_sigmas, "scale of the loss in range sigma [-]")->check(cli::positive());
   cli.option("passes", c.o.solver.passes, "solves per chunk, re-integrated at the solved biases")->check(CLI::Range(1, 20));
   cli.flag("corrected-range", c.o.use_corrected_range, "fit range_corr instead of range_raw");
-  cli.flag("estimate-anchors", c.o.estimate_anchors,
-           "estimate the anchors the run estimated (calibrated, uncertain) with the trajectory, a bundle "
-           "adjustment; writes RUN/anchors_smoothed.csv");
+  cli.optional("config", c.o.estimator_config,
+               "the estimator options file the run was made with (meshnav run --config): its IMU, range, ZUPT and "
+               "height models (default: the estimator's defaults)")
+      ->type_name("FILE");
+  cli.flag("keep-run-anchors", c.keep_run_anchors,
+           "take the anchors the run estimated (calibrated, uncertain) as it left them (anchors.csv) instead of "
+           "fitting them with the trajectory (the default, a bundle adjustment written to RUN/anchors_smoothed.csv)");
   cli.flag("known-anchors-only", c.known_anchors_only,
            "use only the setup's known anchors, not the ones the run estimated (for calibrating those on the "
            "smoothed path)");
@@ -60,6 +65,7 @@ void declareOptions(Cli& cli, SmoothCli& c) {
 
 int run(SmoothCli& c) {
   c.o.use_run_anchors = !c.known_anchors_only;
+  c.o.estimate_anchors = !c.keep_run_anchors;
   c.o.solver.range_loss = c.loss == "huber" ? BatchSmootherOptions::Loss::Huber : BatchSmootherOptions::Loss::Cauchy;
   Diagnostics diag;
   const Dataset ds = readDataset(c.dataset, diag);
@@ -88,7 +94,7 @@ int run(SmoothCli& c) {
   y << YAML::Key << "chunks" << YAML::Value << YAML::BeginSeq;
   for (const auto& ch : sm.chunks) {
     const auto& r = ch.result;
-    ok = ok && r.converged;
+    ok = ok && r.converged && r.covariance_ok;
     y << YAML::Flow << YAML::BeginMap << YAML::Key << "t0_s" << YAML::Value << ch.t0_s << YAML::Key << "t1_s"
       << YAML::Value << ch.t1_s << YAML::Key << "converged" << YAML::Value << r.converged << YAML::Key
       << "covariance_ok" << YAML::Value << r.covariance_ok << YAML::Key << "imu_chi2_per_dof" << YAML::Value
@@ -102,7 +108,9 @@ int run(SmoothCli& c) {
     if (ch.imu_gaps > 0)
       spdlog::warn("chunk [{}, {}] s: {} IMU gap(s), bridged by the gap noise model", ch.t0_s, ch.t1_s, ch.imu_gaps);
     if (!r.converged) spdlog::error("chunk [{}, {}] s did not converge: {}", ch.t0_s, ch.t1_s, r.message);
-    if (!r.covariance_ok) spdlog::warn("chunk [{}, {}] s: no covariance ({}); its rows carry NaN", ch.t0_s, ch.t1_s, r.message);
+    if (!r.covariance_ok)
+      spdlog::error("chunk [{}, {}] s: no covariance ({}); its rows carry NaN, which readers of estimate.csv skip",
+                    ch.t0_s, ch.t1_s, r.message);
   }
   y << YAML::EndSeq << YAML::EndMap;
   writeFileAtomically((fs::path(c.run) / "smoother.yaml").string(),

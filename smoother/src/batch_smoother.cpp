@@ -288,16 +288,19 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
   for (const auto& a : pr.anchors) anchor_blocks.push_back({a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z()});
   SmootherResult result;
   const double k_loss = options_.loss_scale_sigmas;
-  auto robustLoss = [&]() -> ceres::LossFunction* {
-    if (options_.range_loss == BatchSmootherOptions::Loss::Cauchy) return new ceres::CauchyLoss(k_loss);
-    return new ceres::HuberLoss(k_loss);
+  /// The loss on a residual whitened by σ_eff = `inflation` × the measurement's own σ: its scale
+  /// stays k own-σ's.
+  auto robustLoss = [&](double inflation = 1.0) -> ceres::LossFunction* {
+    const double k = k_loss / inflation;
+    if (options_.range_loss == BatchSmootherOptions::Loss::Cauchy) return new ceres::CauchyLoss(k);
+    return new ceres::HuberLoss(k);
   };
 
   for (int pass = 0; pass < std::max(1, options_.passes); ++pass) {
+    ceres::AutoDiffManifold<LocalQuaternionPlus, 4, 3> quat_manifold;  // outlives the problem
     ceres::Problem::Options popt;
     popt.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     ceres::Problem problem(popt);
-    ceres::AutoDiffManifold<LocalQuaternionPlus, 4, 3> quat_manifold;
     for (auto& b : blocks) {
       problem.AddParameterBlock(b.p.data(), 3);
       problem.AddParameterBlock(b.q.data(), 4, &quat_manifold);
@@ -421,17 +424,18 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
     };
     // Ranges.
     std::vector<ceres::ResidualBlockId> range_ids;
-    std::vector<double> range_sigma;
+    std::vector<double> range_sigma, range_inflation;
     for (const auto& r : pr.ranges) {
       if (r.t < pr.knots.front().t || r.t > pr.knots.back().t) continue;
       double* gu = r.gamma_unknown >= 0 ? &biases[static_cast<size_t>(r.gamma_unknown)] : &zero_gamma;
       if (r.tag == 0) {  // anchor–anchor
         auto* cost = new AnchorRangeCost{r.z_m, r.beta, r.gamma_fixed_m, 1.0 / r.sigma_m};
         range_ids.push_back(problem.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<AnchorRangeCost, 1, 3, 3, 1>(cost), robustLoss(),
+            new ceres::AutoDiffCostFunction<AnchorRangeCost, 1, 3, 3, 1>(cost), robustLoss(r.noise_inflation),
             anchorBlock(r.anchor, r.p_AinG, r.anchor_unknown), anchorBlock(r.anchor_b, r.p_BinG, r.anchor_b_unknown),
             gu));
         range_sigma.push_back(r.sigma_m);
+        range_inflation.push_back(r.noise_inflation);
         continue;
       }
       size_t k = 0;
@@ -443,13 +447,14 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
       cost->beta = r.beta;
       cost->gamma_fixed = r.gamma_fixed_m;
       cost->inv_sigma = 1.0 / r.sigma_m;
-      ceres::LossFunction* loss = robustLoss();
+      ceres::LossFunction* loss = robustLoss(r.noise_inflation);
       double* cu = r.common_unknown >= 0 ? &biases[static_cast<size_t>(r.common_unknown)] : &zero_common;
       KnotBlocks& b = blocks[k];
       range_ids.push_back(problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<RangeCost, 1, 3, 4, 3, 3, 3, 1, 1, 3>(cost), loss, b.p.data(), b.q.data(),
           b.v.data(), b.bg.data(), b.ba.data(), gu, cu, anchorBlock(r.anchor, r.p_AinG, r.anchor_unknown)));
       range_sigma.push_back(r.sigma_m);
+      range_inflation.push_back(r.noise_inflation);
     }
 
     ceres::Solver::Options sopt;
@@ -477,7 +482,7 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
     for (size_t i = 0; i < range_ids.size(); ++i) {
       double res = 0.0;
       problem.EvaluateResidualBlock(range_ids[i], false, nullptr, &res, nullptr);
-      if (std::abs(res) > 3.0 * k_loss) {
+      if (std::abs(res) * range_inflation[i] > 3.0 * k_loss) {  // beyond 3 loss scales of its own σ
         ++result.n_range_outliers;
       } else {
         ++n_in;

@@ -17,6 +17,7 @@
 #include "common/pose_interpolation.h"
 #include "estimator/core/estimator_options.h"
 #include "estimator/core/so3.h"
+#include "estimator/uwb/range_error_correlation.h"
 
 namespace fs = std::filesystem;
 
@@ -42,6 +43,9 @@ FilterRun readFilterRun(const std::string& dir, Diagnostics& diag) {
     } catch (const std::exception& e) {
       diag.report("status.txt:unreadable", (d / "status.txt").string() + ": " + e.what() + " (UWB clock delay 0)");
     }
+  } else {
+    diag.report("status.txt:missing", (d / "status.txt").string() +
+                                          " does not exist: the UWB clock delay is setup.yaml's (uwb_clock.offset_s)");
   }
   return run;
 }
@@ -59,7 +63,8 @@ struct RangeModelSource {
   estimator::EstimatorOptions est;
   double sigma_gamma_unlisted = 0.1, sigma_common = 0.5, sigma_fallback = 0.15, tau_s = 0.1;
 
-  RangeModelSource(const SystemSetup& s, const FilterRun& r) : setup(s), run(r) {
+  RangeModelSource(const SystemSetup& s, const FilterRun& r, const std::string& config) : setup(s), run(r) {
+    if (!config.empty()) est = estimator::EstimatorOptions::fromYaml(config);
     est.applySetupNoise(s.noise);
     sigma_gamma_unlisted = s.noise.sigma_gamma_m.value_or(est.uwb.uncalibrated_gamma_sigma_m);
     sigma_common = est.uwb.uncalibrated_common_gamma_sigma_m;
@@ -85,7 +90,7 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
   if (ds.imu.size() < 2) throw std::runtime_error("smoother: the dataset has no IMU samples");
   if (!(o.knot_period_s > 0.0) || !(o.chunk_s > o.overlap_s) || o.overlap_s < 0.0)
     throw std::invalid_argument("smoother: knot period must be > 0 and chunk longer than overlap");
-  const RangeModelSource model(ds.setup, run);
+  const RangeModelSource model(ds.setup, run, o.estimator_config);
   estimator::EstimatorOptions est = model.est;
   const Duration dt_clock = Duration::fromSec(run.has_clock_offset ? run.uwb_clock_offset_s
                                                                    : ds.setup.uwb_clock.offset_s);
@@ -104,7 +109,9 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
   int chunk_index = 0;
   while (s < span1) {
     Timestamp e = s + chunk;
-    if (e > span1 || span1 - e < overlap) e = span1;
+    // The last chunk takes a remainder shorter than the overlap or than a knot period (a chunk needs
+    // two knots).
+    if (e > span1 || span1 - e < std::max(overlap, period)) e = span1;
     const bool final_chunk = e == span1;
     const Timestamp out_end = final_chunk ? span1 : e - overlap;
     ChunkReport report;
@@ -120,8 +127,12 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
       if (hi != ds.imu.end()) ++hi;
       pr.imu.assign(lo, hi);
     }
+    // The gap's accelerometer density is the estimator's; its gyro density is the smoother's own
+    // (o.gap_sigma_gyro_rad_s): the filter leaves attitude uninflated in a gap for a reason of its
+    // own (a tilt that range updates would use to explain position), which a fit with both ends of
+    // the gap does not have.
     pr.imu_noise = ImuNoiseDensities{est.imu.acc_noise_density, est.imu.gyro_noise_density, est.imu.max_dt_s,
-                                     est.imu.gap_sigma_acc_m_s2, est.imu.gap_sigma_gyro_rad_s};
+                                     est.imu.gap_sigma_acc_m_s2, o.gap_sigma_gyro_rad_s};
     for (size_t i = 1; i < pr.imu.size(); ++i)
       if ((pr.imu[i].t - pr.imu[i - 1].t).sec() > est.imu.max_dt_s) ++report.imu_gaps;
     pr.acc_bias_rw = est.imu.acc_bias_rw;
@@ -229,7 +240,7 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
     std::map<SensorId, int> anchor_unknown_index;
     std::map<std::pair<SensorId, SensorId>, int> pair_unknown;
     std::map<SensorId, int> common_unknown;
-    std::map<std::pair<SensorId, SensorId>, Timestamp> previous;
+    estimator::RangeErrorCorrelation correlation(model.tau_s);
     auto r0 = std::lower_bound(ranges.begin(), ranges.end(), s, [](const RangeSample& r, Timestamp t) { return r.t < t; });
     // An anchor's position: exactly known (setup), else an unknown of the fit (estimate_anchors),
     // else the run's final estimate of it (a calibrated or a known-but-uncertain one), else an
@@ -243,7 +254,7 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
       const auto f = ds.setup.abs_anchor_positions.find(id);
       const auto g = run.anchors.find(id);
       const auto u = ds.setup.abs_anchor_sigmas_m.find(id);
-      const bool uncertain = u != ds.setup.abs_anchor_sigmas_m.end();
+      const bool uncertain = u != ds.setup.abs_anchor_sigmas_m.end() && u->second > 0.0;  // σ 0: exact
       if (f != ds.setup.abs_anchor_positions.end() && !uncertain) return AnchorRef{f->second};
       if (o.estimate_anchors && o.use_run_anchors && (g != run.anchors.end() || uncertain)) {
         AnchorRef a{g != run.anchors.end() ? g->second : f->second};
@@ -255,7 +266,10 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
         return a;
       }
       if (o.use_run_anchors && g != run.anchors.end()) return AnchorRef{g->second};
-      if (f != ds.setup.abs_anchor_positions.end()) return AnchorRef{f->second, -1, u->second};
+      // An uncertain anchor at its setup position: its σ added to each range's noise (a constant
+      // error taken as white, overconfident over many ranges; estimate_anchors fits it instead).
+      // Not with known_anchors_only: only the exactly known anchors then.
+      if (o.use_run_anchors && f != ds.setup.abs_anchor_positions.end()) return AnchorRef{f->second, -1, u->second};
       return std::nullopt;
     };
     for (auto it = r0; it != ranges.end() && it->t <= e; ++it) {
@@ -302,8 +316,10 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
       double sigma = ds.setup.noise.sigma_range_m.value_or(r.R_m2 > 0.0 ? std::sqrt(r.R_m2) : model.sigma_fallback);
       const auto key = pairKey(a_id, sr.anchor);
       std::optional<PairBias> pb = ds.setup.findPairBias(a_id, sr.anchor);
-      if (!pb) pb = model.calibrated(a_id, sr.anchor);
-      if (!pb) pb = model.calibrated(sr.anchor, a_id);
+      // A calibration's γ came from these ranges: with the anchors fitted here (a bundle
+      // adjustment) the pair takes the uncalibrated prior instead, so that no range counts twice.
+      if (!pb && !o.estimate_anchors) pb = model.calibrated(a_id, sr.anchor);
+      if (!pb && !o.estimate_anchors) pb = model.calibrated(sr.anchor, a_id);
       if (pb) {
         sr.beta = pb->beta;
         sigma = pb->sigma_m;
@@ -325,13 +341,13 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
         }
       }
       // A pair's errors are correlated over τ: a range Δt after the pair's previous one carries
-      // (1 − ρ)/(1 + ρ) of an independent one's information, ρ = exp(−Δt/τ).
-      if (auto p = previous.find(key); p != previous.end() && model.tau_s > 0.0) {
-        const double rho = std::exp(-std::max((r.t - p->second).sec(), 0.0) / model.tau_s);
-        sigma *= std::sqrt((1.0 + rho) / std::max(1.0 - rho, 1e-6));
-      }
-      previous[key] = r.t;
+      // (1 − ρ)/(1 + ρ) of an independent one's information, ρ = exp(−Δt/τ), as in the filter
+      // (RangeErrorCorrelation); the robust loss keeps its scale on the range's own σ.
+      const double inflation = correlation.inflation(a_id, sr.anchor, r.t);
+      correlation.noteRange(a_id, sr.anchor, r.t);
       sr.sigma_m = std::sqrt(sigma * sigma + sigma_anchors2);
+      sr.noise_inflation = std::sqrt(inflation);
+      sr.sigma_m *= sr.noise_inflation;
       pr.ranges.push_back(sr);
     }
     out.n_ranges_used += static_cast<int>(pr.ranges.size());

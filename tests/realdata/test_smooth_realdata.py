@@ -16,7 +16,7 @@ import realdata_support as rs
 
 STARLOC_DIR = os.path.join(rs.SHARED, "data", "real-starloc-loop2d-s1")
 # smoothed position RMSE [m] (the filter's in brackets), 2026-12-06
-MEASURED = {"starloc": 0.121, "isas": 0.055, "ifo002": 0.250}  # (0.141, 0.250, 1.006)
+MEASURED = {"starloc": 0.123, "isas": 0.052, "ifo002": 0.250}  # (0.141, 0.250, 1.006)
 TARGET = {"starloc": 0.20, "isas": 0.16}  # issue 35; MILUV: half the filter's figure
 MARGIN_M = 0.02
 

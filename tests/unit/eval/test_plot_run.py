@@ -125,9 +125,6 @@ class RangeResiduals(unittest.TestCase):
             self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
 
 
-if __name__ == "__main__":
-    unittest.main()
-
 
 class SmoothedBesideTheFilter(unittest.TestCase):
     """meshnav_eval passes --smoothed and --smoothed-errors when the run has estimate_smoothed.csv:
@@ -159,3 +156,7 @@ class SmoothedBesideTheFilter(unittest.TestCase):
             sys.argv = argv
         for png in ("trajectory_xy.png", "trajectory_3d.png", "position_error.png", "position_error_smoothed.png"):
             self.assertTrue(os.path.exists(os.path.join(out, png)), png)
+
+
+if __name__ == "__main__":
+    unittest.main()
