@@ -401,8 +401,8 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
                                  b.p.data(), b.q.data(), b.v.data(), b.bg.data(), b.ba.data(), &height_bias);
       }
     }
-    // Anchors: an estimated one's block is shared by its ranges, a known one's is constant.
-    std::map<SensorId, size_t> known_index;
+    // Anchors: an estimated one's block is shared by its ranges, a known one's is constant (a map's
+    // elements stay where they are, as Ceres needs of a parameter block).
     for (size_t i = 0; i < anchor_blocks.size(); ++i) {
       problem.AddParameterBlock(anchor_blocks[i].data(), 3);
       if (pr.anchors[i].prior_sigma_m > 0.0)
@@ -410,17 +410,15 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
                                      pr.anchors[i].prior_mean_m, 1.0 / pr.anchors[i].prior_sigma_m}),
                                  nullptr, anchor_blocks[i].data());
     }
-    std::vector<std::array<double, 3>> known_blocks;
-    known_blocks.reserve(2 * pr.ranges.size());
+    std::map<SensorId, std::array<double, 3>> known_blocks;
     auto anchorBlock = [&](SensorId id, const Eigen::Vector3d& p, int unknown) -> double* {
       if (unknown >= 0) return anchor_blocks[static_cast<size_t>(unknown)].data();
-      auto [it, fresh] = known_index.emplace(id, known_blocks.size());
+      auto [it, fresh] = known_blocks.emplace(id, std::array<double, 3>{p.x(), p.y(), p.z()});
       if (fresh) {
-        known_blocks.push_back({p.x(), p.y(), p.z()});
-        problem.AddParameterBlock(known_blocks.back().data(), 3);
-        problem.SetParameterBlockConstant(known_blocks.back().data());
+        problem.AddParameterBlock(it->second.data(), 3);
+        problem.SetParameterBlockConstant(it->second.data());
       }
-      return known_blocks[it->second].data();
+      return it->second.data();
     };
     // Ranges.
     std::vector<ceres::ResidualBlockId> range_ids;

@@ -58,17 +58,15 @@ using estimator::so3::logMap;
 /// setup pair_biases first, then a calibrated anchor's biases, else an unlisted pair with the
 /// estimator's model γ = c_tag + e_pair.
 struct RangeModelSource {
-  const SystemSetup& setup;
   const FilterRun& run;
   estimator::EstimatorOptions est;
-  double sigma_gamma_unlisted = 0.1, sigma_common = 0.5, sigma_fallback = 0.15, tau_s = 0.1;
+  double sigma_gamma_unlisted = 0.1;  ///< the setup's noise.sigma_gamma, else the estimator's [m]
+  double tau_s = 0.1;                 ///< the setup's noise.range_correlation_time, else the estimator's [s]
 
-  RangeModelSource(const SystemSetup& s, const FilterRun& r, const std::string& config) : setup(s), run(r) {
+  RangeModelSource(const SystemSetup& s, const FilterRun& r, const std::string& config) : run(r) {
     if (!config.empty()) est = estimator::EstimatorOptions::fromYaml(config);
     est.applySetupNoise(s.noise);
     sigma_gamma_unlisted = s.noise.sigma_gamma_m.value_or(est.uwb.uncalibrated_gamma_sigma_m);
-    sigma_common = est.uwb.uncalibrated_common_gamma_sigma_m;
-    sigma_fallback = est.uwb.sigma_range_m;
     tau_s = s.noise.range_correlation_time_s.value_or(est.uwb.range_error_correlation_s);
   }
 
@@ -313,7 +311,7 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
         sigma_anchors2 = a->sigma_m * a->sigma_m;
       }
       const SensorId a_id = sr.tag != 0 ? sr.tag : sr.anchor_b;
-      double sigma = ds.setup.noise.sigma_range_m.value_or(r.R_m2 > 0.0 ? std::sqrt(r.R_m2) : model.sigma_fallback);
+      double sigma = ds.setup.noise.sigma_range_m.value_or(r.R_m2 > 0.0 ? std::sqrt(r.R_m2) : est.uwb.sigma_range_m);
       const auto key = pairKey(a_id, sr.anchor);
       std::optional<PairBias> pb = ds.setup.findPairBias(a_id, sr.anchor);
       // A calibration's γ came from these ranges: with the anchors fitted here (a bundle
@@ -336,7 +334,7 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
         sr.gamma_unknown = f->second;
         if (sr.tag != 0) {  // a tag's pairs share its common offset (docs/uwb_bias_model.md)
           auto [c, cfresh] = common_unknown.emplace(sr.tag, static_cast<int>(pr.range_biases.size()));
-          if (cfresh) pr.range_biases.push_back(RangeBiasUnknown{0.0, model.sigma_common});
+          if (cfresh) pr.range_biases.push_back(RangeBiasUnknown{0.0, est.uwb.uncalibrated_common_gamma_sigma_m});
           sr.common_unknown = c->second;
         }
       }
