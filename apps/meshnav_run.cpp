@@ -46,6 +46,7 @@ constexpr char kDescription[] =
 struct RunOptions {
   std::string dataset, fleet, out, strategy, config, mission, calib_config;
   bool no_calibration = false, allow_lost = false, print_config = false, print_model_parameters = false;
+  bool calibrate_on_smoothed = false;
 };
 
 void declareOptions(Cli& cli, RunOptions& o) {
@@ -72,6 +73,10 @@ void declareOptions(Cli& cli, RunOptions& o) {
                       ->type_name("FILE");
   cli.flag("no-calibration", o.no_calibration, "known anchors only: ranges to unknown anchors are ignored (and counted)")
       ->excludes(mission);
+  cli.flag("calibrate-on-smoothed", o.calibrate_on_smoothed,
+           "the calibrator's tag poses become the fixed-lag smoothed ones as they come (fixed_lag.lag_s later; "
+           "docs/smoother.md, calibration on the smoothed path)")
+      ->excludes("--no-calibration");
   cli.optional("calib-config", o.calib_config,
                "calibrator options YAML (default: built-in = config/calibrator.yaml); calibration results are "
                "written to calibration.yaml in --out")
@@ -230,6 +235,7 @@ struct VehicleRun {
   Dataset ds;
   std::unique_ptr<EstimateCsvWriter> estimates;
   std::unique_ptr<AnchorsCsvWriter> anchors;
+  std::unique_ptr<EstimateCsvWriter> smoothed;  ///< fixed-lag smoothed poses (fixed_lag.enabled)
   std::string who() const { return name.empty() ? "" : "vehicle " + name + ": "; }
 };
 
@@ -283,6 +289,7 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
   pipeline::PipelineOptions popts;
   popts.estimator = options;
   popts.calibration_enabled = !o.no_calibration;
+  popts.calibrator_on_smoothed = o.calibrate_on_smoothed;
   calib::CalibratorConfig calib_config = calib::CalibratorConfig::load(o.calib_config);
   if (!o.mission.empty()) popts.mission = mission::loadMission(o.mission);
 
@@ -303,10 +310,14 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
     std::filesystem::create_directories(r.out);
     // A smoother's output of an earlier run in this folder belongs to that run: meshnav_eval would
     // score it beside this one (docs/smoother.md).
+    // (estimate_smoothed.csv is this run's fixed-lag smoother's, fixed_lag.enabled.)
     for (const char* stale : {"estimate_smoothed.csv", "anchors_smoothed.csv", "smoother.yaml", "errors_smoothed.csv"})
-      if (std::filesystem::remove(r.out / stale))
+      if ((!options.fixed_lag.enabled() || std::string(stale) != "estimate_smoothed.csv") &&
+          std::filesystem::remove(r.out / stale))
         spdlog::info("removed {} of an earlier run (meshnav smooth it again)", (r.out / stale).string());
     r.estimates = std::make_unique<EstimateCsvWriter>((r.out / "estimate.csv").string());
+    if (options.fixed_lag.enabled())
+      r.smoothed = std::make_unique<EstimateCsvWriter>((r.out / "estimate_smoothed.csv").string());
     r.anchors = std::make_unique<AnchorsCsvWriter>((r.out / "anchors.csv").string());
   }
   // The calibrator's range σ_d comes from setup.yaml (the first vehicle's in a fleet) unless the
@@ -320,6 +331,8 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
     runs[v].estimates->write(e);
     last_pose[v] = std::max(last_pose[v].value_or(e.t), e.t);
   };
+  if (options.fixed_lag.enabled())
+    psinks.pose_smoothed = [&](size_t v, const PoseEstimate& e) { runs[v].smoothed->write(e); };
   psinks.anchors = [&](size_t v, const std::vector<AnchorEstimate>& list) {
     for (const auto& a : list) runs[v].anchors->write(a);
   };
@@ -335,14 +348,16 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
   std::signal(SIGTERM, onStopSignal);
   const double wall_s = feed(pipe, inputs, data_s);
   int code = 0;
+  // The end of the stream: what waits for an IMU sample, a re-run still on its worker (before the
+  // final anchors), the last lag_s of smoothed poses.
+  pipe.finish();
   for (size_t v = 0; v < runs.size(); ++v) {
     EstimatorNode& node = pipe.estimator(v);
-    node.flushHeld();    // the end of the stream: no IMU sample will come for what waits for one
-    node.finishRerun();  // refine.rerun_mode async: a re-run still on its worker comes in before the final anchors
     if (node.initialized())
       for (const auto& a : node.anchors()) runs[v].anchors->write(a);
     runs[v].estimates->flush();
     runs[v].anchors->flush();
+    if (runs[v].smoothed) runs[v].smoothed->flush();
     writeTimings(node.timings(), (runs[v].out / "timings.csv").string());
   }
   if (pipe.diagnostics().total() > 0) spdlog::info("fleet: {}", pipe.diagnostics().summary());

@@ -5,6 +5,7 @@
 ///
 /// Files in the output folder:
 ///  - estimate.csv    every POSE (common/estimate_io.h)
+///  - estimate_smoothed.csv  every POSE_SMOOTHED (the same columns), from the first one on
 ///  - anchors.csv     every anchor of every ANCHORS message
 ///  - anchor_init.yaml  every ANCHOR_INIT, in the calibration YAML format (`anchors:` list),
 ///                    rewritten at each one (into a temporary file renamed over it: a kill -9
@@ -50,6 +51,9 @@ class RunRecorder {
   void countMessage(const std::string& channel, int64_t bytes, int64_t wall_utime);
 
   void onPose(const PoseEstimate& e);
+  /// A fixed-lag smoothed pose: estimate_smoothed.csv is opened at the first one (continued when
+  /// `append`, its torn last row cut).
+  void onPoseSmoothed(const PoseEstimate& e);
   void onAnchors(const std::vector<AnchorEstimate>& anchors);
   void onAnchorInit(const AnchorInit& a);
   void onGroundTruth(const PoseSample& p);
@@ -68,6 +72,7 @@ class RunRecorder {
 
   const std::map<std::string, ChannelStats>& channels() const { return channels_; }
   int64_t posesWritten() const { return n_poses_; }
+  int64_t smoothedPosesWritten() const { return n_smoothed_; }
   int64_t anchorRowsWritten() const { return n_anchor_rows_; }
   const std::string& outDir() const { return out_dir_; }
   /// The recorder's own counters (torn rows cut on a restart).
@@ -76,6 +81,8 @@ class RunRecorder {
  private:
   std::string out_dir_;
   std::unique_ptr<EstimateCsvWriter> estimate_;
+  std::unique_ptr<EstimateCsvWriter> smoothed_;  ///< at the first POSE_SMOOTHED
+  bool append_ = false;
   std::unique_ptr<AnchorsCsvWriter> anchors_;
   std::vector<AnchorInit> anchor_inits_;
   std::vector<PoseSample> ground_truth_;
@@ -84,6 +91,7 @@ class RunRecorder {
   std::optional<CalibStatus> last_calib_status_;
   std::optional<MissionStatus> last_mission_status_;
   int64_t n_poses_ = 0;
+  int64_t n_smoothed_ = 0;
   int64_t n_anchor_rows_ = 0;
   bool finished_ = false;
   Diagnostics diag_;

@@ -52,6 +52,10 @@ struct PipelineOptions {
   std::optional<mission::Mission> mission;
   bool calibration_enabled = true;     ///< false: no calibrator (known anchors only)
   double pose_to_calibrator_hz = 50.0; ///< POSE decimation towards the calibrator (0: every pose) [Hz]
+  /// The calibrator's tag poses: the filter's POSE (false), or each of them replaced by its
+  /// fixed-lag smoothed twin once that comes, lag_s later (true; issue 35 item 3, docs/smoother.md
+  /// "Calibration on the smoothed path").
+  bool calibrator_on_smoothed = false;
 };
 
 /// One vehicle of a fleet: a name (its output folder) and its setup. The anchors of every vehicle's
@@ -65,6 +69,9 @@ struct Vehicle {
 /// (the vehicle's index in the constructor's list, 0 for a single vehicle).
 struct PipelineSinks {
   std::function<void(size_t vehicle, const PoseEstimate&)> pose;
+  /// Fixed-lag smoothed poses (POSE_SMOOTHED; estimator.yaml fixed_lag.*). Without it the
+  /// estimators smooth nothing.
+  std::function<void(size_t vehicle, const PoseEstimate&)> pose_smoothed;
   std::function<void(size_t vehicle, const std::vector<AnchorEstimate>&)> anchors;
   std::function<void(size_t vehicle, const EstimatorStatus&)> estimator_status;
   std::function<void(const AnchorInit&)> anchor_init;
@@ -90,6 +97,11 @@ class Pipeline {
   /// The same for vehicle `vehicle` (out of range: std::out_of_range).
   void onInput(size_t vehicle, const estimator::EstimatorInput& in);
 
+  /// The end of the streams: every estimator processes what waits for an IMU sample (flushHeld),
+  /// takes a re-run still on its worker (finishRerun) and emits its last fixed-lag smoothed poses
+  /// (flushSmoothed); then every message they cause is delivered.
+  void finish();
+
   size_t vehicleCount() const { return vehicles_.size(); }
   const std::string& vehicleName(size_t v) const { return vehicles_.at(v).name; }
   /// The estimator of vehicle `v` (0: the only one of a single vehicle).
@@ -105,7 +117,11 @@ class Pipeline {
   const Diagnostics& diagnostics() const { return diag_; }
 
  private:
-  using Message = std::variant<PoseEstimate, std::vector<AnchorEstimate>, EstimatorStatus, AnchorInit, CalibStatus,
+  /// A POSE_SMOOTHED (a type of its own in the queue: it goes elsewhere than a POSE).
+  struct SmoothedPose {
+    PoseEstimate pose;
+  };
+  using Message = std::variant<PoseEstimate, SmoothedPose, std::vector<AnchorEstimate>, EstimatorStatus, AnchorInit, CalibStatus,
                                CalibCommand, EstimatorCommand, MissionStatus>;
   struct Event {
     size_t vehicle = 0;  ///< whose estimator sent it (estimator outputs only)
@@ -131,6 +147,9 @@ class Pipeline {
   Diagnostics diag_;
   std::set<std::tuple<int64_t, SensorId, SensorId>> mesh_ranges_;  ///< (µs, ids) given to the calibrator
   std::vector<std::optional<Timestamp>> last_pose_to_calibrator_;  ///< per vehicle
+  /// Per vehicle, the POSE instants the calibrator took whose smoothed twin has not come yet
+  /// (calibrator_on_smoothed).
+  std::vector<std::set<int64_t>> awaiting_smoothed_;
   bool t0_set_ = false;
 };
 

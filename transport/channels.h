@@ -39,6 +39,8 @@ inline constexpr Channel<HeightSample> kHeight{"HEIGHT"};                     //
 inline constexpr Channel<PoseSample> kGroundTruth{"GROUND_TRUTH"};            ///< ground_truth_t (simulator, logs)
 inline constexpr Channel<AnchorInit> kAnchorInit{"ANCHOR_INIT"};              ///< anchor_init_t, calibrator → estimator
 inline constexpr Channel<PoseEstimate> kPose{"POSE"};                         ///< pose_t, estimator →
+/// pose_t, estimator → (fixed-lag smoothed, `fixed_lag.lag_s` or more after its utime; docs/smoother.md)
+inline constexpr Channel<PoseEstimate> kPoseSmoothed{"POSE_SMOOTHED"};
 inline constexpr Channel<std::vector<AnchorEstimate>> kAnchors{"ANCHORS"};    ///< anchors_t, estimator →
 inline constexpr Channel<EstimatorStatus> kEstimatorStatus{"ESTIMATOR_STATUS"}; ///< estimator_status_t (heartbeat)
 inline constexpr Channel<EstimatorCommand> kEstimatorCmd{"ESTIMATOR_CMD"};    ///< estimator_cmd_t, mission → estimator
@@ -52,7 +54,7 @@ inline constexpr Channel<time_sync_t> kTimeSync{"TIME_SYNC"};                 //
 inline constexpr auto kTyped =
     std::tuple{kImu,  kBaro,           kRange,     kFlightState, kGroundTruth,   kAnchorInit,      kPose,     kAnchors,
                kEstimatorStatus, kEstimatorCmd, kCalibCmd, kCalibStatus, kMissionStatus, kHeight, kTimeSyncRequest,
-               kTimeSync};
+               kTimeSync,        kPoseSmoothed};
 
 /// The name of every channel above, for tools that list or record them.
 inline constexpr auto kAll =

@@ -23,7 +23,12 @@
 ///  - Micro/<s>/<N>: reference scenario (a 6-state p, v body at 100 Hz, N stationary 3-state
 ///    anchors, body–anchor ranges at 10 Hz each, ring i → i+1 ranges, σ 0.1 m): one range update;
 ///  - Sequence/<s>: a whole simulated paper sequence (seed 1) through EstimatorNode (needs the
-///    simulator library), counter realtime_factor;
+///    simulator library), counter realtime_factor, and pose_latency_p99_us / pose_latency_max_us
+///    (wall time from an IMU sample's onInput to its POSE);
+///  - SequenceFixedLag/<s>: the same with the fixed-lag smoother (a POSE_SMOOTHED sink): its cost
+///    is the ratio of the two CPU times, its effect on POSE the latency counters;
+///  - SequenceFlyBy/<s>, SequenceFlyByFixedLag/<s>: both with the S2 fly-by anchors joining at 80
+///    and 100 s (each join re-runs the stored history): the paper scenario's estimator;
 ///  - AlignerSolve/<window_s>: one in-motion alignment (MotionAligner::solve: the multi-start
 ///    Levenberg–Marquardt fit of IMU and tag–anchor ranges) over the last <window_s> seconds of
 ///    that sequence before t = 52 s, in flight; the node runs it while uninitialized, lost or
@@ -37,6 +42,8 @@
 #include <benchmark/benchmark.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <chrono>
 #include <random>
 
 #include "estimator/core/strategy_list.h"
@@ -371,20 +378,63 @@ const Dataset& paperSequence() {
   return ds;
 }
 
-void Sequence(benchmark::State& state, std::string strategy) {
+/// The sequence's inputs; with `flyby` the fly-by anchors the setup does not know (106–110) join
+/// as the calibrator's ANCHOR_INITs would in S2 (config/missions/paper_s2.yaml: 106–108 at 80 s,
+/// 109–110 at 100 s), at their true position 0.05 m off with σ 0.06 m: each join re-runs the
+/// filter over the stored history (refine.rerun_on_anchor_join), the estimator's main extra cost.
+std::vector<EstimatorInput> sequenceInputs(const Dataset& ds, bool flyby) {
+  std::vector<EstimatorInput> inputs = mergeInTimeOrder(ds);
+  if (!flyby || !ds.truth) return inputs;
+  for (const auto& [id, p] : ds.truth->anchor_positions) {
+    if (ds.setup.abs_anchor_positions.count(id)) continue;
+    AnchorInit a;
+    a.t = Timestamp::fromSec(id <= 108 ? 80.0 : 100.0);
+    a.id = id;
+    a.p_AinG = p + Eigen::Vector3d(0.05, -0.03, 0.02);
+    a.cov_p_m2 = Eigen::Matrix3d::Identity() * 0.06 * 0.06;
+    const auto at = std::lower_bound(inputs.begin(), inputs.end(), a.t,
+                                     [](const EstimatorInput& in, Timestamp t) { return inputTime(in) < t; });
+    inputs.insert(at, a);
+  }
+  return inputs;
+}
+
+/// `fixed_lag`: with a POSE_SMOOTHED sink, so the fixed-lag smoother runs (SequenceFixedLag/<s>).
+/// `flyby`: anchors join (sequenceInputs; SequenceFlyBy/<s>, SequenceFlyByFixedLag/<s>).
+/// Counters pose_latency_p99_us / _max_us: the wall time from an IMU sample's onInput to its POSE.
+void Sequence(benchmark::State& state, std::string strategy, bool fixed_lag, bool flyby) {
   const Dataset& ds = paperSequence();
-  const auto inputs = mergeInTimeOrder(ds);
+  const auto inputs = sequenceInputs(ds, flyby);
   EstimatorOptions o;
   o.strategy = strategy;
+  size_t smoothed = 0;
+  std::vector<double> latency_us;
   for (auto _ : state) {
-    EstimatorNode node(o, ds.setup, {});
-    for (const auto& in : inputs) node.onInput(in);
+    latency_us.clear();
+    std::chrono::steady_clock::time_point t_in;
+    EstimatorSinks sinks;
+    sinks.pose = [&](const PoseEstimate&) {
+      latency_us.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t_in).count());
+    };
+    if (fixed_lag) sinks.pose_smoothed = [&](const PoseEstimate&) { ++smoothed; };
+    EstimatorNode node(o, ds.setup, sinks);
+    for (const auto& in : inputs) {
+      t_in = std::chrono::steady_clock::now();
+      node.onInput(in);
+    }
+    node.flushSmoothed();
     benchmark::DoNotOptimize(node.pose());
   }
   const double dur = (inputTime(inputs.back()) - inputTime(inputs.front())).sec();
   state.counters["inputs"] = static_cast<double>(inputs.size());
   state.counters["realtime_factor"] =
       benchmark::Counter(dur * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  if (!latency_us.empty()) {
+    std::sort(latency_us.begin(), latency_us.end());
+    state.counters["pose_latency_p99_us"] = latency_us[latency_us.size() * 99 / 100];
+    state.counters["pose_latency_max_us"] = latency_us.back();
+  }
+  if (fixed_lag) state.counters["smoothed_per_iteration"] = static_cast<double>(smoothed) / static_cast<double>(state.iterations());
 }
 
 void AlignerSolve(benchmark::State& state, double window_s) {
@@ -446,7 +496,12 @@ void registerAll() {
       benchmark::RegisterBenchmark(("Micro/" + std::string(s) + "/" + std::to_string(N)).c_str(), Micro, s, N);
 #ifdef MESHNAV_BENCH_WITH_SIM
   for (const char* s : listedStrategies())
-    benchmark::RegisterBenchmark(("Sequence/" + std::string(s)).c_str(), Sequence, s)->Unit(benchmark::kMillisecond);
+    for (bool flyby : {false, true})
+      for (bool fixed_lag : {false, true})
+        benchmark::RegisterBenchmark(
+            (std::string(flyby ? "SequenceFlyBy" : "Sequence") + (fixed_lag ? "FixedLag/" : "/") + s).c_str(), Sequence,
+            s, fixed_lag, flyby)
+            ->Unit(benchmark::kMillisecond);
   for (double w : {6.0, 12.0})
     benchmark::RegisterBenchmark(("AlignerSolve/" + std::to_string(static_cast<int>(w))).c_str(), AlignerSolve, w)
         ->Unit(benchmark::kMillisecond);

@@ -86,7 +86,7 @@ const Field kFields[] = {
     {"time.max_offset_s", field<&EstimatorOptions::time, &TimeGuardOptions::max_offset_s>, "an input stamped farther than this from the current (newest) time is refused and counted [s]"},
     {"refine.rerun_on_anchor_join", field<&EstimatorOptions::refine, &RefineOptions::rerun_on_anchor_join>, "on ANCHOR_INIT re-run from the oldest stored input with the calibrated anchors uncertain from there"},
     {"refine.max_history_s", field<&EstimatorOptions::refine, &RefineOptions::max_history_s>, "inputs kept for re-runs (about 260 B each, S2: 360 inputs/s); older ones are dropped in eighths, counted [s]"},
-    {"refine.rerun_mode", field<&EstimatorOptions::refine, &RefineOptions::rerun_mode>, "auto | sync | async: re-run inline, or on a worker while the node keeps publishing; auto = async in the LCM process"},
+    {"fixed_lag.lag_s", field<&EstimatorOptions::fixed_lag, &FixedLagOptions::lag_s>, "fixed-lag smoothed poses beside the filter's (POSE_SMOOTHED, estimate_smoothed.csv), each holding at least this much data after it; 0 = none [s]"},
 };
 
 /// The model parameters (docs/configuration.md, "Model parameters"): fixed in code with their
@@ -169,6 +169,8 @@ const Field kModelParameters[] = {
     {"refine.rerun_gamma_sigma_m", field<&EstimatorOptions::refine, &RefineOptions::rerun_gamma_sigma_m>, "sigma of its gamma in a re-run [m]"},
     {"refine.rerun_gamma_from_calibration", field<&EstimatorOptions::refine, &RefineOptions::rerun_gamma_from_calibration>, "gamma means of a re-run: the calibration's (true) or the calibrator's prior mean 0 (false)"},
     {"refine.rerun_with_dah", field<&EstimatorOptions::refine, &RefineOptions::rerun_with_dah>, "strategy dah too (with its joint sets, uwb.dah_joint_anchors; see docs)"},
+    {"refine.rerun_mode", field<&EstimatorOptions::refine, &RefineOptions::rerun_mode>, "auto | sync | async: re-run inline, or on a worker while the node keeps publishing; auto = async in the LCM process, sync in replays"},
+    {"fixed_lag.period_s", field<&EstimatorOptions::fixed_lag, &FixedLagOptions::period_s>, "data time between two backward passes of the fixed-lag smoother [s]"},
 };
 
 /// Visits every option as (dotted key, field, unit/comment).
@@ -317,6 +319,8 @@ void EstimatorOptions::validate() const {
        "refine.max_history_s >= window_s, refine.rerun_prior_sigma_m > 0, refine.rerun_gamma_sigma_m > 0");
   need(refine.rerun_mode == "auto" || refine.rerun_mode == "sync" || refine.rerun_mode == "async",
        "refine.rerun_mode must be auto, sync or async");
+  need(fixed_lag.lag_s >= 0.0 && fixed_lag.lag_s <= 60.0 && fixed_lag.period_s > 0.0 && fixed_lag.period_s <= 10.0,
+       "fixed_lag.lag_s in [0, 60] and fixed_lag.period_s in (0, 10]");
   need(zupt.rate_hz > 0 && zupt.sigma_acc_m_s2 > 0 && zupt.sigma_gyro_rad_s > 0 && zupt.sigma_vel_m_s > 0 &&
            zupt.stillness_sigma_vel_m_s > 0 && zupt.stillness_sigma_gyro_rad_s > 0,
        "zupt rate and sigmas > 0");

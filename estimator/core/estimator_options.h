@@ -281,6 +281,18 @@ struct ZuptOptions {
   double stillness_sigma_gyro_rad_s = 0.02;  ///< [rad/s]
 };
 
+/// The fixed-lag smoother beside the filter (FixedLagSmoother, docs/smoother.md).
+struct FixedLagOptions {
+  /// Smallest age of a smoothed pose: the data after it that it holds; 0 = no smoothed poses
+  /// (POSE_SMOOTHED, estimate_smoothed.csv) [s]
+  double lag_s = 2.0;
+  /// Model parameter: data time between two backward passes (the lag is lag_s … about
+  /// lag_s + 2 period_s). Each record is visited (lag_s + period_s) / period_s times: 1 s keeps the
+  /// smoother's CPU near the filter's at 200 Hz (docs/smoother.md) [s]
+  double period_s = 1.0;
+  bool enabled() const { return lag_s > 0.0; }
+};
+
 /// Re-initialization when the health monitor reports `lost`.
 struct RecoveryOptions {
   bool enabled = true;
@@ -363,6 +375,7 @@ struct EstimatorOptions {
   RecoveryOptions recovery;
   FlightVolumeOptions flight_volume;
   RefineOptions refine;
+  FixedLagOptions fixed_lag;
   /// Inputs stamped far from the node's current time (common/time_guard.h): `time.max_offset_s`
   /// (>= window_s) and `time.rebase_after`.
   TimeGuardOptions time;

@@ -50,6 +50,7 @@ void CentralizedEkf::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vec
   if (dt <= 0.0) return;
   ImuMatrix Phi, Q;
   propagator_.propagate(x_.imu, acc_m_s2, gyro_rad_s, dt, &Phi, &Q);
+  noteTransition(Phi);
   x_.t = t_to;
   constexpr int kI = ImuErr::kDim;  // the IMU block is always first
   const int n = layout_.dim();

@@ -55,6 +55,12 @@ class FusionStrategy {
 
   /// Propagates to `t_to` with IMU readings held constant since the state's time.
   virtual void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) = 0;
+  /// Starts accumulating the IMU block's error transition: transition() is the identity until the
+  /// next propagate(), then Φ_n ⋯ Φ_1 of the propagations since (the fixed-lag smoother's Φ over
+  /// one propagation of the node, which may be several steps across an IMU gap; FixedLagSmoother).
+  void startTransition() { transition_ = ImuMatrix::Identity(); }
+  /// The product of the IMU block's Φ since startTransition() (addImuNoise changes no Φ).
+  const ImuMatrix& transition() const { return transition_; }
   /// Adds Q to the IMU instance's covariance (Σ_II ← Σ_II + Q; cross-covariances unchanged, so
   /// the full matrix stays positive definite). Used for IMU gaps (held readings).
   virtual void addImuNoise(const ImuMatrix& Q) = 0;
@@ -72,7 +78,12 @@ class FusionStrategy {
   /// definite and, for the modular strategies, the factor bookkeeping is consistent.
   virtual void checkInvariants() const = 0;
 
+ private:
+  ImuMatrix transition_ = ImuMatrix::Identity();
+
  protected:
+  /// Every propagate() records its step's Φ here (transition()).
+  void noteTransition(const ImuMatrix& Phi) { transition_ = Phi * transition_; }
   /// The nominal state addInstance writes the new value into.
   virtual NominalState& mutableState() = 0;
   /// Appends a block of kind `kind` with covariance `cov` (its dimension), uncorrelated with the

@@ -37,6 +37,7 @@ void ModularFilter::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vect
   if (dt <= 0.0) return;
   ImuMatrix Phi, Q;
   propagator_.propagate(x_.imu, acc_m_s2, gyro_rad_s, dt, &Phi, &Q);
+  noteTransition(Phi);
   x_.t = t_to;
   cov_.propagate(x_.imu_id, Phi, Q, t_to);
   // Kind by kind in registry order, instances by id: Σ_kk += σ_k² Δt I.

@@ -85,7 +85,8 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       reentry_(options_.uwb, diag_),
       resume_(options_, setup_, diag_),
       timeline_(options_.window_s, options_.refine, AnchorRerun::enabledBy(options_), diag_),
-      rerun_(options_, diag_, timings_) {
+      rerun_(options_, diag_, timings_),
+      smoother_(options_.fixed_lag, diag_, sinks_.pose_smoothed) {
   options_.validate();
   resetAll();
 }
@@ -99,6 +100,7 @@ void EstimatorNode::reportSetupGeometry() {
 }
 
 void EstimatorNode::resetAll() {
+  smoother_.reset();
   init_.reset();
   volume_.reset();
   gravity_.reset();
@@ -272,6 +274,10 @@ void EstimatorNode::accept(const EstimatorInput& in) {
     replayAfter(it);  // resets next_imu_
   }
   timeline_.advance(t);
+  if (smoother_.enabled()) {
+    ScopedStepTimer timer(timings_, "fixed_lag");
+    smoother_.work();  // after this input's POSE: a pass never delays one
+  }
   releaseReentryIfDue();
   // Anchors calibrated together arrive as consecutive ANCHOR_INITs: one re-run for all of them.
   // Not from a measurement being released: the re-run would end with it but without its sample.
@@ -328,7 +334,38 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
 void EstimatorNode::propagateTo(Timestamp t) {
   if (!cur_.last_imu || t <= cur_.filter->state().t) return;
   ScopedStepTimer timer(timings_, "propagate");
-  sensors_.imu.toTime(*cur_.filter, t, propagationInputs());
+  propagateRecorded([&] { sensors_.imu.toTime(*cur_.filter, t, propagationInputs()); });
+}
+
+namespace {
+/// The filter's IMU block as the fixed-lag smoother keeps it.
+ImuBelief imuBeliefOf(const FusionStrategy& f) {
+  const NominalState& x = f.state();
+  return ImuBelief{x.t, x.imu, ImuMatrix(f.covariance(x.imu_id, x.imu_id))};
+}
+}  // namespace
+
+template <class Propagate>
+void EstimatorNode::propagateRecorded(Propagate&& propagate) {
+  FusionStrategy& f = *cur_.filter;
+  if (!smoother_.wants(f.state().t)) {  // off, or a replay of what no smoothed pose needs
+    if (smoother_.enabled()) smoother_.skip(f.state().t);
+    propagate();
+    return;
+  }
+  ImuBelief from;
+  {
+    ScopedStepTimer timer(timings_, "fixed_lag");
+    from = imuBeliefOf(f);
+    f.startTransition();
+  }
+  propagate();
+  ScopedStepTimer timer(timings_, "fixed_lag");
+  smoother_.onPropagation(from, imuBeliefOf(f), f.transition());
+}
+
+void EstimatorNode::flushSmoothed() {
+  if (smoother_.enabled() && initialized()) smoother_.finish(imuBeliefOf(*cur_.filter));
 }
 
 ImuPropagation::Inputs EstimatorNode::propagationInputs() const {
@@ -348,7 +385,7 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
   }
   if (s.t > t0) {
     ScopedStepTimer timer(timings_, "propagate");
-    sensors_.imu.toSample(f, s, propagationInputs());
+    propagateRecorded([&] { sensors_.imu.toSample(f, s, propagationInputs()); });
   }
   const std::optional<ImuSample> previous = cur_.last_imu;
   cur_.prev_imu = previous;
@@ -366,7 +403,11 @@ void EstimatorNode::processImu(const ImuSample& s, bool first) {
     cur_.last_carried_height = s.t;
     processHeight(HeightSample{s.t, setup_.carried_height->height_m}, first);
   }
-  if (first && sinks_.pose && outputs_.poseDue(s.t)) sinks_.pose(poseOf(*cur_.filter));
+  if (first && (sinks_.pose || smoother_.enabled()) && outputs_.poseDue(s.t)) {
+    const PoseEstimate e = poseOf(*cur_.filter);
+    if (sinks_.pose) sinks_.pose(e);
+    smoother_.onPose(e);
+  }
 }
 
 void EstimatorNode::applyCommand(const EstimatorCommand& c, bool first) {

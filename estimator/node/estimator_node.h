@@ -70,6 +70,7 @@
 #include "estimator/filter/fusion_strategy.h"
 #include "estimator/refine/anchor_rerun.h"
 #include "estimator/restart/resume.h"
+#include "estimator/smooth/fixed_lag_smoother.h"
 #include "estimator/node/estimator_input.h"
 #include "estimator/health/health_monitor.h"
 #include "estimator/health/recovery_confirmation.h"
@@ -97,6 +98,9 @@ namespace meshnav::estimator {
 
 struct EstimatorSinks {
   std::function<void(const PoseEstimate&)> pose;
+  /// Fixed-lag smoothed poses (FixedLagSmoother, `fixed_lag.*`): one per POSE, `fixed_lag.lag_s`
+  /// to lag_s + period_s of data time after it, in time order. Without this sink nothing is smoothed.
+  std::function<void(const PoseEstimate&)> pose_smoothed;
   std::function<void(const std::vector<AnchorEstimate>&)> anchors;
   std::function<void(const EstimatorStatus&)> status;
 };
@@ -121,6 +125,10 @@ class EstimatorNode : private RerunReplayer {
   /// Processes the measurements held for their next IMU sample on extrapolated readings: the end
   /// of a stream, when no sample will come (meshnav_run and the process call it at their end).
   void flushHeld();
+  /// The end of a stream: every fixed-lag smoothed pose still waiting for its lag goes out,
+  /// smoothed with the data there is (meshnav_run and the process call it at their end, after
+  /// flushHeld and finishRerun).
+  void flushSmoothed();
 
   bool initialized() const { return filter() != nullptr; }
   /// The current estimate (at the newest processed input), when initialized.
@@ -200,6 +208,10 @@ class EstimatorNode : private RerunReplayer {
   /// interpolated towards next_imu_ when known, else extrapolated along the last two samples to
   /// the step's middle (ImuPropagation::toTime, imu_readings.h).
   void propagateTo(Timestamp t);
+  /// Runs `propagate` (a propagation of cur_'s filter) and gives the fixed-lag smoother its record:
+  /// the IMU block before and after and the transition between.
+  template <class Propagate>
+  void propagateRecorded(Propagate&& propagate);
   /// What ImuPropagation reads besides the filter (cur_'s samples, mean reading, g, λ).
   ImuPropagation::Inputs propagationInputs() const;
   /// Gravity in G: (0, 0, ∓|g|) by the gravity direction's sign.
@@ -318,6 +330,7 @@ class EstimatorNode : private RerunReplayer {
   InputTimeline timeline_;
   AnchorRerun rerun_;
   std::map<SensorId, InstanceStatus> instance_stats_;
+  FixedLagSmoother smoother_;  ///< enabled by fixed_lag.enabled and a pose_smoothed sink
 };
 
 }  // namespace meshnav::estimator

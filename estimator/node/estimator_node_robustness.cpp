@@ -176,6 +176,7 @@ void EstimatorNode::checkFlightVolume(Timestamp t) {
 }
 
 void EstimatorNode::replaceImu(const ImuState& x, const ImuMatrix& P, Timestamp t, const ImuSample& last_imu) {
+  flushSmoothed();  // the chain of IMU beliefs ends here: the smoothed poses before it go out now
   cur_.replaceImu(x, P, t, last_imu, options_, setup_.imu_id, gravity_.zSign());
   setUwbClockPrior(*cur_.filter);
   reentry_.restart(t);  // held ranges were in the history; the new pose comes from ranges

@@ -3,24 +3,15 @@
 
 #include "estimator/node/output_schedule.h"
 
+#include "estimator/smooth/fixed_lag_smoother.h"
+
 #include <algorithm>
 
 namespace meshnav::estimator {
 
 PoseEstimate poseOf(const FusionStrategy& f) {
   const NominalState& x = f.state();
-  const Eigen::MatrixXd P = f.covariance(x.imu_id, x.imu_id);
-  PoseEstimate e;
-  e.t = x.t;
-  e.p_IinG = x.imu.p_IinG;
-  e.v_IinG = x.imu.v_IinG;
-  e.q_ItoG = x.imu.q_ItoG;
-  e.bias_gyro_rad_s = x.imu.bias_gyro_rad_s;
-  e.bias_acc_m_s2 = x.imu.bias_acc_m_s2;
-  e.cov_p_m2 = P.block<3, 3>(ImuErr::kP, ImuErr::kP);
-  e.cov_v = P.block<3, 3>(ImuErr::kV, ImuErr::kV);
-  e.cov_theta_rad2 = P.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta);
-  return e;
+  return poseOfBelief(ImuBelief{x.t, x.imu, ImuMatrix(f.covariance(x.imu_id, x.imu_id))});
 }
 
 std::vector<AnchorEstimate> anchorsOf(const FusionStrategy& f, const UwbNetwork& network) {

@@ -1,11 +1,13 @@
 /// estimator: the EstimatorNode (estimator/node/estimator_node.h) on LCM.
-///   IMU, BARO, RANGE, FLIGHT_STATE, ANCHOR_INIT, ESTIMATOR_CMD -> POSE, ANCHORS, ESTIMATOR_STATUS.
+///   IMU, BARO, RANGE, FLIGHT_STATE, ANCHOR_INIT, ESTIMATOR_CMD -> POSE, POSE_SMOOTHED, ANCHORS, ESTIMATOR_STATUS.
 /// ESTIMATOR_STATUS goes out at the node's data-time rate and, as the process heartbeat, every
 /// --heartbeat seconds of wall time (also before any data arrives, so bridges can wait for it).
 /// With --state-dir the node's checkpoint (estimator/restart/checkpoint.h) is written there every
 /// --state-period seconds of data time and read back at start: a respawned estimator resumes
 /// with its anchors (and its pose after a short outage) instead of starting over.
+#include <chrono>
 #include <iostream>
+#include <thread>
 #include <optional>
 
 #include "common/dir_lock.h"
@@ -91,6 +93,8 @@ class EstimatorProcess {
     // (waiting could outlast the supervisor's stop timeout under a sanitizer).
     node_.flushHeld();  // measurements waiting for an IMU sample that will not come
     node_.stopRerun();
+    finishing_ = true;
+    node_.flushSmoothed();  // the last fixed_lag.lag_s of POSE_SMOOTHED, with the data there is
     if (node_.initialized()) lcm_.publish(channels::kAnchors, node_.anchors());
     const EstimatorStatus st = process_.stamped(node_.status());
     lcm_.publish(channels::kEstimatorStatus, st);
@@ -106,6 +110,13 @@ class EstimatorProcess {
     s.pose = [this](const PoseEstimate& e) {
       lcm_.publish(channels::kPose, e);
       checkpoint(e.t);
+    };
+    // POSE_SMOOTHED: the fixed-lag smoother's poses (fixed_lag.enabled; after their POSE, never before).
+    s.pose_smoothed = [this](const PoseEstimate& e) {
+      lcm_.publish(channels::kPoseSmoothed, e);
+      // At the end (flushSmoothed) the last lag_s of poses go out at once: paced, so that a
+      // subscriber's socket buffer (about 200 kB) takes them (running, the node spreads them).
+      if (finishing_ && ++finish_published_ % 64 == 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
     };
     s.anchors = [this](const std::vector<AnchorEstimate>& a) { lcm_.publish(channels::kAnchors, a); };
     s.status = [this](const EstimatorStatus& st) { lcm_.publish(channels::kEstimatorStatus, process_.stamped(st)); };
@@ -129,6 +140,8 @@ class EstimatorProcess {
   const EstimatorProcessOptions& o_;
   std::optional<Timestamp> last_checkpoint_;
   bool was_initialized_ = false;
+  bool finishing_ = false;  ///< in finish(): POSE_SMOOTHED paced
+  int64_t finish_published_ = 0;
   bool ready_ = false;  ///< false while node_ is constructed: no checkpoint from inside its constructor
   estimator::EstimatorNode node_;
 };
@@ -138,8 +151,8 @@ class EstimatorProcess {
 int main(int argc, char** argv) {
   transport::ProcessMain process(
       "estimator",
-      "Subscribes IMU, BARO, RANGE, FLIGHT_STATE, ANCHOR_INIT, ESTIMATOR_CMD; publishes POSE, ANCHORS and "
-      "ESTIMATOR_STATUS (also a wall-clock heartbeat). Messages may arrive out of order: the node re-processes "
+      "Subscribes IMU, BARO, RANGE, FLIGHT_STATE, ANCHOR_INIT, ESTIMATOR_CMD; publishes POSE, POSE_SMOOTHED "
+      "(fixed-lag smoothed poses, estimator.yaml fixed_lag), ANCHORS and ESTIMATOR_STATUS (also a wall-clock heartbeat). Messages may arrive out of order: the node re-processes "
       "within its window. Malformed messages are counted per channel (\"<CHANNEL>:decode_error\" / "
       "\":invalid_message\") and reported in ESTIMATOR_STATUS.");
   return process.run<EstimatorProcessOptions>(argc, argv, declareOptions, [&](EstimatorProcessOptions& o) {

@@ -74,6 +74,7 @@ bool continuesRun(const std::filesystem::path& id_file, const std::string& run_i
 /// The typed channels the run files are made of.
 void subscribeRunFiles(transport::LcmNode& node, logging::RunRecorder& recorder) {
   node.subscribe(channels::kPose, [&](const PoseEstimate& e) { recorder.onPose(e); });
+  node.subscribe(channels::kPoseSmoothed, [&](const PoseEstimate& e) { recorder.onPoseSmoothed(e); });
   node.subscribe(channels::kAnchors, [&](const std::vector<AnchorEstimate>& a) { recorder.onAnchors(a); });
   node.subscribe(channels::kAnchorInit, [&](const AnchorInit& a) { recorder.onAnchorInit(a); });
   node.subscribe(channels::kGroundTruth, [&](const PoseSample& p) { recorder.onGroundTruth(p); });

@@ -27,7 +27,7 @@ void writeYaml(const YAML::Emitter& e, const std::string& path) {
 
 }  // namespace
 
-RunRecorder::RunRecorder(const std::string& out_dir, bool append) : out_dir_(out_dir) {
+RunRecorder::RunRecorder(const std::string& out_dir, bool append) : out_dir_(out_dir), append_(append) {
   std::error_code ec;
   fs::create_directories(out_dir, ec);
   if (ec) throw std::runtime_error(out_dir + ": cannot create folder: " + ec.message());
@@ -62,6 +62,22 @@ void RunRecorder::onPose(const PoseEstimate& e) {
   ++n_poses_;
 }
 
+void RunRecorder::onPoseSmoothed(const PoseEstimate& e) {
+  if (!smoothed_) {
+    const std::string path = (fs::path(out_dir_) / "estimate_smoothed.csv").string();
+    const bool append = append_ && fs::exists(path);
+    if (append)
+      if (const int64_t cut = cutTornLine(path); cut > 0)
+        diag_.report("estimate_smoothed.csv:torn_row_cut",
+                     fmt::format("{}: cut a half-written last row of {} bytes (the previous logger was killed "
+                                 "while writing it)",
+                                 path, cut));
+    smoothed_ = std::make_unique<EstimateCsvWriter>(path, append);
+  }
+  smoothed_->write(e);
+  ++n_smoothed_;
+}
+
 void RunRecorder::onAnchors(const std::vector<AnchorEstimate>& anchors) {
   for (const auto& a : anchors) {
     anchors_->write(a);
@@ -80,6 +96,7 @@ void RunRecorder::onGroundTruth(const PoseSample& p) { ground_truth_.push_back(p
 
 void RunRecorder::flush() {
   estimate_->flush();
+  if (smoothed_) smoothed_->flush();
   anchors_->flush();
 }
 
@@ -106,6 +123,7 @@ void RunRecorder::finish(const Diagnostics& process_diag) {
   e << YAML::EndMap;
   e << YAML::Key << "files" << YAML::Value << YAML::Flow << YAML::BeginMap;
   e << YAML::Key << "estimate_rows" << YAML::Value << n_poses_;
+  e << YAML::Key << "estimate_smoothed_rows" << YAML::Value << n_smoothed_;
   e << YAML::Key << "anchor_rows" << YAML::Value << n_anchor_rows_;
   e << YAML::Key << "anchor_inits" << YAML::Value << anchor_inits_.size();
   e << YAML::Key << "ground_truth_rows" << YAML::Value << ground_truth_.size();

@@ -23,12 +23,15 @@ Pipeline::Pipeline(const PipelineOptions& options, std::vector<Vehicle> vehicles
     }
     estimator::EstimatorSinks es;
     es.pose = [this, v](const PoseEstimate& p) { queue_.push_back({v, p}); };
+    if (sinks_.pose_smoothed || (options_.calibration_enabled && options_.calibrator_on_smoothed))
+      es.pose_smoothed = [this, v](const PoseEstimate& p) { queue_.push_back({v, SmoothedPose{p}}); };
     es.anchors = [this, v](const std::vector<AnchorEstimate>& a) { queue_.push_back({v, a}); };
     es.status = [this, v](const EstimatorStatus& s) { queue_.push_back({v, s}); };
     estimators_.push_back(std::make_unique<estimator::EstimatorNode>(options_.estimator, vehicles_[v].setup, es));
   }
   anchor_beliefs_.resize(vehicles_.size());
   last_pose_to_calibrator_.resize(vehicles_.size());
+  awaiting_smoothed_.resize(vehicles_.size());
   if (options_.calibration_enabled) {
     calib::CalibratorNodeOptions node_opts = options_.calibrator_node;
     if (!options_.mission) node_opts.auto_mode = true;
@@ -107,6 +110,15 @@ void Pipeline::forwardAnchors(size_t v, const std::vector<AnchorEstimate>& ancho
   calibrator_->onAnchors(merged);
 }
 
+void Pipeline::finish() {
+  for (auto& e : estimators_) {
+    e->flushHeld();
+    e->finishRerun();
+    e->flushSmoothed();
+  }
+  drain();
+}
+
 void Pipeline::drain() {
   while (!queue_.empty()) {
     Event ev = std::move(queue_.front());
@@ -121,8 +133,18 @@ void Pipeline::drain() {
                 (options_.pose_to_calibrator_hz <= 0.0 || !last || (m.t - *last).sec() >= 1.0 / options_.pose_to_calibrator_hz)) {
               calibrator_->onPose(m, v);
               last = m.t;
+              if (options_.calibrator_on_smoothed) awaiting_smoothed_[v].insert(m.t.us);
             }
             if (sinks_.pose) sinks_.pose(v, m);
+          } else if constexpr (std::is_same_v<T, SmoothedPose>) {
+            // The calibrator's pose at this instant becomes the smoothed one (same instant: the
+            // newer replaces it, CalibratorNode::onPose).
+            auto& awaiting = awaiting_smoothed_[v];
+            if (auto it = awaiting.find(m.pose.t.us); it != awaiting.end()) {
+              calibrator_->onPose(m.pose, v);
+              awaiting.erase(awaiting.begin(), std::next(it));
+            }
+            if (sinks_.pose_smoothed) sinks_.pose_smoothed(v, m.pose);
           } else if constexpr (std::is_same_v<T, std::vector<AnchorEstimate>>) {
             if (calibrator_) forwardAnchors(v, m);
             if (sinks_.anchors) sinks_.anchors(v, m);

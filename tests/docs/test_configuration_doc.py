@@ -145,9 +145,9 @@ class ConfigurationDoc(unittest.TestCase):
         # Not vacuous: both listings parse into many keys, with none in both.
         self.assertGreater(len(self.options), 40)
         self.assertGreater(len(self.parameters), 40)
-        for key in ("profile", "strategy", "uwb.sigma_range_m", "refine.rerun_mode"):
+        for key in ("profile", "strategy", "uwb.sigma_range_m", "fixed_lag.lag_s"):
             self.assertIn(key, self.options)
-        for key in ("joseph_form", "process_noise.max_grow", "time.rebase_after"):
+        for key in ("joseph_form", "process_noise.max_grow", "time.rebase_after", "refine.rerun_mode"):
             self.assertIn(key, self.parameters)
         self.assertEqual(sorted(set(self.options) & set(self.parameters)), [])
 

@@ -119,4 +119,19 @@ echo "== deterministic run (meshnav_run, estimator only like the launched proces
 echo "== compare position RMSE against ground truth"
 "$BIN/meshnav_compare_estimates" --groundtruth "$WORK/data/groundtruth.csv" --reference "$WORK/run/estimate.csv" \
   --candidate "$WORK/lcm/estimate.csv" --tolerance 0.05 || fail "LCM pipeline RMSE not within 5 % of meshnav_run"
+
+echo "== the fixed-lag smoother (POSE_SMOOTHED): one per POSE, as meshnav_run's, better than the filter"
+[[ -s "$WORK/lcm/estimate_smoothed.csv" ]] || fail "logging wrote no estimate_smoothed.csv (no POSE_SMOOTHED)"
+n_pose=$(sed -n 's/^  POSE: {messages: \([0-9]*\),.*/\1/p' "$WORK/lcm/summary.yaml")
+n_smoothed=$(sed -n 's/^  POSE_SMOOTHED: {messages: \([0-9]*\),.*/\1/p' "$WORK/lcm/summary.yaml")
+echo "POSE $n_pose, POSE_SMOOTHED $n_smoothed"
+[[ -n "$n_pose" && "$n_pose" == "$n_smoothed" ]] || fail "POSE_SMOOTHED ($n_smoothed) is not one per POSE ($n_pose)"
+"$BIN/meshnav_compare_estimates" --groundtruth "$WORK/data/groundtruth.csv" --reference "$WORK/run/estimate_smoothed.csv" \
+  --candidate "$WORK/lcm/estimate_smoothed.csv" --tolerance 0.05 || fail "POSE_SMOOTHED RMSE not within 5 % of meshnav_run's"
+"$BIN/meshnav_compare_estimates" --groundtruth "$WORK/data/groundtruth.csv" --reference "$WORK/lcm/estimate.csv" \
+  --candidate "$WORK/lcm/estimate_smoothed.csv" --tolerance 10 > "$WORK/smoothed_vs_filter.txt" 2>&1 || true
+cat "$WORK/smoothed_vs_filter.txt"
+rmse_filter=$(sed -n 's/^reference: .*RMSE \([0-9.]*\) m/\1/p' "$WORK/smoothed_vs_filter.txt")
+rmse_smoothed=$(sed -n 's/^candidate: .*RMSE \([0-9.]*\) m/\1/p' "$WORK/smoothed_vs_filter.txt")
+awk -v f="$rmse_filter" -v s="$rmse_smoothed" 'BEGIN { exit !(f != "" && s != "" && s + 0 < f + 0) }' || fail "the smoothed poses are not better than the filter's"
 echo "PASS"

@@ -87,9 +87,12 @@ TEST(EstimatorOptions, UnknownKeysAndBadValuesNameFileAndKey) {
   EXPECT_NE(e.find("'uwb' must be a map"), std::string::npos) << e;
   e = loadError("opts_time.yaml", "time:\n  max_offset_s: 0.5\n");  // below window_s
   EXPECT_NE(e.find("time.max_offset_s >= window_s"), std::string::npos) << e;
-  e = loadError("opts_rerun_mode.yaml", "refine:\n  rerun_mode: threaded\n");
-  EXPECT_NE(e.find("refine.rerun_mode must be auto, sync or async"), std::string::npos) << e;
-  EXPECT_EQ(loadError("opts_rerun_async.yaml", "refine:\n  rerun_mode: async\n"), "");
+  // refine.rerun_mode is a model parameter (auto does the right thing in the process and in replays).
+  e = loadError("opts_rerun_mode.yaml", "refine:\n  rerun_mode: async\n");
+  EXPECT_NE(e.find("key 'refine.rerun_mode' is a model parameter"), std::string::npos) << e;
+  e = loadError("opts_fixed_lag.yaml", "fixed_lag:\n  lag_s: -1\n");
+  EXPECT_NE(e.find("fixed_lag.lag_s in [0, 60]"), std::string::npos) << e;
+  EXPECT_EQ(loadError("opts_fixed_lag_off.yaml", "fixed_lag:\n  lag_s: 0\n"), "");
   e = loadError("opts_huber.yaml", "uwb:\n  huber_k: -1\n");
   EXPECT_NE(e.find("uwb.huber_k >= 0"), std::string::npos) << e;
   EXPECT_EQ(loadError("opts_huber_on.yaml", "uwb:\n  huber_k: 2\n"), "");

@@ -216,3 +216,28 @@ TEST(RunRecorder, ARestartedLoggerCutsTheRowItsPredecessorLeftHalfWritten) {
 TEST(RunRecorder, UnwritableFolderThrows) {
   EXPECT_THROW(RunRecorder("/proc/meshnav_cannot_write_here"), std::exception);
 }
+
+TEST(RunRecorder, SmoothedPosesGoToTheirOwnFileFromTheFirstOne) {
+  const auto d = freshDir("smoothed");
+  {
+    RunRecorder rec(d.string());
+    rec.onPose(pose(1.0));
+    rec.flush();
+    EXPECT_FALSE(fs::exists(d / "estimate_smoothed.csv"));  // no POSE_SMOOTHED yet: no file
+    rec.onPoseSmoothed(pose(1.0));
+    rec.onPoseSmoothed(pose(2.0));
+    rec.finish(Diagnostics{});
+    EXPECT_EQ(rec.smoothedPosesWritten(), 2);
+  }
+  {
+    RunRecorder again(d.string(), true);  // a restart within the run continues the file
+    again.onPoseSmoothed(pose(3.0));
+    again.finish(Diagnostics{});
+  }
+  Diagnostics diag;
+  const auto smoothed = readEstimateCsv((d / "estimate_smoothed.csv").string(), diag);
+  ASSERT_EQ(smoothed.size(), 3u);
+  EXPECT_NEAR(smoothed[2].t.sec(), 3.0, 1e-9);
+  EXPECT_EQ(YAML::LoadFile((d / "summary.yaml").string())["files"]["estimate_smoothed_rows"].as<int>(), 1);
+  fs::remove_all(d);
+}

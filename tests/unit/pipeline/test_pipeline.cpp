@@ -2,6 +2,7 @@
 // known anchors 101–104, anchors 106/107 calibrated at 80 s and 108–110 at 100 s, then fused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 
 #include "common/pose_interpolation.h"
@@ -30,21 +31,24 @@ const Flight& flight1() {
 }
 
 struct RunResult {
-  std::vector<PoseEstimate> poses;
+  std::vector<PoseEstimate> poses, smoothed;
   std::vector<AnchorInit> inits;
   std::map<SensorId, AnchorEstimate> final_anchors;
   EstimatorStatus status;
 };
 
-RunResult runPipeline(const Flight& f, bool with_mission) {
+RunResult runPipeline(const Flight& f, bool with_mission, bool calibrate_on_smoothed = false) {
   pipeline::PipelineOptions o;
+  o.calibrator_on_smoothed = calibrate_on_smoothed;
   if (with_mission) o.mission = mission::loadMission(std::string(MESHNAV_SOURCE_DIR) + "/config/missions/paper_s2.yaml");
   RunResult r;
   pipeline::PipelineSinks sinks;
   sinks.pose = [&](size_t, const PoseEstimate& p) { r.poses.push_back(p); };
+  sinks.pose_smoothed = [&](size_t, const PoseEstimate& p) { r.smoothed.push_back(p); };
   sinks.anchor_init = [&](const AnchorInit& a) { r.inits.push_back(a); };
   pipeline::Pipeline p(o, f.ds.setup, sinks);
   for (const auto& in : f.inputs) p.onInput(in);
+  p.finish();
   for (const auto& a : p.estimator().anchors()) r.final_anchors[a.id] = a;
   r.status = p.estimator().status();
   return r;
@@ -123,4 +127,25 @@ TEST(Pipeline, IsDeterministic) {
   EXPECT_EQ(a.poses.back().p_IinG, b.poses.back().p_IinG);
   ASSERT_EQ(a.inits.size(), b.inits.size());
   for (size_t i = 0; i < a.inits.size(); ++i) EXPECT_EQ(a.inits[i].p_AinG, b.inits[i].p_AinG);
+}
+
+// The fixed-lag smoother through the pipeline (issue 35): one smoothed pose per POSE at its time,
+// closer to the truth; with calibrator_on_smoothed the calibrator takes them instead of the
+// filter's (its calibrations change) and still calibrates every fly-by anchor.
+TEST(Pipeline, FixedLagSmoothedPosesAndTheCalibratorOnThem) {
+  const RunResult r = runPipeline(flight1(), true);
+  ASSERT_EQ(r.smoothed.size(), r.poses.size());
+  for (size_t i = 0; i < r.poses.size(); ++i) ASSERT_EQ(r.smoothed[i].t, r.poses[i].t);
+  const auto& gt = flight1().ds.ground_truth;
+  EXPECT_LT(positionRmse(r.smoothed, gt), 0.8 * positionRmse(r.poses, gt));
+
+  const RunResult s = runPipeline(flight1(), true, true);
+  ASSERT_EQ(s.inits.size(), r.inits.size());
+  double moved = 0.0;
+  for (size_t i = 0; i < s.inits.size(); ++i) {
+    ASSERT_EQ(s.inits[i].id, r.inits[i].id);
+    moved = std::max(moved, (s.inits[i].p_AinG - r.inits[i].p_AinG).norm());
+    EXPECT_LT((s.inits[i].p_AinG - flight1().ds.truth->anchor_positions.at(s.inits[i].id)).norm(), 0.30);
+  }
+  EXPECT_GT(moved, 1e-4);  // the calibrator did take the smoothed poses
 }
