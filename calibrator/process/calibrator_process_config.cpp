@@ -41,6 +41,9 @@ void declareCalibratorProcessOptions(Cli& cli, CalibratorProcessConfig& c) {
   cli.option("pose-rate", c.pose_rate_hz, "POSE decimation towards the calibrator [Hz] (0 = every pose)")
       ->type_name("HZ")
       ->check(cli::nonNegative());
+  cli.flag("smoothed-poses", c.smoothed_poses,
+           "replace each POSE taken by its POSE_SMOOTHED twin when that comes (the estimator's fixed-lag smoother, "
+           "fixed_lag.lag_s later; as meshnav_run --calibrate-on-smoothed)");
   cli.option("heartbeat", c.heartbeat_s, "wall seconds between heartbeat CALIB_STATUS")
       ->type_name("S")
       ->check(cli::positive());
@@ -76,6 +79,7 @@ std::string CalibratorProcessConfig::toString() const {
   s << "  state_dir: " << (state_dir.empty() ? "(none)" : state_dir) << "\n";
   s << "  pose_rate: " << pose_rate_hz << "  # [Hz], 0 = every pose\n";
   s << "  heartbeat: " << heartbeat_s << "  # [s] wall time\n";
+  s << "  smoothed_poses: " << (smoothed_poses ? "true" : "false") << "  # POSE_SMOOTHED replaces the POSE taken\n";
   return s.str();
 }
 

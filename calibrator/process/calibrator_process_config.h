@@ -25,6 +25,9 @@ struct CalibratorProcessConfig {
   std::string state_dir;            ///< --state-dir: input journal of a restart ("" = none)
   double pose_rate_hz = 50.0;       ///< --pose-rate: POSE decimation towards the node (0 = every pose) [Hz]
   double heartbeat_s = 1.0;         ///< --heartbeat: wall time between CALIB_STATUS heartbeats [s]
+  /// --smoothed-poses: each POSE the node took is replaced by its POSE_SMOOTHED twin when that
+  /// comes (the estimator's fixed-lag smoother; issue 35 item 3, docs/smoother.md)
+  bool smoothed_poses = false;
   bool print_config = false;        ///< --print-config
   bool auto_requested = false;      ///< --auto (forces node.auto_mode on after --config is read)
   CalibratorOptions calibrator;     ///< `calibrator:` of --config

@@ -7,6 +7,7 @@
 #include <memory>
 #include <iostream>
 #include <optional>
+#include <set>
 
 #include "calibrator/node/calibrator_node.h"
 #include "calibrator/process/calibrator_process_config.h"
@@ -59,6 +60,8 @@ class CalibratorProcess {
       CalibCommand c;
       if (ch == channels::kRange.name && transport::InputJournal::decode(rb, channels::kRange, r, diag)) onRange(r);
       if (ch == channels::kPose.name && transport::InputJournal::decode(rb, channels::kPose, p, diag)) onPose(p);
+      if (ch == channels::kPoseSmoothed.name && transport::InputJournal::decode(rb, channels::kPoseSmoothed, p, diag))
+        onPoseSmoothed(p);
       if (ch == channels::kAnchors.name && transport::InputJournal::decode(rb, channels::kAnchors, a, diag)) onAnchors(a);
       if (ch == channels::kCalibCmd.name && transport::InputJournal::decode(rb, channels::kCalibCmd, c, diag)) onCommand(c);
     });
@@ -74,6 +77,8 @@ class CalibratorProcess {
   void connect() {
     lcm_.subscribe(channels::kRange, [this](const RangeSample& r) { onRange(r); });
     lcm_.subscribe(channels::kPose, [this](const PoseEstimate& p) { onPose(p); });
+    if (config_.smoothed_poses)
+      lcm_.subscribe(channels::kPoseSmoothed, [this](const PoseEstimate& p) { onPoseSmoothed(p); });
     lcm_.subscribe(channels::kAnchors, [this](const std::vector<AnchorEstimate>& a) { onAnchors(a); });
     lcm_.subscribe(channels::kCalibCmd, [this](const CalibCommand& c) { onCommand(c); });
     const int64_t progress_period_us = 10'000'000;  // a progress line every 10 s of wall time
@@ -128,7 +133,17 @@ class CalibratorProcess {
     last_pose_ = p.t;
     journaled(channels::kPose, p, p.t);
     node_.onPose(p);
+    if (config_.smoothed_poses) awaiting_smoothed_.insert(p.t.us);
     writeResults(false);
+  }
+  /// A POSE_SMOOTHED of an instant the node took replaces that pose (the same instant: the newer
+  /// wins, CalibratorNode::onPose); others are not needed (decimation).
+  void onPoseSmoothed(const PoseEstimate& p) {
+    const auto it = awaiting_smoothed_.find(p.t.us);
+    if (it == awaiting_smoothed_.end()) return;
+    awaiting_smoothed_.erase(awaiting_smoothed_.begin(), std::next(it));
+    journaled(channels::kPoseSmoothed, p, p.t);
+    node_.onPose(p);
   }
   void onAnchors(const std::vector<AnchorEstimate>& a) {
     journaled(channels::kAnchors, a, a.empty() ? Timestamp{} : a.front().t);
@@ -148,6 +163,7 @@ class CalibratorProcess {
   calib::CalibrationYamlWriter results_file_;
   std::unique_ptr<transport::InputJournal> journal_;
   std::optional<Timestamp> last_pose_;
+  std::set<int64_t> awaiting_smoothed_;  ///< µs of the POSEs taken whose smoothed twin has not come (--smoothed-poses)
   Duration pose_period_;
   int64_t next_progress_ = 0;
 };

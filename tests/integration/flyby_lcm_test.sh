@@ -28,8 +28,11 @@ BIN=$(cd "$2" && pwd)
 WORK=$3
 SEED=${4:-1}
 MODE=${5:-mission}
-[[ "$MODE" == mission || "$MODE" == auto ]] || { echo "FAIL: MODE must be mission or auto"; exit 1; }
+[[ "$MODE" == mission || "$MODE" == auto || "$MODE" == auto_smoothed ]] ||
+  { echo "FAIL: MODE must be mission, auto or auto_smoothed"; exit 1; }
 LAUNCH=$([[ "$MODE" == mission ]] && echo flyby.yaml || echo flyby_auto.yaml)
+# auto_smoothed: the calibrator takes the estimator's POSE_SMOOTHED (--smoothed-poses, issue 35).
+CALIBRATOR_POSES=$([[ "$MODE" == auto_smoothed ]] && echo --smoothed-poses || echo --pose-rate=50)
 RATE=10
 ANCHORS=106,107,108,109,110
 
@@ -63,6 +66,7 @@ cd "$SRC" || fail "cannot cd to $SRC"
 python3 "$SRC/scripts/supervisor.py" "$SRC/config/launch/$LAUNCH" BIN="$BIN" DATASET="$WORK/data" \
   OUT="$WORK/out" RATE=$RATE MISSION="$SRC/config/missions/paper_s2.yaml" MISSION_T0="$t0" \
   ESTIMATOR_CONFIG="$SRC/config/estimator.yaml" CALIBRATOR_CONFIG="$SRC/config/calibrator.yaml" \
+  CALIBRATOR_POSES="$CALIBRATOR_POSES" \
   > "$WORK/launch.log" 2>&1 &
 SUP=$!
 start=$(now_us)
@@ -125,6 +129,7 @@ grep -q "^  ANCHOR_INIT: {messages: 5," "$OUT/summary.yaml" || fail "the logger 
 grep -q "^    calibrations_ok: 5$" "$OUT/summary.yaml" || fail "the calibrator did not calibrate exactly 5 times"
 grep -q "initialized: true" "$OUT/summary.yaml" || fail "the estimator never initialized"
 grep -E "^  [A-Z_]+: \{messages" "$OUT/summary.yaml" | sed 's/^/  /'
+grep -q "^  POSE_SMOOTHED: {messages:" "$OUT/summary.yaml" || fail "the logger saw no POSE_SMOOTHED"
 echo "  estimate ends at t = $(tail -n 1 "$OUT/estimate.csv" | cut -d, -f1) s"
 
 echo "== anchors (logger's anchor_init.yaml, anchors.csv) and estimate vs truth"
