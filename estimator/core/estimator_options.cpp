@@ -319,8 +319,10 @@ void EstimatorOptions::validate() const {
        "refine.max_history_s >= window_s, refine.rerun_prior_sigma_m > 0, refine.rerun_gamma_sigma_m > 0");
   need(refine.rerun_mode == "auto" || refine.rerun_mode == "sync" || refine.rerun_mode == "async",
        "refine.rerun_mode must be auto, sync or async");
-  need(fixed_lag.lag_s >= 0.0 && fixed_lag.lag_s <= 60.0 && fixed_lag.period_s > 0.0 && fixed_lag.period_s <= 10.0,
-       "fixed_lag.lag_s in [0, 60] and fixed_lag.period_s in (0, 10]");
+  // A pass shorter than 0.05 s would start at nearly every propagation and finish the previous one
+  // before the POSE (FixedLagSmoother::startPass).
+  need(fixed_lag.lag_s >= 0.0 && fixed_lag.lag_s <= 60.0 && fixed_lag.period_s >= 0.05 && fixed_lag.period_s <= 10.0,
+       "fixed_lag.lag_s in [0, 60] and fixed_lag.period_s in [0.05, 10]");
   need(zupt.rate_hz > 0 && zupt.sigma_acc_m_s2 > 0 && zupt.sigma_gyro_rad_s > 0 && zupt.sigma_vel_m_s > 0 &&
            zupt.stillness_sigma_vel_m_s > 0 && zupt.stillness_sigma_gyro_rad_s > 0,
        "zupt rate and sigmas > 0");

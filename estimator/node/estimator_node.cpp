@@ -100,6 +100,7 @@ void EstimatorNode::reportSetupGeometry() {
 }
 
 void EstimatorNode::resetAll() {
+  flushSmoothed();  // the smoothed poses still waiting go out (a Reset, a clock gone back): one per POSE
   smoother_.reset();
   init_.reset();
   volume_.reset();

@@ -83,7 +83,10 @@ void FixedLagSmoother::reset() {
 void FixedLagSmoother::truncateAfter(Timestamp t) {
   while (!records_.empty() && records_.back().to.t > t) records_.pop_back();
   if (pass_ && pass_->s.t > t) {
-    pass_.reset();  // its next record is gone; the next pass starts on the new history
+    // Its next record is gone: a pass starts again at the next propagation, on the new history
+    // (waiting a period instead let frequent late inputs starve the passes: lag and memory grew).
+    pass_.reset();
+    last_pass_.reset();
     diag_.count("fixed_lag_pass_dropped");
   }
 }

@@ -41,6 +41,9 @@ RunRecorder::RunRecorder(const std::string& out_dir, bool append) : out_dir_(out
                                  path, cut));
     }
   }
+  // A fresh run: an earlier run's smoothed file would be scored as this one's if no POSE_SMOOTHED
+  // comes (lag 0, never initialized).
+  if (!append) fs::remove(fs::path(out_dir) / "estimate_smoothed.csv", ec);
   estimate_ = std::make_unique<EstimateCsvWriter>((fs::path(out_dir) / "estimate.csv").string(), append);
   anchors_ = std::make_unique<AnchorsCsvWriter>((fs::path(out_dir) / "anchors.csv").string(), append);
   const fs::path inits = fs::path(out_dir) / "anchor_init.yaml";

@@ -93,6 +93,9 @@ TEST(EstimatorOptions, UnknownKeysAndBadValuesNameFileAndKey) {
   e = loadError("opts_fixed_lag.yaml", "fixed_lag:\n  lag_s: -1\n");
   EXPECT_NE(e.find("fixed_lag.lag_s in [0, 60]"), std::string::npos) << e;
   EXPECT_EQ(loadError("opts_fixed_lag_off.yaml", "fixed_lag:\n  lag_s: 0\n"), "");
+  EstimatorOptions tiny_period;
+  tiny_period.fixed_lag.period_s = 0.001;  // a model parameter: the C++ API
+  EXPECT_THROW(tiny_period.validate(), std::invalid_argument);
   e = loadError("opts_huber.yaml", "uwb:\n  huber_k: -1\n");
   EXPECT_NE(e.find("uwb.huber_k >= 0"), std::string::npos) << e;
   EXPECT_EQ(loadError("opts_huber_on.yaml", "uwb:\n  huber_k: 2\n"), "");

@@ -169,6 +169,8 @@ TEST(FixedLagSmoother, EmitsEveryPoseOnceInOrderAtLeastTheLagAfterIt) {
     smoother.onPropagation(from, to, chain.Phi);
     smoother.onPose(poseOfBelief(ImuBelief{tk, ImuState{}, chain.P0}));
     smoother.work();
+    // Memory: the records of lag + 2 periods at most (+ the one being added).
+    ASSERT_LE(smoother.recordCount(), static_cast<size_t>((0.2 + 2 * 0.1) / chain.dt) + 2) << k;
   }
   ASSERT_FALSE(emitted.empty());
   for (size_t i = 0; i < emitted.size(); ++i) {
@@ -183,6 +185,39 @@ TEST(FixedLagSmoother, EmitsEveryPoseOnceInOrderAtLeastTheLagAfterIt) {
   EXPECT_GT(emitted.size(), before_finish);
   // Memory: records of at most lag + 2 periods (+ one) were held at any time; none after finish.
   EXPECT_EQ(smoother.recordCount(), 0u);
+}
+
+TEST(FixedLagSmoother, FrequentRewindsKeepTheLagAndTheMemoryBounded) {
+  // Every step the last 1–40 records are fed again (a late input's rewind, as over LCM where
+  // ranges come after the IMU): passes that needed a dropped record start again at once.
+  Diagnostics diag;
+  std::vector<std::pair<Timestamp, Timestamp>> emitted;
+  Timestamp newest;
+  constexpr double lag = 0.5, period = 0.2, dt = 0.01;
+  FixedLagSmoother s({.lag_s = lag, .period_s = period}, diag,
+                     [&](const PoseEstimate& e) { emitted.push_back({e.t, newest}); });
+  LinearChain chain;
+  std::vector<std::pair<ImuBelief, ImuBelief>> history;
+  std::mt19937 rng(2);
+  size_t most_records = 0;
+  for (int k = 1; k <= 2000; ++k) {
+    const Timestamp tp = Timestamp::fromSec(1.0 + (k - 1) * dt), tk = Timestamp::fromSec(1.0 + k * dt);
+    newest = tk;
+    history.push_back({ImuBelief{tp, ImuState{}, chain.P0},
+                       ImuBelief{tk, ImuState{}, chain.Phi * chain.P0 * chain.Phi.transpose() + chain.Q}});
+    const size_t depth = std::min<size_t>(history.size(), 1 + rng() % 40);
+    for (size_t i = history.size() - depth; i < history.size(); ++i)
+      s.onPropagation(history[i].first, history[i].second, chain.Phi);
+    s.onPose(poseOfBelief(ImuBelief{tk, ImuState{}, chain.P0}));
+    s.work();
+    most_records = std::max(most_records, s.recordCount());
+  }
+  ASSERT_GT(emitted.size(), 1500u);
+  double oldest_s = 0.0;
+  for (const auto& [t, at] : emitted) oldest_s = std::max(oldest_s, (at - t).sec());
+  EXPECT_LE(oldest_s, lag + 2.0 * period + 0.05);
+  EXPECT_LE(most_records, static_cast<size_t>((lag + 2.0 * period) / dt) + 45);
+  EXPECT_GT(diag.get("fixed_lag_pass_dropped"), 0);  // the path was taken
 }
 
 TEST(FixedLagSmoother, AChangedHistoryReplacesTheRecordsAfterItsStart) {
