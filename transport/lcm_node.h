@@ -264,4 +264,13 @@ class LcmNode {
 /// The LCM URL a process uses: `--lcm-url` if given, else LCM_DEFAULT_URL, else LCM's default.
 std::string resolveLcmUrl(const std::string& cli_value);
 
+/// Receive buffer every process asks for on udpm unless its URL says `recv_buf_size` [bytes]. The
+/// kernel's default (about 208 kB) holds about 0.1 s of a 10× replay with POSE and POSE_SMOOTHED
+/// (4000 messages/s): a subscriber held up longer lost messages (the logger an ANCHOR_INIT in
+/// integration.flyby_auto_smoothed_lcm). The kernel caps it at net.core.rmem_max.
+inline constexpr int kUdpmReceiveBufferBytes = 4 * 1024 * 1024;
+
+/// `url` with `recv_buf_size=kUdpmReceiveBufferBytes` added when it is udpm without one.
+std::string withReceiveBuffer(const std::string& url);
+
 }  // namespace meshnav::transport

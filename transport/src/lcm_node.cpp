@@ -43,9 +43,15 @@ std::string resolveLcmUrl(const std::string& cli_value) {
   return "udpm://239.255.76.67:7667?ttl=0";
 }
 
+std::string withReceiveBuffer(const std::string& url) {
+  if (url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size") != std::string::npos) return url;
+  return url + (url.find('?') == std::string::npos ? "?" : "&") + "recv_buf_size=" +
+         std::to_string(kUdpmReceiveBufferBytes);
+}
+
 LcmNode::LcmNode(std::string name, const std::string& url)
     : name_(std::move(name)),
-      url_(resolveLcmUrl(url)),
+      url_(withReceiveBuffer(resolveLcmUrl(url))),
       instance_id_(PublisherWatch::newInstanceId(replay::wallUtimeNow())) {
   lcm_ = std::make_unique<lcm::LCM>(url_);
   if (!lcm_->good())

@@ -372,3 +372,12 @@ TEST(LcmNode, AnotherPublisherThatStartedLaterOnlyCountsAndLeavesItRunning) {
   EXPECT_EQ(node.diagnostics().get("POSE:second_publisher"), 1);  // from its second message
   EXPECT_EQ(node.publishers().secondPublishers().at("POSE"), std::set<int64_t>{newer});
 }
+
+TEST(LcmUrl, UdpmGetsALargerReceiveBufferUnlessItSaysOne) {
+  EXPECT_EQ(withReceiveBuffer("udpm://239.255.76.67:7667?ttl=0"),
+            "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=" + std::to_string(kUdpmReceiveBufferBytes));
+  EXPECT_EQ(withReceiveBuffer("udpm://239.255.76.67:7667"),
+            "udpm://239.255.76.67:7667?recv_buf_size=" + std::to_string(kUdpmReceiveBufferBytes));
+  EXPECT_EQ(withReceiveBuffer("udpm://239.255.76.67:7667?recv_buf_size=65536"), "udpm://239.255.76.67:7667?recv_buf_size=65536");
+  EXPECT_EQ(withReceiveBuffer("memq://"), "memq://");
+}
