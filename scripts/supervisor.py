@@ -9,6 +9,7 @@ Launch file (YAML, read with yaml.safe_load; a key given twice is an error):
     stop_timeout: 5          # s between SIGTERM and SIGKILL when stopping (default 5)
     shutdown_after: [imu_bridge, uwb_bridge]  # stop all once these have all exited for good ...
     shutdown_delay: 2.0      # ... and this many seconds more have passed (default 1)
+    stop_last: [logging]     # stopped once every other process has exited (a logger records their last messages)
     t0_margin: 3.0           # ${T0_UTIME} = launch time + this [s] (default 3)
     processes:
       - name: estimator
@@ -37,7 +38,9 @@ environment; an unknown variable without default is an error naming it. Built in
 the wall time [us since the Unix epoch] t0_margin seconds after the launch, so that bridges
 started together replay in step (--t0-utime ${T0_UTIME}). Every output line of a
 process is printed as "[name] line". SIGINT/SIGTERM stop all processes (SIGTERM to each process
-group, SIGKILL after stop_timeout). A process that is not required may exit (and exhaust its
+group, SIGKILL after stop_timeout; the stop_last processes get theirs once the others have exited,
+so that a logger records what they publish on exit, e.g. the estimator's last POSE_SMOOTHED).
+A process that is not required may exit (and exhaust its
 respawns) without stopping the others. A process that exits with 7 heard another instance of
 itself on the LCM network or found its output folder in use (a second launch): it is never
 restarted, and when it is required the launch stops with exit 1. Exit code: 0 when every
@@ -204,7 +207,7 @@ def _number(d, key, default, where, minimum, integer=False):
 
 
 class Launch:
-    KEYS = {'name', 'processes', 'stop_timeout', 'shutdown_after', 'shutdown_delay', 't0_margin'}
+    KEYS = {'name', 'processes', 'stop_timeout', 'shutdown_after', 'shutdown_delay', 't0_margin', 'stop_last'}
 
     def __init__(self, path, variables):
         try:
@@ -242,6 +245,10 @@ class Launch:
         for n in self.shutdown_after:
             if n not in names:
                 raise LaunchError('%s: shutdown_after names unknown process %r' % (path, n))
+        self.stop_last = [str(n) for n in (doc.get('stop_last') or [])]
+        for n in self.stop_last:
+            if n not in names:
+                raise LaunchError('%s: stop_last names unknown process %r' % (path, n))
         self.path = path
 
     def hosts(self):
@@ -282,6 +289,7 @@ class Supervisor:
         self.final = {}  # name -> last exit code
         self.gone = set()  # names that exited for good (no respawn)
         self.stopping = False
+        self.last_pending = False  # stop_last processes wait for the others to exit
         self.kill_deadline = None
         self.signal_received = None  # set by the signal handler (only a flag: no locks there)
         self.failed = []
@@ -339,9 +347,9 @@ class Supervisor:
             self.events.append((name, code))
             self.cv.notify_all()
 
-    def signal_all(self, sig):
-        for p in list(self.running.values()):
-            if p.poll() is None:
+    def signal_all(self, sig, names=None):
+        for name, p in list(self.running.items()):
+            if (names is None or name in names) and p.poll() is None:
                 try:
                     os.killpg(p.pid, sig)
                 except ProcessLookupError:
@@ -352,9 +360,27 @@ class Supervisor:
             return
         self.stopping = True
         alive = sorted(n for n, p in self.running.items() if p.poll() is None)
-        self.say('supervisor', 'stopping (%s)%s' % (why, ': SIGTERM to ' + ', '.join(alive) if alive else ''))
-        self.signal_all(signal.SIGTERM)
+        first = [n for n in alive if n not in self.launch.stop_last]
+        # stop_last (a logger): signalled once the others have exited, so it records what they
+        # publish on their way out (run_stop_last).
+        self.last_pending = bool(first) and any(n in self.launch.stop_last for n in alive)
+        now_stopped = first if self.last_pending else alive
+        self.say('supervisor', 'stopping (%s)%s' % (why, ': SIGTERM to ' + ', '.join(now_stopped) if now_stopped else ''))
+        self.signal_all(signal.SIGTERM, set(now_stopped))
         self.kill_deadline = time.monotonic() + self.launch.stop_timeout
+
+    def stop_last_when_alone(self):
+        """While stopping: SIGTERM to the stop_last processes once every other one has exited."""
+        if not self.last_pending:
+            return
+        if any(n not in self.launch.stop_last and p.poll() is None for n, p in self.running.items()):
+            return
+        self.last_pending = False
+        last = sorted(n for n, p in self.running.items() if n in self.launch.stop_last and p.poll() is None)
+        if last:
+            self.say('supervisor', 'SIGTERM to %s (stop_last: the others have exited)' % ', '.join(last))
+            self.signal_all(signal.SIGTERM, set(last))
+            self.kill_deadline = time.monotonic() + self.launch.stop_timeout
 
     def on_exit(self, name, code, spec):
         """Handles one exit; returns the monotonic time of the restart, or None when the process
@@ -409,13 +435,19 @@ class Supervisor:
                 if shutdown_at is not None and now >= shutdown_at:
                     self.stop_all('every shutdown_after process has exited')
             elif not killed and now >= self.kill_deadline:
-                alive = sorted(n for n, p in self.running.items() if p.poll() is None)
+                # The processes signalled last (all, or the first ones while stop_last waits).
+                alive = sorted(n for n, p in self.running.items() if p.poll() is None and
+                               (not self.last_pending or n not in self.launch.stop_last))
                 if alive:
                     self.say('supervisor', 'SIGKILL to %s after %.1f s' % (', '.join(alive), self.launch.stop_timeout))
                     self.failed.extend('%s (killed after stop_timeout)' % n for n in alive
                                        if specs[n].required or n in self.launch.shutdown_after)
-                    self.signal_all(signal.SIGKILL)
-                killed = True
+                    self.signal_all(signal.SIGKILL, set(alive))
+                # With stop_last still waiting, its SIGTERM comes once the killed ones are reaped
+                # (stop_last_when_alone, with a deadline of its own).
+                killed = not self.last_pending
+                if self.last_pending:
+                    self.kill_deadline = now + self.launch.stop_timeout
             with self.cv:
                 if not self.events:
                     self.cv.wait(timeout=0.1)
@@ -426,6 +458,8 @@ class Supervisor:
                 when = self.on_exit(name, code, specs[name])
                 if when is not None:
                     respawn_at[name] = when
+            if self.stopping:
+                self.stop_last_when_alone()
             if not self.stopping and self.launch.shutdown_after and shutdown_at is None and \
                     all(n in self.gone for n in self.launch.shutdown_after):
                 shutdown_at = time.monotonic() + self.launch.shutdown_delay

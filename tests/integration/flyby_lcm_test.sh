@@ -129,7 +129,10 @@ grep -q "^  ANCHOR_INIT: {messages: 5," "$OUT/summary.yaml" || fail "the logger 
 grep -q "^    calibrations_ok: 5$" "$OUT/summary.yaml" || fail "the calibrator did not calibrate exactly 5 times"
 grep -q "initialized: true" "$OUT/summary.yaml" || fail "the estimator never initialized"
 grep -E "^  [A-Z_]+: \{messages" "$OUT/summary.yaml" | sed 's/^/  /'
-grep -q "^  POSE_SMOOTHED: {messages:" "$OUT/summary.yaml" || fail "the logger saw no POSE_SMOOTHED"
+# One POSE_SMOOTHED per POSE: the logger is stopped last (stop_last), after the estimator's flush.
+n_pose=$(sed -n 's/^  POSE: {messages: \([0-9]*\),.*/\1/p' "$OUT/summary.yaml")
+n_smoothed=$(sed -n 's/^  POSE_SMOOTHED: {messages: \([0-9]*\),.*/\1/p' "$OUT/summary.yaml")
+[[ -n "$n_pose" && "$n_pose" == "$n_smoothed" ]] || fail "POSE_SMOOTHED ($n_smoothed) is not one per POSE ($n_pose)"
 echo "  estimate ends at t = $(tail -n 1 "$OUT/estimate.csv" | cut -d, -f1) s"
 
 echo "== anchors (logger's anchor_init.yaml, anchors.csv) and estimate vs truth"

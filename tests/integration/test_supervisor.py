@@ -267,6 +267,48 @@ processes:
         self.assertIn('SIGKILL to stubborn', out)
         self.assertEqual(rc, 0, out)  # stubborn is neither required nor in shutdown_after
 
+    def test_stop_last_is_stopped_once_the_others_have_exited(self):
+        # A logger in stop_last records what the others publish on their way out (issue 35: the
+        # estimator's last POSE_SMOOTHED).
+        rc, out, _ = run_launch('''
+stop_timeout: 3
+stop_last: [logger]
+processes:
+  - name: logger
+    command: sh -c 'trap "echo logger got TERM; exit 0" TERM; echo ready; while true; do sleep 0.05; done'
+  - name: pub
+    command: sh -c 'trap "sleep 0.3; echo pub done; exit 0" TERM; while true; do sleep 0.05; done'
+  - name: trigger
+    command: sh -c 'sleep 0.5'
+    required: true
+''')
+        self.assertEqual(rc, 0, out)
+        self.assertIn('[logger] logger got TERM', out)
+        self.assertLess(out.index('[pub] pub done'), out.index('[logger] logger got TERM'), out)
+        self.assertIn('SIGTERM to logger (stop_last', out)
+
+    def test_stop_last_follows_a_process_killed_after_stop_timeout(self):
+        rc, out, _ = run_launch('''
+stop_timeout: 0.5
+stop_last: [logger]
+processes:
+  - name: logger
+    command: sh -c 'trap "echo logger got TERM; exit 0" TERM; while true; do sleep 0.05; done'
+  - name: stubborn
+    command: sh -c 'trap "" TERM; while true; do sleep 0.1; done'
+  - name: trigger
+    command: sh -c 'sleep 0.3'
+    required: true
+''')
+        self.assertEqual(rc, 0, out)
+        self.assertIn('SIGKILL to stubborn', out)
+        self.assertLess(out.index('SIGKILL to stubborn'), out.index('[logger] logger got TERM'), out)
+
+    def test_stop_last_must_name_a_process(self):
+        rc, out, err = run_launch('stop_last: [ghost]\nprocesses:\n  - {name: a, command: sleep 1}\n')
+        self.assertEqual(rc, 2, out + err)
+        self.assertIn("stop_last names unknown process 'ghost'", out + err)
+
     def test_failed_shutdown_after_process_fails_the_launch(self):
         rc, out, _ = run_launch('''
 shutdown_after: [job]
