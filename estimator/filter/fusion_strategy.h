@@ -55,12 +55,21 @@ class FusionStrategy {
 
   /// Propagates to `t_to` with IMU readings held constant since the state's time.
   virtual void propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vector3d& gyro_rad_s, Timestamp t_to) = 0;
-  /// Starts accumulating the IMU block's error transition: transition() is the identity until the
+  /// Starts accumulating the IMU block's error transition: takeTransition() is the identity until the
   /// next propagate(), then Φ_n ⋯ Φ_1 of the propagations since (the fixed-lag smoother's Φ over
   /// one propagation of the node, which may be several steps across an IMU gap; FixedLagSmoother).
-  void startTransition() { transition_ = ImuMatrix::Identity(); }
-  /// The product of the IMU block's Φ since startTransition() (addImuNoise changes no Φ).
-  const ImuMatrix& transition() const { return transition_; }
+  /// Without a startTransition() since the last takeTransition() nothing is accumulated: the
+  /// filter's propagation pays for it only while the fixed-lag smoother records.
+  void startTransition() {
+    transition_ = ImuMatrix::Identity();
+    tracking_ = true;
+  }
+  /// The product of the IMU block's Φ since startTransition() (addImuNoise changes no Φ); ends
+  /// the accumulation.
+  const ImuMatrix& takeTransition() {
+    tracking_ = false;
+    return transition_;
+  }
   /// Adds Q to the IMU instance's covariance (Σ_II ← Σ_II + Q; cross-covariances unchanged, so
   /// the full matrix stays positive definite). Used for IMU gaps (held readings).
   virtual void addImuNoise(const ImuMatrix& Q) = 0;
@@ -80,10 +89,13 @@ class FusionStrategy {
 
  private:
   ImuMatrix transition_ = ImuMatrix::Identity();
+  bool tracking_ = false;  ///< between startTransition() and takeTransition()
 
  protected:
-  /// Every propagate() records its step's Φ here (transition()).
-  void noteTransition(const ImuMatrix& Phi) { transition_ = Phi * transition_; }
+  /// Every propagate() records its step's Φ here (takeTransition(), while tracking).
+  void noteTransition(const ImuMatrix& Phi) {
+    if (tracking_) transition_ = Phi * transition_;
+  }
   /// The nominal state addInstance writes the new value into.
   virtual NominalState& mutableState() = 0;
   /// Appends a block of kind `kind` with covariance `cov` (its dimension), uncorrelated with the

@@ -362,7 +362,7 @@ void EstimatorNode::propagateRecorded(Propagate&& propagate) {
   }
   propagate();
   ScopedStepTimer timer(timings_, "fixed_lag");
-  smoother_.onPropagation(from, imuBeliefOf(f), f.transition());
+  smoother_.onPropagation(from, imuBeliefOf(f), f.takeTransition());
 }
 
 void EstimatorNode::flushSmoothed() {

@@ -7,7 +7,7 @@
 /// **The chain.** Every propagation of the filter is a record: the IMU block's filtered belief at
 /// its start a (x⁺_a, P⁺_a: after every update at t_a), its predicted belief at its end b
 /// (x⁻_b, P⁻_b: before any update at t_b) and the error transition Φ_ab (the product of the steps'
-/// Φ, FusionStrategy::transition()), so that P⁻_b = Φ_ab P⁺_a Φ_abᵀ + Q_ab whatever Q was (the
+/// Φ, FusionStrategy::takeTransition()), so that P⁻_b = Φ_ab P⁺_a Φ_abᵀ + Q_ab whatever Q was (the
 /// noise adapter's λ, an IMU gap's noise). What happens at t_b between x⁻_b and the next
 /// record's x⁺_b (range, baro, height and zero-velocity updates, a re-run's swap) is an update to
 /// the backward pass, which never reads it.
