@@ -11,11 +11,16 @@
 #   --table-md FILE        also write the table as Markdown
 #   --smooth               also smooth each run (meshnav_smooth) and print the smoothed estimate
 #                          beside the filter's, per seed and on average (docs/smoother.md)
+#   --fixed-lag            print the fixed-lag smoothed estimate (every run's estimate_smoothed.csv)
+#                          beside the filter's, as --smooth does for the whole-recording smoother
+#   --hardware-draws       sequence s flies other UWB modules (meshnav_sim --hardware-seed 1000+s)
+#                          instead of the paper's one fixed set: figures over the simulator's
+#                          hardware distribution (docs/smoother.md, "Consistency over hardware draws")
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${MESHNAV_BUILD_DIR:-$ROOT/build}/bin"
 seeds="1-12"; strategy="centralized"; out=""; mission=""; config=""; sim_args=""; run_args_extra=""; table_md=""
-smooth=0
+smooth=0; fixed_lag=0; hardware_draws=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --seeds) seeds="$2"; shift 2 ;;
@@ -27,7 +32,9 @@ while [[ $# -gt 0 ]]; do
     --run-args) run_args_extra="$2"; shift 2 ;;
     --table-md) table_md="$2"; shift 2 ;;
     --smooth) smooth=1; shift ;;
-    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    --fixed-lag) fixed_lag=1; shift ;;
+    --hardware-draws) hardware_draws=1; shift ;;
+    -h|--help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "paper_table: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -39,7 +46,9 @@ for ((s = first; s <= last; s++)); do
   mkdir -p "$d"
   echo "[paper-table] seed $s: simulate, run ($strategy), evaluate -> $d" >&2
   # shellcheck disable=SC2086
-  "$BIN/meshnav_sim" --seed "$s" --out "$d/dataset" $sim_args > "$d/sim.log" 2>&1 || { cat "$d/sim.log"; exit 1; }
+  hw_args=""
+  [[ $hardware_draws == 1 ]] && hw_args="--hardware-seed $((1000 + s))"
+  "$BIN/meshnav_sim" --seed "$s" --out "$d/dataset" $hw_args $sim_args > "$d/sim.log" 2>&1 || { cat "$d/sim.log"; exit 1; }
   run_args=(--dataset "$d/dataset" --out "$d/run" --strategy "$strategy")
   [[ -n "$mission" ]] && run_args+=(--mission "$mission")
   [[ -n "$config" ]] && run_args+=(--config "$config")
@@ -57,7 +66,7 @@ done
 batch=(--batch "$out")
 [[ -n "$table_md" ]] && batch+=(--table-md "$table_md")
 "$BIN/meshnav_eval" "${batch[@]}"
-if [[ $smooth == 1 ]]; then
+if [[ $smooth == 1 || $fixed_lag == 1 ]]; then
   # The filter and the smoother of each run, from the metrics.yaml meshnav_eval wrote (flying only).
   /usr/bin/python3 - "$out" "$first" "$last" <<'PY'
 import sys, yaml

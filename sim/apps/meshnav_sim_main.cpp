@@ -105,6 +105,11 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
       ->type_name("S")->check(cli_checks::finite())->group("Sensors");
   cli.option("drop,--drop-fraction", o.uwb.drop_fraction, "fraction of dropped range messages")
       ->type_name("F")->check(cli_checks::nonNegative())->group("Sensors");
+  cli.option("hardware-seed", o.hardware.hardware_seed,
+             "seed of the UWB modules' pair biases and of their a-priori calibration's error, drawn once (the "
+             "default is the paper scenario's fixed set: the same modules in every sequence; another seed is "
+             "another set of modules, for consistency figures over hardware draws, docs/smoother.md)")
+      ->type_name("N")->check(CLI::NonNegativeNumber)->group("Sensors");
   c.bias_max_m = o.hardware.gamma_max_m;
   cli.option("bias-max", c.bias_max_m,
              "max |constant pairwise bias gamma| of the UWB hardware [m], (0, 2]; gamma ~ N(0, (0.375 M)^2) clipped "
