@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "common/fleet_file.h"
 #include "common/setup.h"
 #include "common/types.h"
 #include "estimator/node/estimator_input.h"
@@ -21,15 +22,9 @@
 
 namespace meshnav::pipeline {
 
-/// One entry of a fleet file.
-struct FleetEntry {
-  std::string name;
-  std::string dataset;  ///< folder, resolved against the fleet file's folder
-};
-
-/// Reads a fleet file. Throws std::runtime_error "<path>[:line]: ..." naming the key for a missing
-/// or unknown key, an empty list, a bad or repeated name.
-std::vector<FleetEntry> loadFleetFile(const std::string& path);
+/// The fleet file (common/fleet_file.h), also read by meshnav eval --fleet.
+using meshnav::FleetEntry;
+using meshnav::loadFleetFile;
 
 /// Makes the vehicles' anchors one map and returns what the fleet's calibrator knows: every
 /// vehicle's tags (with their lever arms) and the union of the known anchors, their σ and the pair

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 
 #include "common/dataset.h"
 #include "common/estimate_io.h"
@@ -137,7 +138,9 @@ TEST(EndToEnd, UncertainAnchorsDpAndDahOnSimulatedSeed10) {
 // anchors, one calibrator for both (mission S2: 106–110 calibrated at 80 s and 100 s). Each vehicle
 // gets its own run folder with every output, each estimates its pose as well as a single vehicle
 // does (the bounds of runAndCheck), and both end up fusing the five calibrated anchors close to
-// their true positions. A fleet file naming a missing dataset key is refused with file and key.
+// their true positions. `meshnav_eval --fleet` scores both in one table with their mean, the same
+// figures as each vehicle's own evaluation, and refuses a fleet whose vehicle has no run folder. A
+// fleet file naming a missing dataset key is refused with file and key.
 TEST(EndToEnd, FleetOfTwoSimulatedVehiclesSharesOneAnchorMap) {
   const meshnav::test::TempDir tmp("e2e_fleet");
   const fs::path data = tmp / "data", out = tmp / "run";
@@ -170,6 +173,39 @@ TEST(EndToEnd, FleetOfTwoSimulatedVehiclesSharesOneAnchorMap) {
       EXPECT_LE(err, 0.15) << v << " anchor " << id;
     }
   }
+
+  // meshnav_eval --fleet: one row per vehicle (its RMSE as scored above, to the table's 3 decimals)
+  // and the mean row; exit 1 when a vehicle's run folder is missing.
+  const fs::path eval_log = tmp / "eval_fleet.log";
+  ASSERT_EQ(run(std::string(MESHNAV_EVAL_BIN) + " --fleet " + (data / "fleet.yaml").string() + " --run " +
+                out.string() + " --no-plots --no-baseline > " + eval_log.string() + " 2>&1"),
+            0);
+  {
+    std::ifstream in(eval_log);
+    std::map<std::string, double> rmse;
+    for (std::string line; std::getline(in, line);) {
+      std::istringstream row(line);
+      std::string name;
+      double v = 0.0;
+      if (row >> name >> v && (name == "v0" || name == "v1" || name == "mean")) rmse[name] = v;
+    }
+    ASSERT_EQ(rmse.size(), 3u) << "eval --fleet printed no row per vehicle and mean";
+    const double r0 = comparePoses("v0", data / "v0", out / "v0").rmse_p_m;
+    const double r1 = comparePoses("v1", data / "v1", out / "v1").rmse_p_m;
+    EXPECT_NEAR(rmse["v0"], r0, 0.002);
+    EXPECT_NEAR(rmse["v1"], r1, 0.002);
+    EXPECT_NEAR(rmse["mean"], 0.5 * (r0 + r1), 0.002);
+  }
+  fs::rename(out / "v1", tmp / "v1_moved");
+  EXPECT_NE(run(std::string(MESHNAV_EVAL_BIN) + " --fleet " + (data / "fleet.yaml").string() + " --run " +
+                out.string() + " --no-plots --no-baseline > " + eval_log.string() + " 2>&1"),
+            0);
+  {
+    std::ifstream in(eval_log);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("vehicle v1"), std::string::npos) << text;
+  }
+  fs::rename(tmp / "v1_moved", out / "v1");
 
   const fs::path bad = tmp / "bad_fleet.yaml";
   std::ofstream(bad) << "vehicles:\n  - {name: v0, dataset: data/v0}\n  - {name: v1}\n";

@@ -151,5 +151,56 @@ class MiluvBadInput(unittest.TestCase):
             self.assertIn("clash", log)
 
 
+class MiluvAllRobots(unittest.TestCase):
+    """`--robot all` (issue 38 item 4): one dataset per robot folder, the same as importing each
+    alone, and a fleet.yaml that `meshnav run --fleet` takes, vehicles named as the robots; a robot
+    folder added to the experiment is imported without code changes."""
+
+    def test_every_robot_with_a_folder_and_a_fleet_file(self):
+        rs.require(rs.MILUV_DIR)
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "fleet")
+            code, log = rs.run_import("miluv", "--dir", rs.MILUV_DIR, "--robot", "all", "--out", out)
+            self.assertEqual(code, 0, log)
+            self.assertIn("ifo003", log)  # in tags.yaml, no folder here: said, and skipped
+            fleet = rs.read_yaml(os.path.join(out, "fleet.yaml"))
+            self.assertEqual(fleet, {"vehicles": [{"name": "ifo001", "dataset": "ifo001"},
+                                                  {"name": "ifo002", "dataset": "ifo002"}]})
+            for robot in ("ifo001", "ifo002"):
+                alone = os.path.join(tmp, robot)
+                code, log = rs.run_import("miluv", "--dir", rs.MILUV_DIR, "--robot", robot, "--out", alone)
+                self.assertEqual(code, 0, log)
+                for name in ("imu.csv", "ranges.csv", "groundtruth.csv", "height.csv", "setup.yaml"):
+                    self.assertEqual(rs.read_text(os.path.join(out, robot, name)), rs.read_text(os.path.join(alone, name)),
+                                     f"{robot}/{name}")
+
+    def test_an_added_robot_folder_becomes_a_vehicle(self):
+        rs.require(rs.MILUV_DIR)
+        with tempfile.TemporaryDirectory() as tmp:
+            exp = os.path.join(tmp, "exp")
+            os.makedirs(exp)
+            for name in ("anchors.yaml", "tags.yaml"):
+                os.symlink(os.path.join(rs.MILUV_DIR, name), os.path.join(exp, name))
+            # ifo003 is in tags.yaml; its folder here is ifo002's recording (the importer keeps only
+            # ranges that involve ifo003's own tags, so it gets none of them: still a dataset).
+            for robot, src in (("ifo001", "ifo001"), ("ifo003", "ifo002")):
+                os.symlink(os.path.join(rs.MILUV_DIR, src), os.path.join(exp, robot))
+            out = os.path.join(tmp, "fleet")
+            code, log = rs.run_import("miluv", "--dir", exp, "--robot", "all", "--out", out)
+            self.assertEqual(code, 0, log)
+            names = [v["name"] for v in rs.read_yaml(os.path.join(out, "fleet.yaml"))["vehicles"]]
+            self.assertEqual(names, ["ifo001", "ifo003"])
+            self.assertTrue(os.path.isfile(os.path.join(out, "ifo003", "imu.csv")))
+
+    def test_no_robot_folder_is_a_clear_error(self):
+        rs.require(rs.MILUV_DIR)
+        with tempfile.TemporaryDirectory() as tmp:
+            for name in ("anchors.yaml", "tags.yaml"):
+                os.symlink(os.path.join(rs.MILUV_DIR, name), os.path.join(tmp, name))
+            code, log = rs.run_import("miluv", "--dir", tmp, "--robot", "all", "--out", os.path.join(tmp, "o"))
+            self.assertEqual(code, 1, log)
+            self.assertIn("no robot of", log)
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -1,4 +1,6 @@
-"""One robot of a MILUV experiment folder -> meshnav dataset folder (docs/formats.md).
+"""One robot of a MILUV experiment folder -> meshnav dataset folder (docs/formats.md); with
+`--robot all`, every robot of tags.yaml that has a folder -> OUT/<robot>/ and OUT/fleet.yaml for
+`meshnav run --fleet` (docs/fleet.md), the vehicles named as the robots.
 
 Layout read: DIR/anchors.yaml ({id: [x, y, z]}, Vicon world frame), DIR/tags.yaml
 ({robot: {tag id: [x, y, z]}}, body = PX4 IMU frame), DIR/<robot>/imu_px4.csv, uwb_range.csv,
@@ -29,8 +31,10 @@ HEIGHT_COLS = ["timestamp", "range"]
 
 def add_arguments(p):
     p.add_argument("--dir", required=True, help="experiment folder (anchors.yaml, tags.yaml, <robot>/)")
-    p.add_argument("--robot", required=True, help="robot folder name, e.g. ifo001")
-    p.add_argument("--out", required=True, help="dataset folder to write (created)")
+    p.add_argument("--robot", required=True,
+                   help="robot folder name, e.g. ifo001; 'all': every robot of tags.yaml with a folder, each to "
+                        "OUT/<robot>, and OUT/fleet.yaml")
+    p.add_argument("--out", required=True, help="dataset folder to write (created); with --robot all, the fleet folder")
     p.add_argument("--anchor-id-offset", type=int, default=100, help="meshnav anchor id = MILUV id + this (default 100)")
     p.add_argument("--range-column", default="range", choices=("range", "range_raw"),
                    help="measured range column of uwb_range.csv (default range: MILUV's processed range)")
@@ -150,7 +154,47 @@ def _setup_ids(args):
     return anchors, own, all_tags
 
 
+ROBOT_NAME_CHARS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-")
+
+
+def _robots_with_folders(args):
+    """The robots of tags.yaml with a folder in --dir, in tags.yaml's order; the others are logged."""
+    tags_path = os.path.join(args.dir, "tags.yaml")
+    robots = []
+    for r in map(str, _load_yaml(tags_path)):
+        if not os.path.isdir(os.path.join(args.dir, r)):
+            dw.log(f"robot {r}: in {tags_path} but no folder {os.path.join(args.dir, r)}: skipped")
+        elif not (1 <= len(r) <= 64 and set(r) <= ROBOT_NAME_CHARS):
+            raise ValueError(f"{tags_path}: robot '{r}' is not a fleet vehicle name (1-64 of [A-Za-z0-9_-])")
+        else:
+            robots.append(r)
+    if not robots:
+        raise ValueError(f"{args.dir}: no robot of {tags_path} has a folder")
+    return robots
+
+
 def run(args):
+    """Imports one robot, or every robot (`--robot all`); returns the process exit code."""
+    if args.robot != "all":
+        return _run_robot(args)
+    import argparse
+    robots = _robots_with_folders(args)
+    out = dw.prepare_out_dir(args.out)
+    for r in robots:
+        dw.log(f"robot {r} -> {os.path.join(out, r)}")
+        code = _run_robot(argparse.Namespace(**{**vars(args), "robot": r, "out": os.path.join(out, r)}))
+        if code != 0:
+            return code
+    lines = ["# written by ./meshnav import miluv --robot all: one vehicle per robot, for meshnav run --fleet",
+             "# (docs/fleet.md); the inter-robot ranges are in each robot's ranges.csv (type T on both ends)",
+             "vehicles:"] + [f"  - {{name: {r}, dataset: {r}}}" for r in robots]
+    with open(os.path.join(out, "fleet.yaml"), "w", encoding="utf-8") as f:
+        f.write("\n".join(lines) + "\n")
+    dw.log(f"wrote {os.path.join(out, 'fleet.yaml')}: {len(robots)} vehicles ({', '.join(robots)})")
+    return 0
+
+
+def _run_robot(args):
     """Imports one robot; returns the process exit code."""
     report = dw.Report()
     anchors, own, all_tags = _setup_ids(args)
