@@ -5,7 +5,7 @@ drew (and the time of its first frame with the vehicle, from the moment it was o
 time to the first frame and the frame rate while the log played (minimum, median, mean over 1 s
 windows). A measurement, not a test: it asserts nothing.
 
-  scripts/view_measure.py --log FILE.lcmlog [--speed 10] [--bin build/bin] [--chromium chromium]
+  scripts/view_measure.py --log FILE.lcmlog [--speed 10] [--setup setup.yaml] [--bin build/bin] [--chromium chromium]
 """
 import argparse
 import json
@@ -26,11 +26,12 @@ def main():
     ap.add_argument('--bin', default=os.path.join(os.path.dirname(__file__), '..', 'build', 'bin'))
     ap.add_argument('--chromium', default=shutil.which('chromium') or 'chromium')
     ap.add_argument('--window', default='1280,800', help='browser window size W,H [px]')
+    ap.add_argument('--setup', help="setup.yaml for the residuals' tag lever arms (view_server --setup)")
     ap.add_argument('--timeout', type=float, default=600.0, help='give up after this many seconds')
     args = ap.parse_args()
 
     server = subprocess.Popen([os.path.join(args.bin, 'view_server'), '--log', args.log, '--speed', str(args.speed),
-                               '--port', '0'], stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+                               '--port', '0'] + (['--setup', args.setup] if args.setup else []), stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     url_ready = threading.Event()
     state = {'url': None, 'perf': [], 'played': False}
 
