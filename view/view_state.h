@@ -135,7 +135,7 @@ class ViewState {
   std::optional<Timestamp> t_latest_;
   std::optional<PoseEstimate> pose_;
   std::optional<PoseSample> truth_pose_;
-  Track path_;       ///< t, x, y, z, σ_xy (√ of the larger x–y eigenvalue)
+  Track path_;       ///< t, x, y, z, the x–y ellipse a, b, angle (ellipse_scale), σz
   Track truth_;      ///< t, x, y, z
   Track residuals_;  ///< t, anchor id, residual
   std::map<SensorId, Anchor> anchors_;

@@ -55,7 +55,7 @@ std::string ViewState::Anchor::state() const {
 
 ViewState::ViewState(ViewStateOptions options)
     : options_(options),
-      path_(5, options.path_capacity, Track::Overflow::Thin),
+      path_(8, options.path_capacity, Track::Overflow::Thin),
       truth_(4, options.path_capacity, Track::Overflow::Thin),
       residuals_(3, options.residual_capacity, Track::Overflow::DropOldest),
       residual_maker_(
@@ -100,8 +100,10 @@ void ViewState::onPose(const PoseEstimate& p) {
     return;
   }
   const double t = rel(p.t);
-  const Ellipse2d e = horizontalEllipse(p.cov_p_m2, 1.0);
-  if (joins(path_, t, p.p_IinG)) path_.append({t, p.p_IinG.x(), p.p_IinG.y(), p.p_IinG.z(), e.a_m});
+  const Ellipse2d e = horizontalEllipse(p.cov_p_m2, options_.ellipse_scale);
+  if (joins(path_, t, p.p_IinG))
+    path_.append({t, p.p_IinG.x(), p.p_IinG.y(), p.p_IinG.z(), e.a_m, e.b_m, e.angle_rad,
+                  std::sqrt(std::max(0.0, p.cov_p_m2(2, 2)))});
   pose_ = p;
   ++n_poses_;
   residual_maker_.onPose(p);

@@ -1,6 +1,8 @@
-// meshnav live view (docs/view.md): polls /api/state of view_server and draws, on every animation
-// frame, the top view (x–y of G, y up) and the residual strip; the tables are refreshed at most
-// 4 times a second. With ?perf=1 in the URL the page posts its frame counts to /api/perf once a
+// meshnav live view (docs/view.md): polls /api/state of view_server every 100 ms. On every
+// animation frame it draws the top view (x–y of G, y up): a layer with the paths, ellipses and
+// anchors, redrawn when new state has come, under the vehicle, which glides from its previous
+// pose to the newest over one poll. The residual and height strips are redrawn with new state,
+// the tables at most 4 times a second. With ?perf=1 in the URL the page posts its frame counts to /api/perf once a
 // second (the measurement of docs/view.md).
 'use strict';
 
@@ -19,6 +21,11 @@ const S = {
   truth: { epoch: -1, rows: [] },
   res: { epoch: -1, rows: [] },
   j: null,            // the last state
+  dirty: false,       // new state since the last redraw of the layer and the strips
+  panelsDirty: false, // new state since the last refresh of the tables
+  layer: null,        // the top view without the vehicle (drawTopLayer)
+  prevP: null,        // where the vehicle's glide starts [m]
+  poseAt: 0,          // when the newest pose came [ms, performance.now()]
   bounds: null,       // [xmin, xmax, ymin, ymax] of G shown
   panelsAt: 0,
   frames: 0, drawMs: 0,
@@ -48,7 +55,16 @@ async function poll() {
       merge(S.path, j.path);
       merge(S.truth, j.truth);
       merge(S.res, j.residuals);
+      const before = S.j && S.j.pose;
+      if (j.pose && (!before || j.pose.t !== before.t)) {
+        // where the vehicle is drawn now becomes the start of its glide to the new pose
+        const f = Math.min(1, Math.max(0, (performance.now() - S.poseAt) / POLL_MS));
+        S.prevP = before ? (S.prevP ? [0, 1].map((k) => S.prevP[k] + f * (before.p[k] - S.prevP[k])) : before.p) : null;
+        S.poseAt = performance.now();
+      }
       S.j = j;
+      S.dirty = true;
+      S.panelsDirty = true;
       growBounds(j);
     }
   } catch (e) {
@@ -107,6 +123,21 @@ function polyline(ctx, T, rows) {
   ctx.stroke();
 }
 
+// The path's 95 % x–y ellipses, faint, at most about 150 along the whole path.
+function pathEllipses(ctx, T) {
+  const rows = S.path.rows;
+  if (rows.length < 2) return;
+  const every = Math.max(1, (rows[rows.length - 1][0] - rows[0][0]) / 150);
+  ctx.strokeStyle = 'rgba(31, 119, 180, 0.3)';
+  ctx.lineWidth = 1;
+  let next = rows[0][0];
+  for (const r of rows) {
+    if (r[0] < next) continue;
+    ellipse(ctx, T, r[1], r[2], [r[4], r[5], r[6]]);
+    next = r[0] + every;
+  }
+}
+
 function grid(ctx, T, w, h) {
   const step = T.k > 25 ? 1 : T.k > 6 ? 5 : 10;  // metres between lines
   ctx.strokeStyle = '#eeeeee';
@@ -126,13 +157,18 @@ function grid(ctx, T, w, h) {
   document.getElementById('scale').textContent = `grid ${step} m; x → right, y ↑ (G)`;
 }
 
-function drawTop() {
-  const [ctx, w, h] = fitCanvas(document.getElementById('top'));
-  ctx.clearRect(0, 0, w, h);
-  const T = transform(w, h);
+// Everything of the top view but the vehicle, into an offscreen layer: redrawn when new state has
+// come or the canvas changed size, copied on every frame under the moving vehicle.
+function drawTopLayer(w, h, T) {
+  const c = S.layer || (S.layer = document.createElement('canvas'));
+  const top = document.getElementById('top');
+  c.width = top.width;
+  c.height = top.height;
+  const ctx = c.getContext('2d');
+  ctx.setTransform(top.width / w, 0, 0, top.height / h, 0, 0);
   grid(ctx, T, w, h);
   const j = S.j;
-  if (!j) return false;
+  if (!j) return;
   // truth, then the estimate over it
   ctx.lineWidth = 1.5;
   ctx.strokeStyle = '#2ca02c';
@@ -141,6 +177,7 @@ function drawTop() {
   ctx.setLineDash([]);
   ctx.strokeStyle = '#1f77b4';
   polyline(ctx, T, S.path.rows);
+  pathEllipses(ctx, T);
   // anchors
   ctx.font = '11px sans-serif';
   for (const a of j.anchors) {
@@ -164,21 +201,36 @@ function drawTop() {
     ctx.arc(T.x(j.truth_pose.p[0]), T.y(j.truth_pose.p[1]), 6, 0, 2 * Math.PI);
     ctx.stroke();
   }
-  // the vehicle: its 95 % ellipse, a disc and its heading
-  if (j.pose) {
-    const p = j.pose.p, X = T.x(p[0]), Y = T.y(p[1]);
-    ctx.strokeStyle = 'rgba(160, 0, 160, 0.8)';
-    ctx.lineWidth = 1.5;
-    ellipse(ctx, T, p[0], p[1], j.pose.ell);
-    const yaw = j.pose.yaw_deg * Math.PI / 180;
-    ctx.strokeStyle = '#600060';
-    ctx.lineWidth = 2;
-    ctx.beginPath(); ctx.moveTo(X, Y); ctx.lineTo(X + 18 * Math.cos(yaw), Y - 18 * Math.sin(yaw)); ctx.stroke();
-    ctx.fillStyle = VEHICLE;
-    ctx.beginPath(); ctx.arc(X, Y, 8, 0, 2 * Math.PI); ctx.fill();
-    return true;
-  }
-  return false;
+}
+
+// The top view on every frame: the layer, and the vehicle (its 95 % ellipse, a disc and its
+// heading) moved from the previous pose to the newest over one poll period, so that it glides
+// instead of jumping every poll. True when the vehicle was drawn.
+function drawTop(now, redraw) {
+  const top = document.getElementById('top');
+  const [ctx, w, h] = fitCanvas(top);
+  const T = transform(w, h);
+  if (redraw || !S.layer || S.layer.width !== top.width || S.layer.height !== top.height) drawTopLayer(w, h, T);
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.clearRect(0, 0, top.width, top.height);
+  ctx.drawImage(S.layer, 0, 0);
+  ctx.setTransform(top.width / w, 0, 0, top.height / h, 0, 0);
+  const pose = S.j && S.j.pose;
+  if (!pose) return false;
+  const f = Math.min(1, Math.max(0, (now - S.poseAt) / POLL_MS));
+  const from = S.prevP || pose.p;
+  const x = from[0] + f * (pose.p[0] - from[0]), y = from[1] + f * (pose.p[1] - from[1]);
+  const X = T.x(x), Y = T.y(y);
+  ctx.strokeStyle = 'rgba(160, 0, 160, 0.8)';
+  ctx.lineWidth = 1.5;
+  ellipse(ctx, T, x, y, pose.ell);
+  const yaw = pose.yaw_deg * Math.PI / 180;
+  ctx.strokeStyle = '#600060';
+  ctx.lineWidth = 2;
+  ctx.beginPath(); ctx.moveTo(X, Y); ctx.lineTo(X + 18 * Math.cos(yaw), Y - 18 * Math.sin(yaw)); ctx.stroke();
+  ctx.fillStyle = VEHICLE;
+  ctx.beginPath(); ctx.arc(X, Y, 8, 0, 2 * Math.PI); ctx.fill();
+  return true;
 }
 
 function drawResiduals() {
@@ -206,6 +258,45 @@ function drawResiduals() {
     ctx.fillStyle = PALETTE[Math.max(0, ids.indexOf(r[1])) % PALETTE.length];
     ctx.fillRect(X(r[0]) - 1, Y(Math.max(-m, Math.min(m, r[2]))) - 1, 2.5, 2.5);
   }
+}
+
+// Height over the last RESIDUAL_WINDOW_S: the estimate with its ±2σz band, the truth dashed.
+function drawHeight() {
+  const [ctx, w, h] = fitCanvas(document.getElementById('height'));
+  ctx.clearRect(0, 0, w, h);
+  const tEnd = S.j ? S.j.t : 0, tStart = tEnd - RESIDUAL_WINDOW_S;
+  const recent = (rows) => { let i = rows.length; while (i > 0 && rows[i - 1][0] >= tStart) --i; return rows.slice(Math.max(0, i - 1)); };
+  const est = recent(S.path.rows), tru = recent(S.truth.rows);
+  let lo = Infinity, hi = -Infinity;
+  for (const r of est) { lo = Math.min(lo, r[3] - 2 * r[7]); hi = Math.max(hi, r[3] + 2 * r[7]); }
+  for (const r of tru) { lo = Math.min(lo, r[3]); hi = Math.max(hi, r[3]); }
+  ctx.fillStyle = '#666';
+  ctx.font = '10px sans-serif';
+  ctx.fillText(`height z [m], estimate ±2σ and truth, last ${RESIDUAL_WINDOW_S} s`, 50, 12);
+  if (!(hi > lo)) { lo -= 0.5; hi += 0.5; }
+  if (!Number.isFinite(lo)) return;
+  const pad = 0.1 * (hi - lo);
+  lo -= pad; hi += pad;
+  const X = (t) => 40 + (t - tStart) / RESIDUAL_WINDOW_S * (w - 50), Y = (z) => h - 6 - (z - lo) / (hi - lo) * (h - 24);
+  ctx.fillText(hi.toFixed(1), 2, 22);
+  ctx.fillText(lo.toFixed(1), 2, h - 6);
+  if (est.length > 1) {
+    ctx.fillStyle = 'rgba(31, 119, 180, 0.2)';
+    ctx.beginPath();
+    est.forEach((r, i) => (i ? ctx.lineTo : ctx.moveTo).call(ctx, X(r[0]), Y(r[3] + 2 * r[7])));
+    for (let i = est.length - 1; i >= 0; --i) ctx.lineTo(X(est[i][0]), Y(est[i][3] - 2 * est[i][7]));
+    ctx.fill();
+  }
+  const line = (rows, colour, dash) => {
+    if (rows.length < 2) return;
+    ctx.strokeStyle = colour; ctx.setLineDash(dash); ctx.lineWidth = 1.5;
+    ctx.beginPath();
+    rows.forEach((r, i) => (i ? ctx.lineTo : ctx.moveTo).call(ctx, X(r[0]), Y(r[3])));
+    ctx.stroke();
+    ctx.setLineDash([]);
+  };
+  line(tru, '#2ca02c', [5, 4]);
+  line(est, '#1f77b4', []);
 }
 
 // ---- tables -------------------------------------------------------------------------------------
@@ -259,9 +350,19 @@ function updatePanels() {
 // ---- the loop -----------------------------------------------------------------------------------
 function frame(now) {
   const t0 = performance.now();
-  const drewVehicle = drawTop();
-  drawResiduals();
-  if (now - S.panelsAt > 250) { updatePanels(); S.panelsAt = now; }
+  const redraw = S.dirty;
+  S.dirty = false;
+  const drewVehicle = drawTop(now, redraw);
+  if (redraw || S.stripsW !== window.innerWidth) {
+    drawResiduals();
+    drawHeight();
+    S.stripsW = window.innerWidth;
+  }
+  if (S.panelsDirty && now - S.panelsAt > 250) {
+    updatePanels();
+    S.panelsAt = now;
+    S.panelsDirty = false;
+  }
   S.drawMs += performance.now() - t0;
   S.frames += 1;
   if (drewVehicle && S.firstFrameMs === null) {

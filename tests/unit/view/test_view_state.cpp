@@ -38,12 +38,14 @@ TEST(ViewState, PathIsDecimatedAndSentIncrementally) {
   ASSERT_EQ(v.path().size(), 3u);
   EXPECT_DOUBLE_EQ(v.path().at(0, 0), 0.0);  // seconds since the first message
   EXPECT_NEAR(v.path().at(2, 0), 0.7, 1e-9);
-  EXPECT_NEAR(v.path().at(0, 4), 0.2, 1e-12);  // σ of the major x–y axis
+  EXPECT_NEAR(v.path().at(0, 4), 0.2 * meshnav::view::kChi2Scale95, 1e-12);  // the 95 % ellipse's axes
+  EXPECT_NEAR(v.path().at(0, 5), 0.1 * meshnav::view::kChi2Scale95, 1e-12);
+  EXPECT_NEAR(v.path().at(0, 7), 0.3, 1e-12);  // σz
   ViewCursor c;
   c.path_epoch = 0;
   c.path_rows = 2;
   const std::string json = v.json(c);
-  EXPECT_TRUE(contains(json, R"("path":{"epoch":0,"start":2,"rows":[[0.7,0.5,0,1,0.2]]})")) << json;
+  EXPECT_TRUE(contains(json, R"("path":{"epoch":0,"start":2,"rows":[[0.7,0.5,0,1,0.489549,0.244775,0,0.3]]})")) << json;
   EXPECT_TRUE(contains(json, R"("t0_utime":100000000)")) << json;
   // The current pose is the newest, with its 95 % ellipse (0.2 · 2.44775 = 0.489549…).
   EXPECT_TRUE(contains(json, R"("ell":[0.4895,0.2448,0])")) << json;
