@@ -31,7 +31,7 @@ def main():
     args = ap.parse_args()
 
     server = subprocess.Popen([os.path.join(args.bin, 'view_server'), '--log', args.log, '--speed', str(args.speed),
-                               '--port', '0'] + (['--setup', args.setup] if args.setup else []), stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+                               '--port', '0', '--perf'] + (['--setup', args.setup] if args.setup else []), stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     url_ready = threading.Event()
     state = {'url': None, 'perf': [], 'played': False}
 

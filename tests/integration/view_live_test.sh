@@ -3,7 +3,8 @@
 # view_server listens; meshnav_publish_sequence publishes 300 POSE (x = i mm) and an ANCHORS
 # (anchors 201, 202) after every 10th; the state endpoint must show all 300 POSE, the last one's
 # position, the path and both anchors as estimated. Malformed messages on POSE are then counted in
-# the counters the page shows, and view_server keeps serving and stops with exit 0 on SIGTERM.
+# the counters the page shows, and view_server keeps serving and stops with exit 0 on SIGTERM. It
+# serves on 127.0.0.1 by default, and refuses a request that names another host (DNS rebinding).
 #   view_live_test.sh BIN_DIR WORK_DIR
 # Waits are on conditions (a printed line, the state endpoint's contents), each bounded.
 set -u
@@ -44,6 +45,20 @@ for i in $(seq 1 100); do grep -q "^view: http" "$WORK/view.out" && break; sleep
 URL=$(sed -n 's/^view: \(http[^ ]*\)$/\1/p' "$WORK/view.out" | head -n 1)
 [[ -n "$URL" ]] || fail "view_server printed no URL"
 state "j['source']['mode'] == 'live' and j['pose'] is None" || fail "a fresh live view is not empty"
+[[ "$URL" == http://127.0.0.1:* ]] || fail "the view does not serve on 127.0.0.1 by default: $URL"
+# Another site's name for this address (DNS rebinding) is refused; the page itself is served.
+code=$(python3 - "$URL" <<'PY'
+import sys, urllib.error, urllib.request
+try:
+    urllib.request.urlopen(urllib.request.Request(sys.argv[1] + 'api/state', headers={'Host': 'evil.example'}))
+    print(200)
+except urllib.error.HTTPError as e:
+    print(e.code)
+PY
+)
+[[ "$code" == 403 ]] || fail "a request for Host evil.example got $code (expected 403)"
+python3 -c "import sys, urllib.request; b = urllib.request.urlopen(sys.argv[1]).read(); sys.exit(0 if b'view.js' in b else 1)" "$URL" \
+  || fail "GET / does not serve the page"
 
 "$BIN/meshnav_publish_sequence" --count 300 --rate 500 --record "$WORK/sent.csv" > "$WORK/publish.out" 2>&1 \
   || fail "meshnav_publish_sequence"

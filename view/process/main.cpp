@@ -4,8 +4,10 @@
 /// page of view/web/ and its state endpoint over HTTP on `--host` (127.0.0.1) `--port`.
 ///
 /// Endpoints: GET / (the page, view/web/), GET /api/state?pe=&pn=&te=&tn=&re=&rn= (the JSON of
-/// ViewState::json for a page holding those track epochs and rows), POST /api/perf (the page's
-/// frame counts, printed as a `perf:` line on stdout: docs/view.md, "Measured").
+/// ViewState::json for a page holding those track epochs and rows), POST /api/perf (with --perf:
+/// the page's frame counts, printed as a `perf:` line on stdout: docs/view.md, "Measured"). On a
+/// loopback --host, a request whose Host header is not 127.0.0.1, localhost or [::1] with the port
+/// is refused (403): another site's page cannot read the view through DNS rebinding.
 ///
 /// A log is played through an in-process LCM (memq://) into the same typed subscriptions as live
 /// data, so a malformed or foreign message in it is decoded, refused and counted the same way.
@@ -35,6 +37,7 @@ struct ServerOptions {
   double speed = 1.0;
   std::string setup_path;
   std::string web_dir = MESHNAV_VIEW_WEB_DIR;
+  bool perf = false;
 };
 
 void declareOptions(Cli& cli, ServerOptions& o) {
@@ -46,6 +49,7 @@ void declareOptions(Cli& cli, ServerOptions& o) {
                "setup.yaml: tag lever arms for the range residuals and the known anchors (without it: lever arms 0)")
       ->type_name("FILE");
   cli.option("web", o.web_dir, "folder of the page (index.html, view.js)")->type_name("DIR");
+  cli.flag("perf", o.perf, "print the frame reports of a page opened with ?perf=1 (POST /api/perf) as `perf:` lines");
 }
 
 /// What a log holds: checked before anything is served, so that a missing, empty or garbled file
@@ -123,6 +127,17 @@ void playLog(const std::string& path, const LogSummary& summary, double speed, t
   progress(1.0);
 }
 
+/// True for an address of this machine only.
+bool isLoopback(const std::string& host) { return host == "127.0.0.1" || host == "localhost" || host == "::1"; }
+
+/// Served on a loopback address, a request must name it in its Host header: a page of another site
+/// that a browser resolves to 127.0.0.1 (DNS rebinding) is refused.
+bool hostAllowed(const httplib::Request& req, int port) {
+  const std::string host = req.get_header_value("Host");
+  const std::string p = ":" + std::to_string(port);
+  return host == "127.0.0.1" + p || host == "localhost" + p || host == "[::1]" + p;
+}
+
 /// Reads a non-negative integer query parameter (absent or bad: `fallback`).
 int64_t param(const httplib::Request& req, const char* name, int64_t fallback) {
   if (!req.has_param(name)) return fallback;
@@ -184,6 +199,10 @@ int main(int argc, char** argv) {
       res.set_content(body, "application/json");
     });
     server.Post("/api/perf", [&](const httplib::Request& req, httplib::Response& res) {
+      if (!o.perf) {
+        res.status = 404;
+        return;
+      }
       std::string line = req.body.substr(0, 2000);
       for (char& ch : line)
         if (ch == '\n' || ch == '\r') ch = ' ';
@@ -201,9 +220,17 @@ int main(int argc, char** argv) {
       throw std::runtime_error("cannot listen on " + o.host + ":" + std::to_string(port) +
                                " (in use, or not an address of this machine); try --port 0");
     }
-    std::thread http([&] { server.listen_after_bind(); });
-    if (o.host != "127.0.0.1" && o.host != "localhost" && o.host != "::1")
+    if (isLoopback(o.host)) {
+      server.set_pre_routing_handler([port](const httplib::Request& req, httplib::Response& res) {
+        if (hostAllowed(req, port)) return httplib::Server::HandlerResponse::Unhandled;
+        res.status = 403;
+        res.set_content("the view answers requests for 127.0.0.1 or localhost only\n", "text/plain");
+        return httplib::Server::HandlerResponse::Handled;
+      });
+    } else {
       spdlog::warn("serving on {}: the view can be reached from other machines", o.host);
+    }
+    std::thread http([&] { server.listen_after_bind(); });
     std::printf("view: http://%s:%d/\n", o.host.c_str(), port);
     std::fflush(stdout);
 
