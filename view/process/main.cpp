@@ -231,7 +231,8 @@ int main(int argc, char** argv) {
       spdlog::warn("serving on {}: the view can be reached from other machines", o.host);
     }
     std::thread http([&] { server.listen_after_bind(); });
-    std::printf("view: http://%s:%d/\n", o.host.c_str(), port);
+    const std::string shown = o.host.find(':') != std::string::npos ? "[" + o.host + "]" : o.host;  // IPv6
+    std::printf("view: http://%s:%d/\n", shown.c_str(), port);
     std::fflush(stdout);
 
     int rc = 0;
