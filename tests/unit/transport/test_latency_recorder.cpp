@@ -1,0 +1,57 @@
+/// @file test_latency_recorder.cpp
+/// @brief LatencyRecorder (transport/latency_recorder.h): IMU → POSE and RANGE → POSE from receive
+/// times, on hand-made streams with known answers.
+#include <gtest/gtest.h>
+
+#include "transport/latency_recorder.h"
+
+using meshnav::transport::LatencyRecorder;
+using meshnav::transport::LatencyStats;
+
+TEST(LatencyStats, MedianP99AndMaxOfASample) {
+  std::vector<double> s;
+  for (int i = 1; i <= 100; ++i) s.push_back(i);
+  const LatencyStats st = LatencyStats::of(s);
+  EXPECT_EQ(st.n, 100u);
+  EXPECT_DOUBLE_EQ(st.median_us, 51.0);  // the rounded middle of 1..100
+  EXPECT_DOUBLE_EQ(st.p99_us, 99.0);
+  EXPECT_DOUBLE_EQ(st.max_us, 100.0);
+  EXPECT_EQ(LatencyStats::of({}).n, 0u);
+}
+
+// IMU every 5 ms (received at its data time + 100 µs), POSE 30 µs after each IMU; a RANGE at
+// 2 ms after each IMU (received 100 µs after its time): its POSE is the next IMU's, which is made
+// once that IMU is in, so RANGE → POSE is the 30 µs of processing, not the 3 ms wait.
+TEST(LatencyRecorder, ImuAndRangeToPoseWithoutTheWaitForTheNextImuSample) {
+  LatencyRecorder r;
+  for (int k = 0; k < 100; ++k) {
+    const int64_t t = 1'000'000 + k * 5'000;
+    r.onImu(t, t + 100);
+    r.onPose(t, t + 130);
+    r.onRange(t + 2'000, t + 2'100);
+  }
+  const LatencyStats imu = r.imuToPose();
+  EXPECT_EQ(imu.n, 100u);
+  EXPECT_DOUBLE_EQ(imu.median_us, 30.0);
+  EXPECT_DOUBLE_EQ(imu.max_us, 30.0);
+  const LatencyStats range = r.rangeToPose();
+  EXPECT_EQ(range.n, 99u);  // the last RANGE has no later POSE
+  EXPECT_EQ(r.rangesUnanswered(), 1u);
+  EXPECT_DOUBLE_EQ(range.median_us, 30.0);
+  EXPECT_EQ(r.counts().at("IMU"), 100);
+  EXPECT_NEAR(r.ratesHz().at("IMU"), 100.0 / 0.497, 0.5);  // over 100 µs … 497 ms + 130 µs of receive times
+}
+
+// A RANGE that arrives after the POSE of its time went out (late: the estimator re-runs it) is
+// answered by the first POSE that leaves after it, never by one that left before it came.
+TEST(LatencyRecorder, ALateRangeIsAnsweredByTheFirstPoseAfterItCame) {
+  LatencyRecorder r;
+  r.onImu(10'000, 10'000);
+  r.onPose(10'000, 10'050);
+  r.onRange(9'000, 11'000);  // stamped before IMU 10 ms, received after its POSE
+  r.onImu(15'000, 15'000);
+  r.onPose(15'000, 15'040);
+  const LatencyStats range = r.rangeToPose();
+  ASSERT_EQ(range.n, 1u);
+  EXPECT_DOUBLE_EQ(range.median_us, 40.0);  // POSE 15 ms at 15 040 − max(11 000, 15 000)
+}

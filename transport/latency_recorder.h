@@ -1,0 +1,60 @@
+#pragma once
+/// @file latency_recorder.h
+/// @brief What `./meshnav bench lcm` measures from the messages one probe process receives
+/// (scripts/bench_lcm.sh, transport/apps/lcm_probe.cpp): every time below is the probe's receive
+/// time of a message (one clock, LCM's receive thread), so no two hosts' clocks are compared.
+///
+///  - **IMU → POSE**: a POSE stamped u answers the IMU sample stamped u (the estimator publishes
+///    one POSE per IMU sample once initialized): recv(POSE u) − recv(IMU u). This is the estimator's
+///    processing plus two hops over loopback.
+///  - **RANGE → POSE**: a RANGE stamped r is in the first POSE stamped u ≥ r received after it; that POSE can only be
+///    made once both the RANGE and the IMU sample u are in, so its latency is
+///    recv(POSE u) − max(recv(RANGE r), recv(IMU u)): the range's update, the propagation to u and
+///    the POSE, without the wait for the next IMU sample (data time, not processing).
+/// Messages per second are counts over the first to the last receive time of all channels.
+///
+/// Free of LCM: fed with (data utime, receive utime) pairs; unit-tested.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace meshnav::transport {
+
+/// Median, 99th percentile and maximum of a latency sample [µs] (n = 0: all zero).
+struct LatencyStats {
+  size_t n = 0;
+  double median_us = 0.0, p99_us = 0.0, max_us = 0.0;
+  static LatencyStats of(std::vector<double> samples_us);
+};
+
+class LatencyRecorder {
+ public:
+  void onImu(int64_t utime, int64_t recv_utime) { imu_[utime] = recv_utime; note("IMU", recv_utime); }
+  void onRange(int64_t utime, int64_t recv_utime) { ranges_.push_back({utime, recv_utime}); note("RANGE", recv_utime); }
+  void onPose(int64_t utime, int64_t recv_utime) { poses_[utime] = recv_utime; note("POSE", recv_utime); }
+  /// Any other channel, counted only.
+  void onOther(const std::string& channel, int64_t recv_utime) { note(channel, recv_utime); }
+
+  /// IMU → POSE over every POSE whose IMU sample was received.
+  LatencyStats imuToPose() const;
+  /// RANGE → POSE over every RANGE that a later POSE (and its IMU sample) answers; the others
+  /// (after the last POSE, before initialization) are counted in rangesUnanswered().
+  LatencyStats rangeToPose() const;
+  size_t rangesUnanswered() const;
+  /// Messages per second per channel, over the span of all receive times.
+  std::map<std::string, double> ratesHz() const;
+  std::map<std::string, int64_t> counts() const { return counts_; }
+
+ private:
+  void note(const std::string& channel, int64_t recv_utime);
+  std::map<int64_t, int64_t> imu_;    ///< utime → receive utime
+  std::map<int64_t, int64_t> poses_;  ///< utime → receive utime
+  struct Stamped { int64_t utime, recv_utime; };
+  std::vector<Stamped> ranges_;
+  std::map<std::string, int64_t> counts_;
+  int64_t first_recv_ = 0, last_recv_ = 0;
+};
+
+}  // namespace meshnav::transport

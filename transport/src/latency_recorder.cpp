@@ -1,0 +1,57 @@
+#include "transport/latency_recorder.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace meshnav::transport {
+
+LatencyStats LatencyStats::of(std::vector<double> s) {
+  LatencyStats out;
+  out.n = s.size();
+  if (s.empty()) return out;
+  std::sort(s.begin(), s.end());
+  auto at = [&](double q) { return s[std::min(s.size() - 1, static_cast<size_t>(std::floor(q * static_cast<double>(s.size() - 1) + 0.5)))]; };
+  out.median_us = at(0.5);
+  out.p99_us = at(0.99);
+  out.max_us = s.back();
+  return out;
+}
+
+void LatencyRecorder::note(const std::string& channel, int64_t recv_utime) {
+  ++counts_[channel];
+  if (first_recv_ == 0 || recv_utime < first_recv_) first_recv_ = recv_utime;
+  last_recv_ = std::max(last_recv_, recv_utime);
+}
+
+LatencyStats LatencyRecorder::imuToPose() const {
+  std::vector<double> s;
+  for (const auto& [u, recv_pose] : poses_)
+    if (const auto imu = imu_.find(u); imu != imu_.end()) s.push_back(static_cast<double>(recv_pose - imu->second));
+  return LatencyStats::of(std::move(s));
+}
+
+LatencyStats LatencyRecorder::rangeToPose() const {
+  std::vector<double> s;
+  for (const Stamped& r : ranges_) {
+    // The first POSE at or after r that left after the RANGE came (a RANGE received after the
+    // POSE of its time was out is in a later one: the estimator re-ran it as a late input).
+    auto pose = poses_.lower_bound(r.utime);
+    while (pose != poses_.end() && pose->second < r.recv_utime) ++pose;
+    if (pose == poses_.end()) continue;
+    const auto imu = imu_.find(pose->first);
+    if (imu == imu_.end()) continue;
+    s.push_back(static_cast<double>(pose->second - std::max(r.recv_utime, imu->second)));
+  }
+  return LatencyStats::of(std::move(s));
+}
+
+size_t LatencyRecorder::rangesUnanswered() const { return ranges_.size() - rangeToPose().n; }
+
+std::map<std::string, double> LatencyRecorder::ratesHz() const {
+  std::map<std::string, double> out;
+  const double span_s = static_cast<double>(last_recv_ - first_recv_) * 1e-6;
+  for (const auto& [ch, n] : counts_) out[ch] = span_s > 0.0 ? static_cast<double>(n) / span_s : 0.0;
+  return out;
+}
+
+}  // namespace meshnav::transport
