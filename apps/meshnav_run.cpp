@@ -47,6 +47,7 @@ struct RunOptions {
   std::string dataset, fleet, out, strategy, config, mission, calib_config;
   bool no_calibration = false, allow_lost = false, print_config = false, print_model_parameters = false;
   bool calibrate_on_smoothed = false;
+  bool no_inter_vehicle_ranges = false;
 };
 
 void declareOptions(Cli& cli, RunOptions& o) {
@@ -77,6 +78,10 @@ void declareOptions(Cli& cli, RunOptions& o) {
            "the calibrator's tag poses become the fixed-lag smoothed ones as they come (fixed_lag.lag_s later; "
            "docs/smoother.md, calibration on the smoothed path)")
       ->excludes("--no-calibration");
+  cli.flag("no-inter-vehicle-ranges", o.no_inter_vehicle_ranges,
+           "with --fleet: count and drop the ranges between two vehicles' tags instead of fusing each in one of "
+           "the two vehicles with the other's estimated tag (docs/fleet.md, inter-vehicle ranges)")
+      ->needs("--fleet");
   cli.optional("calib-config", o.calib_config,
                "calibrator options YAML (default: built-in = config/calibrator.yaml); calibration results are "
                "written to calibration.yaml in --out")
@@ -290,6 +295,7 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
   popts.estimator = options;
   popts.calibration_enabled = !o.no_calibration;
   popts.calibrator_on_smoothed = o.calibrate_on_smoothed;
+  popts.inter_vehicle_ranges = !o.no_inter_vehicle_ranges;
   calib::CalibratorConfig calib_config = calib::CalibratorConfig::load(o.calib_config);
   if (!o.mission.empty()) popts.mission = mission::loadMission(o.mission);
 

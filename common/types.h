@@ -84,6 +84,17 @@ struct PoseEstimate {
   Eigen::Matrix3d cov_theta_rad2 = Eigen::Matrix3d::Zero();///< orientation error covariance in I [rad²]
 };
 
+/// A range between one of this vehicle's tags and a tag of another vehicle of the fleet (issue 38,
+/// docs/fleet.md "Inter-vehicle ranges"), with where the other vehicle's estimate puts its tag at
+/// the range's instant: the estimator fuses it as a range to a point of that covariance.
+struct PeerRange {
+  Timestamp t;        ///< instant of the range (= range.t)
+  RangeSample range;  ///< as measured; one end is this vehicle's tag, the other the peer's
+  SensorId peer_tag = 0;                                      ///< the other vehicle's tag (an end of range)
+  Eigen::Vector3d p_peer_tag_in_G = Eigen::Vector3d::Zero();  ///< its position from the peer's estimate [m]
+  Eigen::Matrix3d cov_peer_tag_m2 = Eigen::Matrix3d::Zero();  ///< its covariance in G [m²]
+};
+
 /// Estimated (or given) anchor position with covariance.
 struct AnchorEstimate {
   Timestamp t;

@@ -56,6 +56,9 @@ struct PipelineOptions {
   /// fixed-lag smoothed twin once that comes, lag_s later (true; issue 35 item 3, docs/smoother.md
   /// "Calibration on the smoothed path").
   bool calibrator_on_smoothed = false;
+  /// A fleet's ranges between two vehicles' tags: fused (true) as a range to the other vehicle's
+  /// estimated tag (docs/fleet.md "Inter-vehicle ranges"), or counted and dropped (false).
+  bool inter_vehicle_ranges = true;
 };
 
 /// One vehicle of a fleet: a name (its output folder) and its setup. The anchors of every vehicle's
@@ -146,6 +149,9 @@ class Pipeline {
   std::vector<AnchorInit> anchor_inits_;
   Diagnostics diag_;
   std::set<std::tuple<int64_t, SensorId, SensorId>> mesh_ranges_;  ///< (µs, ids) given to the calibrator
+  std::set<std::tuple<int64_t, SensorId, SensorId>> peer_ranges_;  ///< (µs, ids) of inter-vehicle ranges fused
+  /// An inter-vehicle range from vehicle `vehicle`'s data to the vehicle that learns more from it.
+  void routeInterVehicleRange(size_t vehicle, const RangeSample& r);
   std::vector<std::optional<Timestamp>> last_pose_to_calibrator_;  ///< per vehicle
   /// Per vehicle, the POSE instants the calibrator took whose smoothed twin has not come yet
   /// (calibrator_on_smoothed).

@@ -14,7 +14,14 @@
 
 namespace meshnav::sim {
 
-/// Throws std::invalid_argument for n_vehicles outside [1, 16] or invalid options.
-std::vector<SimulationResult> simulateFleet(const SimulationOptions& options, int n_vehicles);
+/// Throws std::invalid_argument for n_vehicles outside [1, 16], a negative or non-finite
+/// `inter_vehicle_hz`, or invalid options.
+///
+/// `inter_vehicle_hz` > 0: every pair of vehicles (j < k) also ranges tag to tag, at that rate,
+/// one tag pair per exchange in turn (TDMA-like), each range in vehicle j's ranges (its tag is the
+/// initiator): z = d + γ + ν from the two true trajectories (ground truth, tags' lever arms), ν ~
+/// N(0, σ_d²), γ per tag pair drawn from the hardware seed like every pair's (N(0, σ_γ²), clipped),
+/// no outliers. 0: none (the default).
+std::vector<SimulationResult> simulateFleet(const SimulationOptions& options, int n_vehicles, double inter_vehicle_hz = 0.0);
 
 }  // namespace meshnav::sim

@@ -161,6 +161,8 @@ void Initialization::feed(const EstimatorInput& in, const UwbNetwork& network, c
   } else if (const auto* r = std::get_if<RangeSample>(&in)) {
     feedRange(*r, network, filter);
   }
+  // A fleet's peer ranges (PeerRange) do not align: the peer's estimate is not an anchor the
+  // alignment can judge (MILUV: a peer 2 m off made a vehicle start 5 m off; docs/fleet.md).
 }
 
 void Initialization::pruneStillness(int64_t oldest_us) {

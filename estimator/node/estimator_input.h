@@ -20,7 +20,8 @@
 namespace meshnav::estimator {
 
 using EstimatorInput =
-    std::variant<FlightStateSample, ImuSample, BaroSample, RangeSample, AnchorInit, EstimatorCommand, HeightSample>;
+    std::variant<FlightStateSample, ImuSample, BaroSample, RangeSample, AnchorInit, EstimatorCommand, HeightSample,
+                 PeerRange>;
 
 /// Ids of an input that order it among inputs of its kind at equal time (0: none).
 struct InputIds {
@@ -53,6 +54,14 @@ template <> struct InputKind<EstimatorCommand> {
   static InputIds ids(const EstimatorCommand& c) { return {c.id, 0}; }
 };
 template <> struct InputKind<HeightSample> { static constexpr int rank = 6; static constexpr const char* name = "HEIGHT"; static constexpr auto kDataset = &Dataset::heights; };
+/// A fleet's inter-vehicle range with the peer's tag position (pipeline/fleet.h composes it from the
+/// peer's POSE); no channel yet: the fleet runs in one process.
+template <> struct InputKind<PeerRange> {
+  // First at equal time: the receiver's own IMU sample of that instant comes after it (the fleet's
+  // other vehicle is earlier in the merged order), and a later rank would rewind for every range.
+  static constexpr int rank = -1; static constexpr const char* name = "PEER_RANGE"; static constexpr bool kDatasetOnly = true;
+  static InputIds ids(const PeerRange& r) { return {r.range.id_initiator, r.range.id_responder}; }
+};
 
 /// Calls `f.template operator()<T>()` for every input kind T, in the variant's order.
 template <class F>
@@ -106,7 +115,7 @@ inline InputOrder inputOrder(const EstimatorInput& in) {
 /// samples (EstimatorNode holds it until the sample after it has come).
 inline bool isMeasurement(const EstimatorInput& in) {
   return std::holds_alternative<RangeSample>(in) || std::holds_alternative<BaroSample>(in) ||
-         std::holds_alternative<HeightSample>(in);
+         std::holds_alternative<HeightSample>(in) || std::holds_alternative<PeerRange>(in);
 }
 
 /// The IMU sample after input `i` of a sequence in the canonical order (`at(j)` the j-th input,

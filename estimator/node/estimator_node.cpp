@@ -316,6 +316,7 @@ void EstimatorNode::process(const EstimatorInput& in, bool first) {
         if constexpr (std::is_same_v<T, ImuSample>) processImu(m, first);
         if constexpr (std::is_same_v<T, BaroSample>) processBaro(m, first);
         if constexpr (std::is_same_v<T, RangeSample>) processRange(m, first);
+        if constexpr (std::is_same_v<T, PeerRange>) processPeerRange(m, first);
         if constexpr (std::is_same_v<T, HeightSample>) {
           if (init_.carriedHeight())
             event(first, "height_ignored_carried_height");  // the carried height uses the height instance

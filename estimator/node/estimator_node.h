@@ -198,6 +198,9 @@ class EstimatorNode : private RerunReplayer {
   void processImu(const ImuSample& s, bool first);
   void processBaro(const BaroSample& s, bool first);
   void processRange(const RangeSample& s, bool first);
+  /// A fleet's inter-vehicle range (docs/fleet.md "Inter-vehicle ranges"): the peer's tag as an
+  /// exactly known point for this update, its covariance added along the line of sight to R.
+  void processPeerRange(const PeerRange& p, bool first);
   void processHeight(const HeightSample& s, bool first);
   void processZupt(const ImuSample& s, bool first);
   /// Instance statistics, health and the "gated_<type>" counter of a scalar update (baro, height).

@@ -114,6 +114,65 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
   }
 }
 
+void EstimatorNode::processPeerRange(const PeerRange& p, bool first) {
+  if (!sensors_.range.enabled()) return;
+  const SensorId own = p.range.id_initiator == p.peer_tag ? p.range.id_responder : p.range.id_initiator;
+  const bool ends = (p.range.id_initiator == p.peer_tag) != (p.range.id_responder == p.peer_tag);
+  if (!ends || !cur_.network->isTag(own) || cur_.network->isTag(p.peer_tag) || cur_.network->exactAnchor(p.peer_tag) ||
+      !p.p_peer_tag_in_G.allFinite() || !p.cov_peer_tag_m2.allFinite() || p.cov_peer_tag_m2.trace() < 0.0) {
+    event(first, "peer_range_invalid",
+          where("PEER_RANGE", p.t) + ": range " + std::to_string(p.range.id_initiator) + "–" +
+              std::to_string(p.range.id_responder) + " is not between a tag of this vehicle and peer tag " +
+              std::to_string(p.peer_tag) + " with a finite position");
+    return;
+  }
+  // The peer's tag, for this update only, as an exactly known point where its vehicle's estimate
+  // puts it; its uncertainty enters R below. A copy: the network the filter keeps is not touched.
+  UwbNetwork with_peer = *cur_.network;
+  with_peer.setExactAnchor(p.peer_tag, p.p_peer_tag_in_G);
+  // A tag pair of two vehicles is an uncalibrated pair unless setup.yaml lists it: γ 0 with the
+  // uncalibrated pairs' σ_γ in R, as for a tag and an anchor the setup does not list.
+  if (!with_peer.hasPairBias(own, p.peer_tag)) {
+    PairBias b;
+    b.a = own;
+    b.b = p.peer_tag;
+    b.sigma_m = 0.0;  // the range σ from rangeSigma's fallbacks
+    b.sigma_gamma_m = options_.uwb.uncalibratedPairSigma();
+    with_peer.setPairBias(b);
+  }
+  RangeMeasurement z = sensors_.range.measurement(p.range);
+  if (cur_.last_imu) z.omega_IinI_rad_s = cur_.last_imu->gyro_rad_s;
+  if (const std::string why = sensors_.range.refusal(z, *cur_.filter, with_peer); !why.empty()) {
+    event(first, "peer_range_" + why);
+    return;
+  }
+  propagateTo(p.t);
+  ScopedStepTimer timer(timings_, "peer_range_update");
+  std::string why;
+  std::optional<Linearization> lin = sensors_.range.linearize(z, *cur_.filter, with_peer, &why);
+  if (!lin) {
+    event(first, "peer_range_" + why);
+    return;
+  }
+  // z = β‖p_T − p_S‖ + γ + ν with p_S ~ N(p̂_S, Σ_S) independent of this vehicle's state:
+  // ∂z/∂p_S = β uᵀ = −∂z/∂p_IinG, so the point's error adds β² uᵀ Σ_S u = H_p Σ_S H_pᵀ to R.
+  const SensorId imu = cur_.filter->state().imu_id;
+  for (const JacobianBlock& b : lin->blocks)
+    if (b.id == imu) {
+      const Eigen::RowVector3d H_p = b.H.block<1, 3>(0, ImuErr::kP);
+      lin->R(0, 0) += H_p * p.cov_peer_tag_m2 * H_p.transpose();
+    }
+  const UpdateResult r = sensors_.range.update(*cur_.filter, *lin);
+  if (!first) return;
+  diag_.count(r.accepted ? "peer_range_fused" : "peer_range_gated");
+  // A peer range that fits says the pose is right as a tag–anchor range does: without it a
+  // vehicle among its peers but out of the anchors' reach was declared lost and re-initialized
+  // from too few ranges (5 m off, docs/fleet.md).
+  health_.onUpdate(p.t, "range", p.peer_tag, r.accepted, r.nis);
+  InstanceStatus& is = instance_stats_[p.peer_tag];
+  ++(r.accepted ? is.n_updates : is.n_rejected);
+}
+
 void EstimatorNode::applyAnchorInit(const AnchorInit& a, bool first) {
   if (const std::string why = sensors_.anchor_join.apply(a, *cur_.filter, cur_.network, first); !why.empty())
     event(first, "bad_command", where("ANCHOR_INIT", a.t) + ": id " + std::to_string(a.id) + why);

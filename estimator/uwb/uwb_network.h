@@ -38,6 +38,8 @@ class UwbNetwork {
   bool hasPairBias(SensorId a, SensorId b) const { return biases_.count(pairKey(a, b)) > 0; }
   /// Inserts or replaces the pair's bias.
   void setPairBias(const PairBias& b) { biases_[pairKey(b.a, b.b)] = b; }
+  /// Inserts or moves an exactly known anchor (a fleet's peer tag for one update: EstimatorNode::processPeerRange).
+  void setExactAnchor(SensorId id, const Eigen::Vector3d& p_AinG) { exact_anchors_p_AinG_[id] = p_AinG; }
   /// Forgets a tag or an exactly known anchor (its ranges become unknown). False if absent.
   bool removeDevice(SensorId id) { return tags_p_TinI_.erase(id) + exact_anchors_p_AinG_.erase(id) > 0; }
   /// Anchors that came from a calibration (ANCHOR_INIT), until removed.

@@ -65,8 +65,11 @@ void Pipeline::onInput(size_t vehicle, const estimator::EstimatorInput& in) {
       const SystemSetup& mine = vehicles_[vehicle].setup;
       const auto foreign = [&](SensorId id) { return fleet_setup_.isTag(id) && !mine.isTag(id); };
       if (foreign(r->id_initiator) || foreign(r->id_responder)) {
-        // A range to another vehicle's tag: no estimator models it yet, the calibrator needs it not.
+        // A range to another vehicle's tag (the calibrator needs it not).
         diag_.count("inter_vehicle_range:" + vehicles_[vehicle].name);
+        if (!options_.inter_vehicle_ranges) return;
+        routeInterVehicleRange(vehicle, *r);
+        drain();  // the receiver's outputs
         return;
       }
     }
@@ -77,6 +80,57 @@ void Pipeline::onInput(size_t vehicle, const estimator::EstimatorInput& in) {
   }
   if (mission_) mission_->onTime(t);
   drain();
+}
+
+void Pipeline::routeInterVehicleRange(size_t vehicle, const RangeSample& r) {
+  // Each range once: the same exchange may be logged by both vehicles (as the anchors' mesh is).
+  constexpr int64_t kKeepUs = 10'000'000;
+  while (!peer_ranges_.empty() && std::get<0>(*peer_ranges_.begin()) < r.t.us - kKeepUs)
+    peer_ranges_.erase(peer_ranges_.begin());
+  const auto key = pairKey(r.id_initiator, r.id_responder);
+  if (!peer_ranges_.emplace(r.t.us, key.first, key.second).second) {
+    diag_.count("inter_vehicle_range_duplicate");
+    return;
+  }
+  // The two vehicles: whose tag is at each end.
+  auto owner = [&](SensorId id) -> std::optional<size_t> {
+    for (size_t k = 0; k < vehicles_.size(); ++k)
+      if (vehicles_[k].setup.isTag(id)) return k;
+    return std::nullopt;
+  };
+  const auto va = owner(r.id_initiator), vb = owner(r.id_responder);
+  if (!va || !vb || *va == *vb) {
+    diag_.count("inter_vehicle_range_not_between_two_vehicles");
+    return;
+  }
+  const std::optional<PoseEstimate> pa = estimators_[*va]->pose(), pb = estimators_[*vb]->pose();
+  if (!pa && !pb) {
+    diag_.count("inter_vehicle_range_no_estimate");
+    return;
+  }
+  // One of the two learns from the range, with the other's estimate as its anchor (never both:
+  // each would count the other's information as independent of its own, docs/fleet.md): the
+  // vehicle without an estimate yet, else the one with the larger position uncertainty.
+  bool to_a = !pa || (pb && pa->cov_p_m2.trace() > pb->cov_p_m2.trace());
+  const size_t receiver = to_a ? *va : *vb, sender = to_a ? *vb : *va;
+  const PoseEstimate& ps = to_a ? *pb : *pa;
+  const SensorId peer_tag = to_a ? r.id_responder : r.id_initiator;
+  // The sender's tag at the range's time, from its pose (at most one input older): p_S = p_I +
+  // v dt + R l, with δθ local (R = R̂ Exp(δθ)): ∂p_S/∂δθ = −R̂ [l]×; Σ_S = Σ_p + dt² Σ_v + J Σ_θ Jᵀ.
+  const Eigen::Vector3d& l = vehicles_[sender].setup.rel_tag_positions.at(peer_tag);
+  const double dt = (r.t - ps.t).sec();
+  const Eigen::Matrix3d R = ps.q_ItoG.toRotationMatrix();
+  Eigen::Matrix3d l_x;
+  l_x << 0, -l.z(), l.y(), l.z(), 0, -l.x(), -l.y(), l.x(), 0;
+  const Eigen::Matrix3d J = -R * l_x;
+  PeerRange pr;
+  pr.t = r.t;
+  pr.range = r;
+  pr.peer_tag = peer_tag;
+  pr.p_peer_tag_in_G = ps.p_IinG + dt * ps.v_IinG + R * l;
+  pr.cov_peer_tag_m2 = ps.cov_p_m2 + dt * dt * ps.cov_v + J * ps.cov_theta_rad2 * J.transpose();
+  diag_.count("inter_vehicle_range_to:" + vehicles_[receiver].name);
+  estimators_[receiver]->onInput(pr);
 }
 
 bool Pipeline::firstInFleet(const RangeSample& r) {

@@ -38,6 +38,7 @@ struct SimCli {
   double uncertain_sigma_m = 0.0;
   double imu_scale_sigma = 0.0, imu_misalignment_deg = 0.0, vibration = 1.0;
   int fleet = 0;
+  double inter_vehicle_hz = 0.0;
   bool no_initial_pose = false, uncertain_known = false;
 };
 
@@ -56,6 +57,12 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
                "--out/fleet.yaml for 'meshnav run --fleet' (docs/fleet.md)")
       ->type_name("N")
       ->check(CLI::Range(1, 16));
+  cli.option("inter-vehicle-hz", c.inter_vehicle_hz,
+             "with --fleet: every pair of vehicles also ranges tag to tag at this rate, one tag pair per exchange, "
+             "into the first vehicle's ranges.csv (type T at both ends; docs/fleet.md); 0 = none [Hz]")
+      ->type_name("F")
+      ->check(CLI::Range(0.0, 100.0))
+      ->needs("--fleet");
   cli.optional("trajectory", c.trajectory,
                "spiral|figure8|lawnmower|helix|hover|walk (default spiral: the paper's flight). hover starts in the "
                "air; walk is a hand-held rig at 0.9-1.5 m with no take-off, no landed state and no barometer "
@@ -204,8 +211,8 @@ void applyScenarioOptions(const meshnav::Cli& cli, SimCli& c) {
 }
 
 /// --fleet N: the datasets out/v0 ... and out/fleet.yaml.
-int simulateFleet(const meshnav::sim::SimulationOptions& options, int n, const std::string& out) {
-  const auto fleet = meshnav::sim::simulateFleet(options, n);
+int simulateFleet(const meshnav::sim::SimulationOptions& options, int n, double inter_vehicle_hz, const std::string& out) {
+  const auto fleet = meshnav::sim::simulateFleet(options, n, inter_vehicle_hz);
   std::filesystem::create_directories(out);
   std::string list;
   for (size_t k = 0; k < fleet.size(); ++k) {
@@ -236,7 +243,7 @@ int simulate(const meshnav::Cli& cli, SimCli& c) {
   }
   const auto& options = c.sim;
   spdlog::info("simulating: {}", options.toString());
-  if (cli.given("fleet")) return simulateFleet(options, c.fleet, c.out);
+  if (cli.given("fleet")) return simulateFleet(options, c.fleet, c.inter_vehicle_hz, c.out);
   const meshnav::sim::ScenarioSimulator simulator(options);
   meshnav::sim::SimulationResult result = simulator.run();
   if (cli.given("uncertain-anchors")) {

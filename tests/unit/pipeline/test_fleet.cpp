@@ -302,7 +302,9 @@ TEST(FleetPipeline, OneCalibrationFromBothVehiclesReachesBothEstimators) {
   EXPECT_EQ(alone.pipeline_counters.count("mesh_range_from_another_vehicle"), 0u);
 }
 
-TEST(FleetPipeline, ARangeToAnotherVehiclesTagIsCountedAndGoesNowhere) {
+// A range between two vehicles' tags is counted per vehicle whose data carries it; logged by both
+// it is used once (the second is a duplicate); with no estimate on either side it goes nowhere.
+TEST(FleetPipeline, ARangeToAnotherVehiclesTagIsCountedAndUsedOnce) {
   std::vector<Vehicle> v = {{"a", vehicleSetup({{10, {0, 0, 0}}})}, {"b", vehicleSetup({{20, {0, 0, 0}}})}};
   const SystemSetup fleet = mergeFleetSetups(v, "test");
   Pipeline pipe(PipelineOptions{}, v, fleet);
@@ -316,6 +318,8 @@ TEST(FleetPipeline, ARangeToAnotherVehiclesTagIsCountedAndGoesNowhere) {
   pipe.onInput(1, r);
   EXPECT_EQ(pipe.diagnostics().get("inter_vehicle_range:a"), 1);
   EXPECT_EQ(pipe.diagnostics().get("inter_vehicle_range:b"), 1);
+  EXPECT_EQ(pipe.diagnostics().get("inter_vehicle_range_duplicate"), 1);
+  EXPECT_EQ(pipe.diagnostics().get("inter_vehicle_range_no_estimate"), 1);
   EXPECT_EQ(pipe.calibrator()->diagnostics().get("ranges_received"), 0);
   EXPECT_THROW(pipe.onInput(2, r), std::out_of_range);
   EXPECT_THROW(Pipeline(PipelineOptions{}, std::vector<Vehicle>{}, fleet), std::invalid_argument);
