@@ -156,3 +156,8 @@ TEST(ControllerOptions, RefusesUnknownKeysAndBadValues) {
   EXPECT_THROW(ControllerOptions::fromYaml(YAML::Load("max_tilt_deg: 95"), "c.yaml"), std::runtime_error);
   EXPECT_NE(ControllerOptions{}.toString().find("pose_timeout_s"), std::string::npos);
 }
+
+TEST(ControllerOptions, ShippedFileHoldsTheDefaults) {
+  const ControllerOptions shipped = ControllerOptions::load(MESHNAV_SOURCE_DIR "/config/controller.yaml");
+  EXPECT_EQ(shipped.toString(), ControllerOptions{}.toString());
+}
