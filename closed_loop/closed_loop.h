@@ -96,7 +96,8 @@ struct ClosedLoopResult {
 
 class ClosedLoop {
  public:
-  /// Throws std::invalid_argument when the mission has no `flight`.
+  /// Throws std::invalid_argument when the mission has no `flight`, or a waypoint, the pad or the
+  /// take-off height lies outside the vehicle's hall (the file, line and key in the message).
   explicit ClosedLoop(ClosedLoopOptions options);
   ClosedLoopResult run();
 

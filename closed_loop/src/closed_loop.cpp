@@ -33,6 +33,20 @@ ClosedLoop::ClosedLoop(ClosedLoopOptions options) : options_(std::move(options))
   if (!options_.mission.flight)
     throw std::invalid_argument(options_.mission.source + ": the mission has no 'flight' (waypoints) to fly");
   const auto& f = *options_.mission.flight;
+  // Every point of the plan inside the hall: a waypoint in a wall is a crash, not a flight.
+  const sim::QuadrotorOptions& dyn = options_.vehicle.dynamics;
+  const auto inside = [&](const Eigen::Vector3d& p) {
+    return (p - dyn.hall_min_m).minCoeff() > 0.0 && (dyn.hall_max_m - p).minCoeff() > 0.0;
+  };
+  const auto where = [&](int line) {
+    return options_.mission.source + (line > 0 ? ":" + std::to_string(line) : std::string());
+  };
+  if (!inside(Eigen::Vector3d(f.pad_xy_m.x(), f.pad_xy_m.y(), f.takeoff_height_m)))
+    throw std::invalid_argument(where(0) + ": key 'flight.pad' / 'flight.takeoff_height' is outside the hall");
+  for (size_t i = 0; i < f.waypoints.size(); ++i)
+    if (!inside(f.waypoints[i].p_IinG))
+      throw std::invalid_argument(where(f.waypoints[i].line) + ": key 'flight.waypoints[" + std::to_string(i) +
+                                  "].p' is outside the hall");
   options_.vehicle.pad_p_m = Eigen::Vector3d(f.pad_xy_m.x(), f.pad_xy_m.y(), 0.0);
   options_.vehicle.pad_yaw_rad = f.pad_yaw_deg * std::numbers::pi / 180.0;
 }

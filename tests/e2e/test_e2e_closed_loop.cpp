@@ -66,6 +66,44 @@ TEST(ClosedLoopE2E, ShortMissionLandsOnThePadWithinTargets) {
   EXPECT_EQ(again.samples.back().p_true, r.samples.back().p_true);
 }
 
+// The shipped paper-like mission (config/missions/paper_like_closed_loop.yaml) on seed 1 against
+// the targets; the anchors' bounds are the replayed S2 flights' means + 0.05 m
+// (docs/closed_loop.md): 0.108 + 0.05 initial, 0.061 + 0.05 final.
+TEST(ClosedLoopE2E, ShippedPaperLikeMissionMeetsTheTargets) {
+  closed_loop::ClosedLoopOptions o;
+  o.mission = mission::loadMission(MESHNAV_SOURCE_DIR "/config/missions/paper_like_closed_loop.yaml");
+  o.vehicle.sensors.seed = 1;
+  const closed_loop::ClosedLoopResult r = closed_loop::ClosedLoop(o).run();
+  const auto& m = r.metrics;
+  EXPECT_FALSE(m.crashed) << m.crash_reason;
+  EXPECT_TRUE(m.mission_complete);
+  EXPECT_LE(m.tracking_rmse_m, 0.25);
+  EXPECT_LE(m.estimation_rmse_m, 0.15);
+  EXPECT_GE(m.landed_within_m, 0.0);
+  EXPECT_LE(m.landed_within_m, 0.3);
+  EXPECT_EQ(m.failsafe_events, 0);
+  ASSERT_EQ(m.anchors.size(), 5u);  // 106-110, all calibrated fly-by
+  EXPECT_LE(m.anchors_initial_mean_m, 0.158);
+  EXPECT_LE(m.anchors_final_mean_m, 0.111);
+  EXPECT_GT(m.flight_time_s, 120.0);
+}
+
+TEST(ClosedLoopE2E, RefusesAPlanOutsideTheHall) {
+  closed_loop::ClosedLoopOptions o = shortMission(1);
+  o.mission.flight->waypoints[2].p_IinG.x() = 3.5;  // beyond the wall at x = 3.0 m
+  o.mission.flight->waypoints[2].line = 12;
+  try {
+    closed_loop::ClosedLoop loop(o);
+    ADD_FAILURE() << "accepted a waypoint in the wall";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("short_mission:12: key 'flight.waypoints[2].p'"), std::string::npos)
+        << e.what();
+  }
+  o = shortMission(1);
+  o.mission.flight.reset();
+  EXPECT_THROW(closed_loop::ClosedLoop{o}, std::invalid_argument);
+}
+
 TEST(ClosedLoopE2E, PoseOutageDrillLandsSoftlyByFailsafe) {
   closed_loop::ClosedLoopOptions o = shortMission(2);
   o.pose_outages_s = {{25.0, 1e9}};  // POSE never reaches the controller again from 25 s
