@@ -13,10 +13,12 @@
 /// `remove` (one ESTIMATOR_CMD RemoveInstance per listed id; `anchors` required).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/types.h"
+#include "mission/flight_plan.h"
 
 namespace meshnav::mission {
 
@@ -38,6 +40,8 @@ struct Mission {
   std::string source;               ///< file it came from (for messages)
   bool collect_at_start = true;     ///< CALIB_CMD Collect (all) at the first sample
   std::vector<MissionStep> steps;   ///< sorted by t (stable: equal times keep file order)
+  /// The flight a closed loop flies (key `flight`, flight_plan.h); nullopt for a replayed dataset.
+  std::optional<FlightPlan> flight;
 };
 
 /// Loads a mission file. Throws std::runtime_error naming the file, the line and the key

@@ -30,12 +30,21 @@ std::vector<BaroSample> BaroSimulator::simulate(const Trajectory& trajectory, do
   out.reserve(static_cast<size_t>(n));
   for (int64_t k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) * dt;
-    BaroSample s;
-    s.t = Timestamp::fromSec(t);
-    s.pressure_pa = idealPressure(trajectory.evaluate(t)) + rng.gaussian(options_.pressure_sigma_pa);
-    out.push_back(s);
+    out.push_back(draw(trajectory.evaluate(t), rng));
   }
   return out;
+}
+
+BaroSample BaroSimulator::draw(const TrajectoryState& state, RandomStream& rng) const {
+  BaroSample s;
+  s.t = Timestamp::fromSec(state.t_s);
+  s.pressure_pa = idealPressure(state) + rng.gaussian(options_.pressure_sigma_pa);
+  return s;
+}
+
+BaroSample BaroSimulator::sample(const TrajectoryState& state) {
+  if (!rng_) rng_.emplace(RandomStream::deriveSeed(seed_, "baro_noise"));
+  return draw(state, *rng_);
 }
 
 }  // namespace meshnav::sim

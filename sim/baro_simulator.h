@@ -7,10 +7,12 @@
 /// level z = 0 (seeded around 97000 Pa, i.e. a site ~400 m above sea level).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/types.h"
+#include "sim/random_stream.h"
 #include "sim/trajectory.h"
 
 namespace meshnav::sim {
@@ -30,10 +32,18 @@ class BaroSimulator {
   double idealPressure(const TrajectoryState& state) const;
   /// Readings at t_k = k/rate for t_k ∈ [0, t_end_s].
   std::vector<BaroSample> simulate(const Trajectory& trajectory, double t_end_s) const;
+  /// Step-wise sampling (a closed-loop vehicle): the next reading for the exact state at its time,
+  /// drawn from the same stream in the same order as `simulate` (the caller keeps the 1/rate grid).
+  BaroSample sample(const TrajectoryState& state);
+  const BaroOptions& options() const { return options_; }
 
  private:
+  /// The reading for `state` with one draw of `rng`.
+  BaroSample draw(const TrajectoryState& state, RandomStream& rng) const;
+
   BaroOptions options_;
   uint64_t seed_;
+  std::optional<RandomStream> rng_;  ///< step-wise stream (sample)
 };
 
 }  // namespace meshnav::sim

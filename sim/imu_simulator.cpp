@@ -5,7 +5,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "sim/random_stream.h"
 
 namespace meshnav::sim {
 
@@ -66,17 +65,12 @@ ImuSample ImuSimulator::ideal(const TrajectoryState& st) {
   return s;
 }
 
-std::vector<ImuSample> ImuSimulator::simulate(const Trajectory& trajectory, double t_end_s) {
-  RandomStream rng_noise(RandomStream::deriveSeed(seed_, "imu_noise"));
-  RandomStream rng_bias(RandomStream::deriveSeed(seed_, "imu_bias"));
-  const double dt = 1.0 / options_.rate_hz;
-  const double sigma_acc_d = options_.acc_noise_density / std::sqrt(dt);
-  const double sigma_gyro_d = options_.gyro_noise_density / std::sqrt(dt);
-  const double sigma_acc_w = options_.acc_bias_rw * std::sqrt(dt);
-  const double sigma_gyro_w = options_.gyro_bias_rw * std::sqrt(dt);
-
-  bias_acc_ = rng_bias.gaussian3(options_.acc_bias_initial_sigma);
-  bias_gyro_ = rng_bias.gaussian3(options_.gyro_bias_initial_sigma);
+void ImuSimulator::start(bool rotorcraft) {
+  rng_noise_.emplace(RandomStream::deriveSeed(seed_, "imu_noise"));
+  rng_bias_.emplace(RandomStream::deriveSeed(seed_, "imu_bias"));
+  n_sampled_ = 0;
+  bias_acc_ = rng_bias_->gaussian3(options_.acc_bias_initial_sigma);
+  bias_gyro_ = rng_bias_->gaussian3(options_.gyro_bias_initial_sigma);
   bias_acc0_ = bias_acc_;
   bias_gyro0_ = bias_gyro_;
   // The axes from a stream of their own: exact axes leave every other draw as it was.
@@ -90,48 +84,64 @@ std::vector<ImuSample> ImuSimulator::simulate(const Trajectory& trajectory, doub
   }
 
   // Rotor vibration: tones, amplitudes and phases from a stream of their own.
-  const bool rotorcraft = !trajectory.isHandCarried() &&
-                          (options_.vibration_acc_m_s2 > 0.0 || options_.vibration_gyro_rad_s > 0.0);
-  std::array<double, 2> rotor_hz{0.0, 0.0};
-  Eigen::Matrix<double, 3, 2> phase_acc = Eigen::Matrix<double, 3, 2>::Zero(), phase_gyro = phase_acc;
-  Eigen::Vector3d amp_acc = Eigen::Vector3d::Zero(), amp_gyro = Eigen::Vector3d::Zero();
-  if (rotorcraft) {
+  rotorcraft_ = rotorcraft && (options_.vibration_acc_m_s2 > 0.0 || options_.vibration_gyro_rad_s > 0.0);
+  rotor_hz_ = {0.0, 0.0};
+  phase_acc_.setZero();
+  phase_gyro_.setZero();
+  amp_acc_.setZero();
+  amp_gyro_.setZero();
+  if (rotorcraft_) {
     RandomStream rng_vib(RandomStream::deriveSeed(seed_, "imu_vibration"));
-    for (double& f : rotor_hz) f = rng_vib.uniform(options_.rotor_min_hz, options_.rotor_max_hz);
+    for (double& f : rotor_hz_) f = rng_vib.uniform(options_.rotor_min_hz, options_.rotor_max_hz);
     for (int i = 0; i < 3; ++i) {
-      amp_acc(i) = rng_vib.uniform(0.5, 1.5) * options_.vibration_acc_m_s2;
-      amp_gyro(i) = rng_vib.uniform(0.5, 1.5) * options_.vibration_gyro_rad_s;
+      amp_acc_(i) = rng_vib.uniform(0.5, 1.5) * options_.vibration_acc_m_s2;
+      amp_gyro_(i) = rng_vib.uniform(0.5, 1.5) * options_.vibration_gyro_rad_s;
       for (int j = 0; j < 2; ++j) {
-        phase_acc(i, j) = rng_vib.uniform(0.0, 2.0 * M_PI);
-        phase_gyro(i, j) = rng_vib.uniform(0.0, 2.0 * M_PI);
+        phase_acc_(i, j) = rng_vib.uniform(0.0, 2.0 * M_PI);
+        phase_gyro_(i, j) = rng_vib.uniform(0.0, 2.0 * M_PI);
       }
     }
   }
+}
+
+ImuSample ImuSimulator::sample(const TrajectoryState& state, bool airborne) {
+  if (!rng_noise_) start(true);
+  const double dt = 1.0 / options_.rate_hz;
+  const double sigma_acc_d = options_.acc_noise_density / std::sqrt(dt);
+  const double sigma_gyro_d = options_.gyro_noise_density / std::sqrt(dt);
+  const double sigma_acc_w = options_.acc_bias_rw * std::sqrt(dt);
+  const double sigma_gyro_w = options_.gyro_bias_rw * std::sqrt(dt);
   const auto vibration = [&](double t, const Eigen::Vector3d& amp, const Eigen::Matrix<double, 3, 2>& phase) {
     Eigen::Vector3d v;
     for (int i = 0; i < 3; ++i)
-      v(i) = amp(i) * (std::sin(2.0 * M_PI * rotor_hz[0] * t + phase(i, 0)) +
-                       std::sin(2.0 * M_PI * rotor_hz[1] * t + phase(i, 1))) / std::sqrt(2.0);
+      v(i) = amp(i) * (std::sin(2.0 * M_PI * rotor_hz_[0] * t + phase(i, 0)) +
+                       std::sin(2.0 * M_PI * rotor_hz_[1] * t + phase(i, 1))) / std::sqrt(2.0);
     return v;
   };
+  if (n_sampled_ > 0) {
+    bias_acc_ += rng_bias_->gaussian3(sigma_acc_w);
+    bias_gyro_ += rng_bias_->gaussian3(sigma_gyro_w);
+  }
+  ++n_sampled_;
+  ImuSample s = ideal(state);
+  s.acc_m_s2 = acc_T_ * s.acc_m_s2 + bias_acc_ + rng_noise_->gaussian3(sigma_acc_d);
+  s.gyro_rad_s = gyro_T_ * s.gyro_rad_s + bias_gyro_ + rng_noise_->gaussian3(sigma_gyro_d);
+  if (rotorcraft_ && airborne) {
+    s.acc_m_s2 += vibration(state.t_s, amp_acc_, phase_acc_);
+    s.gyro_rad_s += vibration(state.t_s, amp_gyro_, phase_gyro_);
+  }
+  return s;
+}
 
+std::vector<ImuSample> ImuSimulator::simulate(const Trajectory& trajectory, double t_end_s) {
+  start(!trajectory.isHandCarried());
+  const double dt = 1.0 / options_.rate_hz;
   std::vector<ImuSample> out;
   const auto n = static_cast<int64_t>(std::floor(t_end_s / dt + 1e-9)) + 1;
   out.reserve(static_cast<size_t>(n));
   for (int64_t k = 0; k < n; ++k) {
-    if (k > 0) {
-      bias_acc_ += rng_bias.gaussian3(sigma_acc_w);
-      bias_gyro_ += rng_bias.gaussian3(sigma_gyro_w);
-    }
     const double t = static_cast<double>(k) * dt;
-    ImuSample s = ideal(trajectory.evaluate(t));
-    s.acc_m_s2 = acc_T_ * s.acc_m_s2 + bias_acc_ + rng_noise.gaussian3(sigma_acc_d);
-    s.gyro_rad_s = gyro_T_ * s.gyro_rad_s + bias_gyro_ + rng_noise.gaussian3(sigma_gyro_d);
-    if (rotorcraft && !trajectory.isLanded(t)) {
-      s.acc_m_s2 += vibration(t, amp_acc, phase_acc);
-      s.gyro_rad_s += vibration(t, amp_gyro, phase_gyro);
-    }
-    out.push_back(s);
+    out.push_back(sample(trajectory.evaluate(t), !trajectory.isLanded(t)));
   }
   return out;
 }

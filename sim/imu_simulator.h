@@ -22,11 +22,14 @@
 /// detector's thresholds scale with them). Off (0) in noiseless(); its draws come from a stream
 /// of their own, so every other draw is the same with or without it.
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/types.h"
+#include "sim/random_stream.h"
 #include "sim/trajectory.h"
 
 namespace meshnav::sim {
@@ -72,8 +75,18 @@ class ImuSimulator {
   /// The ideal (noise-free, bias-free) reading for one state: f_I = Rᵀ(a − g), ω_I.
   static ImuSample ideal(const TrajectoryState& state);
 
-  /// Readings at t_k = k/rate for t_k ∈ [0, t_end_s].
+  /// Readings at t_k = k/rate for t_k ∈ [0, t_end_s] (`start` then `sample` per t_k).
   std::vector<ImuSample> simulate(const Trajectory& trajectory, double t_end_s);
+
+  /// Step-wise sampling (a closed-loop vehicle, sim/closed_loop_vehicle.h): draws the initial
+  /// biases, the axes and the rotor tones exactly as `simulate` does. `rotorcraft`: the vehicle's
+  /// rotors shake the IMU while airborne (false: a hand-carried rig).
+  void start(bool rotorcraft);
+  /// The next reading, for the exact state at its time (the caller keeps the 1/rate grid): the bias
+  /// random-walk step (not before the first sample) and the noise, plus the rotor vibration while
+  /// `airborne`. The same draws in the same order as `simulate`: a trajectory sampled this way
+  /// gives `simulate`'s readings bit for bit. Calls `start(true)` first if it was not called.
+  ImuSample sample(const TrajectoryState& state, bool airborne);
 
   /// Bias at the first sample (after `simulate`) [m/s², rad/s].
   const Eigen::Vector3d& initialAccBias() const { return bias_acc0_; }
@@ -92,6 +105,13 @@ class ImuSimulator {
   Eigen::Vector3d bias_acc0_ = Eigen::Vector3d::Zero(), bias_gyro0_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d bias_acc_ = Eigen::Vector3d::Zero(), bias_gyro_ = Eigen::Vector3d::Zero();
   Eigen::Matrix3d acc_T_ = Eigen::Matrix3d::Identity(), gyro_T_ = Eigen::Matrix3d::Identity();
+  // Step-wise state (start / sample).
+  std::optional<RandomStream> rng_noise_, rng_bias_;
+  int64_t n_sampled_ = 0;
+  bool rotorcraft_ = false;
+  std::array<double, 2> rotor_hz_{0.0, 0.0};
+  Eigen::Matrix<double, 3, 2> phase_acc_ = Eigen::Matrix<double, 3, 2>::Zero(), phase_gyro_ = phase_acc_;
+  Eigen::Vector3d amp_acc_ = Eigen::Vector3d::Zero(), amp_gyro_ = Eigen::Vector3d::Zero();
 };
 
 }  // namespace meshnav::sim

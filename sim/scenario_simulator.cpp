@@ -49,6 +49,8 @@ struct RunFacts {
   BaroOptions baro;
 };
 
+}  // namespace
+
 /// setup.yaml: what a user knows.
 SystemSetup makeSetup(const SimulationOptions& o, const PaperScenario& scenario, const Trajectory& trajectory,
                       const UwbHardwareBiases& biases, const BaroOptions& baro_options) {
@@ -100,6 +102,8 @@ SystemSetup makeSetup(const SimulationOptions& o, const PaperScenario& scenario,
   if (o.uwb.time_offset_s == 0.0) setup.uwb_clock.sigma_s = 0.0;
   return setup;
 }
+
+namespace {
 
 /// The generator's choices, recorded only for scenarios other than the paper's (whose
 /// truth.yaml stays as it always was).

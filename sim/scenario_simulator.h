@@ -6,11 +6,23 @@
 
 #include <optional>
 
+#include "common/setup.h"
+#include "sim/baro_simulator.h"
 #include "sim/paper_scenario.h"
 #include "sim/simulation_options.h"
 #include "sim/simulation_result.h"
 
 namespace meshnav::sim {
+
+class Trajectory;
+class UwbHardwareBiases;
+
+/// setup.yaml of a sequence: what a user knows (ids, tags' lever arms, the known anchors and the
+/// a-priori pair biases among tags and known anchors, baro lever arm, the pad prior drawn around
+/// the trajectory's pose at 0, the noise figures). Also the closed-loop vehicle's
+/// (sim/simulated_vehicle.h), with a trajectory that rests on its pad.
+SystemSetup makeSetup(const SimulationOptions& o, const PaperScenario& scenario, const Trajectory& trajectory,
+                      const UwbHardwareBiases& biases, const BaroOptions& baro_options);
 
 class ScenarioSimulator {
  public:

@@ -27,10 +27,14 @@ TdmaSlot TdmaSchedule::slot(int64_t s) const {
   return out;
 }
 
+int64_t TdmaSchedule::slotCountUntil(double t_end_s) const {
+  if (t_end_s < t0_s_) return 0;
+  return static_cast<int64_t>(std::floor((t_end_s - t0_s_) / slot_s_ + 1e-9)) + 1;
+}
+
 std::vector<TdmaSlot> TdmaSchedule::slotsUntil(double t_end_s) const {
   std::vector<TdmaSlot> out;
-  if (t_end_s < t0_s_) return out;
-  const auto n = static_cast<int64_t>(std::floor((t_end_s - t0_s_) / slot_s_ + 1e-9)) + 1;
+  const int64_t n = slotCountUntil(t_end_s);
   out.reserve(static_cast<size_t>(n));
   for (int64_t s = 0; s < n; ++s) out.push_back(slot(s));
   return out;

@@ -32,6 +32,8 @@ class TdmaSchedule {
   const std::vector<SensorId>& devices() const { return ids_; }
   /// The slot with global index `s` (s ≥ 0).
   TdmaSlot slot(int64_t s) const;
+  /// Number of slots with t₀ ≤ t(s) ≤ t_end_s (with 1e-9 slots of tolerance on the last).
+  int64_t slotCountUntil(double t_end_s) const;
   /// Every slot with t₀ ≤ t(s) ≤ t_end_s, in time order.
   std::vector<TdmaSlot> slotsUntil(double t_end_s) const;
 

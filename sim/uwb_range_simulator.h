@@ -20,12 +20,15 @@
 /// where the flag carries no information; outliers are marked only in `SimulatedRange`).
 
 #include <cstdint>
+#include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/types.h"
 #include "sim/paper_scenario.h"
+#include "sim/random_stream.h"
 #include "sim/trajectory.h"
 #include "sim/tdma_schedule.h"
 #include "sim/uwb_hardware_biases.h"
@@ -64,12 +67,26 @@ class UwbRangeSimulator {
   std::vector<SimulatedRange> simulate(const Trajectory& trajectory, const TdmaSchedule& schedule,
                                        double t_end_s);
 
+  /// The vehicle's exact state at a slot time (a closed loop's vehicle interpolates its steps).
+  using StateAt = std::function<TrajectoryState(double t_s)>;
+  /// Step-wise sampling (a closed-loop vehicle): the ranges of the slots of `schedule` after the
+  /// last one taken so far up to `t_end_s`, with the same draws in the same order as `simulate`
+  /// (which is `reset` + one call of this over the whole trajectory). Counters accumulate.
+  std::vector<SimulatedRange> simulateUntil(const StateAt& state_at, const TdmaSchedule& schedule, double t_end_s);
+  /// Forgets the step-wise progress: the next `simulateUntil` starts at slot 0 with a fresh stream.
+  void reset();
+
   int64_t slotCount() const { return n_slots_; }
   int64_t droppedCount() const { return n_dropped_; }
   int64_t outlierCount() const { return n_outliers_; }
 
  private:
+  /// One slot: its fixed draws from `rng`, then the range (nullopt: dropped, or stamped before 0).
+  std::optional<SimulatedRange> drawSlot(const TdmaSlot& slot, const StateAt& state_at, RandomStream& rng);
+
   std::map<std::pair<SensorId, SensorId>, std::pair<double, double>> pair_error_;  ///< pair → (t [s], e)
+  std::optional<RandomStream> rng_;  ///< step-wise stream
+  int64_t next_slot_ = 0;            ///< step-wise: first slot not taken yet
   PaperScenario scenario_;
   const UwbHardwareBiases& biases_;
   UwbRangeOptions options_;

@@ -2,6 +2,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -110,15 +112,102 @@ MissionStep parseStep(const YAML::Node& n, size_t i, const std::string& source) 
   return s;
 }
 
+/// A number at `n` (finite), refused with file, line and key otherwise.
+double number(const YAML::Node& n, const std::string& key, const std::string& source) {
+  double v = 0.0;
+  try {
+    v = n.as<double>();
+  } catch (const std::exception&) {
+    fail(at(source, n), key, "must be a number, got '" + (n.IsScalar() ? n.Scalar() : "?") + "'");
+  }
+  if (!std::isfinite(v)) fail(at(source, n), key, "must be finite, got " + n.Scalar());
+  return v;
+}
+
+/// A list of `size` numbers at `n`.
+Eigen::VectorXd numbers(const YAML::Node& n, size_t size, const std::string& key, const std::string& source) {
+  if (!n.IsSequence() || n.size() != size)
+    fail(at(source, n), key, "must be a list of " + std::to_string(size) + " numbers");
+  Eigen::VectorXd v(static_cast<Eigen::Index>(size));
+  for (size_t i = 0; i < size; ++i)
+    v(static_cast<Eigen::Index>(i)) = number(n[i], key + "[" + std::to_string(i) + "]", source);
+  return v;
+}
+
+/// Refuses a key of map `n` that is not in `known` (file, line, key).
+void onlyKeys(const YAML::Node& n, const std::vector<std::string>& known, const std::string& key,
+              const std::string& source) {
+  std::string list;
+  for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+  for (const auto& kv : n) {
+    const auto k = keyText(kv.first, source, key);
+    if (std::find(known.begin(), known.end(), k) == known.end())
+      throw std::runtime_error(at(source, kv.first) + ": unknown key '" + key + "." + k + "' (expected " + list + ")");
+  }
+}
+
+FlightPlan parseFlight(const YAML::Node& n, const std::string& source) {
+  if (!n.IsMap()) fail(at(source, n), "flight", "must be a map (pad, takeoff_at, ..., waypoints)");
+  onlyKeys(n,
+           {"pad", "pad_yaw_deg", "takeoff_at", "takeoff_height", "speed", "vertical_speed", "acceleration",
+            "yaw_rate_deg", "waypoints"},
+           "flight", source);
+  FlightPlan f;
+  if (const YAML::Node p = n["pad"]) f.pad_xy_m = numbers(p, 2, "flight.pad", source);
+  struct Scalar {
+    const char* key;
+    double* field;
+    double min;  ///< values must be above (strictly, except for angles and times)
+    bool strict;
+  };
+  const Scalar scalars[] = {{"pad_yaw_deg", &f.pad_yaw_deg, -1e9, false},
+                            {"takeoff_at", &f.takeoff_at_s, 0.0, false},
+                            {"takeoff_height", &f.takeoff_height_m, 0.0, true},
+                            {"speed", &f.speed_m_s, 0.0, true},
+                            {"vertical_speed", &f.vertical_speed_m_s, 0.0, true},
+                            {"acceleration", &f.acceleration_m_s2, 0.0, true},
+                            {"yaw_rate_deg", &f.yaw_rate_deg_s, 0.0, true}};
+  for (const Scalar& sc : scalars) {
+    const YAML::Node v = n[sc.key];
+    if (!v) continue;
+    *sc.field = number(v, std::string("flight.") + sc.key, source);
+    if (sc.strict ? !(*sc.field > sc.min) : !(*sc.field >= sc.min))
+      fail(at(source, v), std::string("flight.") + sc.key, std::string("must be ") + (sc.strict ? "> " : ">= ") +
+                                                             std::to_string(sc.min) + ", got " + v.Scalar());
+  }
+  const YAML::Node wps = n["waypoints"];
+  if (!wps || !wps.IsSequence() || wps.size() == 0)
+    fail(at(source, wps ? wps : n), "flight.waypoints", "must be a non-empty list of {p: [x, y, z], yaw_deg, hold}");
+  for (size_t i = 0; i < wps.size(); ++i) {
+    const std::string key = "flight.waypoints[" + std::to_string(i) + "]";
+    const YAML::Node w = wps[i];
+    if (!w.IsMap()) fail(at(source, w), key, "must be a map {p: [x, y, z], yaw_deg, hold}");
+    onlyKeys(w, {"p", "yaw_deg", "hold"}, key, source);
+    Waypoint wp;
+    wp.line = w.Mark().line + 1;
+    if (!w["p"]) fail(at(source, w), key + ".p", "is missing ([x, y, z] in G [m])");
+    wp.p_IinG = numbers(w["p"], 3, key + ".p", source);
+    if (const YAML::Node y = w["yaw_deg"]) wp.yaw_deg = number(y, key + ".yaw_deg", source);
+    if (const YAML::Node h = w["hold"]) {
+      wp.hold_s = number(h, key + ".hold", source);
+      if (wp.hold_s < 0.0) fail(at(source, h), key + ".hold", "must be >= 0 s");
+    }
+    f.waypoints.push_back(wp);
+  }
+  return f;
+}
+
 Mission parseRoot(const YAML::Node& root, const std::string& source) {
   Mission m;
   m.source = source;
   if (!root.IsMap()) throw std::runtime_error(source + ": expected a map with the key 'steps'");
   for (const auto& kv : root) {
     const auto k = keyText(kv.first, source, "the mission");
-    if (k != "steps" && k != "collect_at_start")
-      throw std::runtime_error(at(source, kv.first) + ": unknown key '" + k + "' (expected steps, collect_at_start)");
+    if (k != "steps" && k != "collect_at_start" && k != "flight")
+      throw std::runtime_error(at(source, kv.first) + ": unknown key '" + k +
+                               "' (expected steps, collect_at_start, flight)");
   }
+  if (const YAML::Node f = root["flight"]) m.flight = parseFlight(f, source);
   if (const YAML::Node c = root["collect_at_start"]) {
     try {
       m.collect_at_start = c.as<bool>();

@@ -113,3 +113,31 @@ TEST(Mission, LoadNamesTheFile) {
     EXPECT_NE(std::string(e.what()).find("missing.yaml: cannot open"), std::string::npos) << e.what();
   }
 }
+
+// The closed loop's flight plan (key `flight`, mission/flight_plan.h).
+TEST(FlightPlanFile, ParsesAndRefusesWithFileLineAndKey) {
+  const auto m = parseMission(
+      "steps: []\nflight:\n  pad: [1, 2]\n  speed: 0.4\n  waypoints:\n    - {p: [1, 2, 3], yaw_deg: 10, hold: 2}\n",
+      "m.yaml");
+  ASSERT_TRUE(m.flight.has_value());
+  EXPECT_EQ(m.flight->pad_xy_m, Eigen::Vector2d(1, 2));
+  EXPECT_DOUBLE_EQ(m.flight->speed_m_s, 0.4);
+  ASSERT_EQ(m.flight->waypoints.size(), 1u);
+  EXPECT_EQ(m.flight->waypoints[0].p_IinG, Eigen::Vector3d(1, 2, 3));
+  EXPECT_DOUBLE_EQ(m.flight->waypoints[0].hold_s, 2.0);
+  const auto refused = [](const std::string& text, const std::string& what) {
+    try {
+      parseMission(text, "m.yaml");
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("m.yaml:"), std::string::npos) << e.what();
+      return;
+    }
+    ADD_FAILURE() << "accepted: " << text;
+  };
+  refused("steps: []\nflight:\n  sped: 1\n  waypoints: [{p: [1, 2, 3]}]\n", "flight.sped");
+  refused("steps: []\nflight:\n  speed: -1\n  waypoints: [{p: [1, 2, 3]}]\n", "flight.speed");
+  refused("steps: []\nflight:\n  waypoints: [{p: [1, 2]}]\n", "flight.waypoints[0].p");
+  refused("steps: []\nflight:\n  waypoints: []\n", "flight.waypoints");
+  refused("steps: []\nflight:\n  waypoints: [{p: [1, 2, .nan]}]\n", "flight.waypoints[0].p[2]");
+}
