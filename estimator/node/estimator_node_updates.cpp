@@ -118,12 +118,14 @@ void EstimatorNode::processPeerRange(const PeerRange& p, bool first) {
   if (!sensors_.range.enabled()) return;
   const SensorId own = p.range.id_initiator == p.peer_tag ? p.range.id_responder : p.range.id_initiator;
   const bool ends = (p.range.id_initiator == p.peer_tag) != (p.range.id_responder == p.peer_tag);
+  // (Its values were checked by the input gate: input_gate.cpp.) The ends: one of this vehicle's
+  // tags and a device this vehicle does not know otherwise.
   if (!ends || !cur_.network->isTag(own) || cur_.network->isTag(p.peer_tag) || cur_.network->exactAnchor(p.peer_tag) ||
-      !p.p_peer_tag_in_G.allFinite() || !p.cov_peer_tag_m2.allFinite() || p.cov_peer_tag_m2.trace() < 0.0) {
+      cur_.filter->state().values<AnchorKind>().count(p.peer_tag)) {
     event(first, "peer_range_invalid",
           where("PEER_RANGE", p.t) + ": range " + std::to_string(p.range.id_initiator) + "–" +
               std::to_string(p.range.id_responder) + " is not between a tag of this vehicle and peer tag " +
-              std::to_string(p.peer_tag) + " with a finite position");
+              std::to_string(p.peer_tag) + " (a device this vehicle does not know otherwise)");
     return;
   }
   // The peer's tag, for this update only, as an exactly known point where its vehicle's estimate

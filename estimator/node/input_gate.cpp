@@ -45,6 +45,13 @@ std::string badValue(const EstimatorInput& in, const UwbOptions& uwb) {
     if (s->id_initiator == s->id_responder || s->id_initiator <= 0 || s->id_responder <= 0)
       return where("RANGE", t) + ": invalid ids " + std::to_string(s->id_initiator) + ", " +
              std::to_string(s->id_responder);
+  } else if (const auto* pr = std::get_if<PeerRange>(&in)) {
+    if (const std::string e = badValue(EstimatorInput(pr->range), uwb); !e.empty()) return "PEER_" + e;
+    const Eigen::Matrix3d& S = pr->cov_peer_tag_m2;
+    if (!pr->p_peer_tag_in_G.allFinite() || !S.allFinite() || (S.diagonal().array() < 0.0).any() ||
+        !S.isApprox(S.transpose(), 1e-9) || pr->range.t != pr->t)
+      return where("PEER_RANGE", t) + ": the peer tag " + std::to_string(pr->peer_tag) +
+             "'s position or covariance is not finite, not symmetric or negative, or its range is stamped elsewhere";
   } else if (const auto* a = std::get_if<AnchorInit>(&in)) {
     if (const std::string e = anchorInitValueError(*a); !e.empty()) return where("ANCHOR_INIT", t) + ": " + e;
   } else if (const auto* c = std::get_if<EstimatorCommand>(&in);

@@ -4,6 +4,7 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
+#include "common/pose_interpolation.h"
 #include "node_test_helpers.h"
 
 using namespace meshnav;
@@ -139,6 +140,65 @@ TEST(EstimatorNode, BadInputIsCountedAndDoesNotChangeTheEstimate) {
   EXPECT_EQ(dirty.diagnostics().get("bad_input"), 4 * n_bad);
   EXPECT_EQ(dirty.diagnostics().get("unknown_id"), n_bad);
   EXPECT_EQ(test::stateDifference(*clean.filter(), *dirty.filter()), 0.0);
+}
+
+// A fleet's peer range (PeerRange, docs/fleet.md): exact ranges from tag 100 to a peer tag 500
+// placed 3 m beside the true path, with the peer's position exact, are fused; malformed ones are
+// counted and change nothing (a node fed both ends bit for bit where the node fed only the good
+// ones does): bad values (the input gate: the same tag at both ends, a NaN position, a negative
+// covariance) and a "peer" that is one of this vehicle's known anchors.
+TEST(EstimatorNode, PeerRangesAreFusedAndMalformedOnesCountedWithoutEffect) {
+  synthetic::SyntheticOptions o;
+  o.duration_s = 8.0;
+  o.noise = true;
+  const Dataset ds = synthetic::makeSyntheticDataset(o);
+  const auto inputs = mergeInTimeOrder(ds);
+  const Eigen::Vector3d lever = ds.setup.rel_tag_positions.at(100);
+  ASSERT_TRUE(ds.setup.abs_anchor_positions.count(101));
+  EstimatorNode good(test::testOptions(), ds.setup), dirty(test::testOptions(), ds.setup);
+  int n_peer = 0;
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    good.onInput(inputs[i]);
+    dirty.onInput(inputs[i]);
+    if (i % 53 != 0 || !good.initialized()) continue;
+    const Timestamp t = inputTime(inputs[i]) + Duration::fromSec(0.001);
+    const auto truth = interpolatePose(ds.ground_truth, t);
+    if (!truth) continue;
+    const Eigen::Vector3d p_tag = truth->p_IinG + truth->q_ItoG * lever;
+    PeerRange pr;
+    pr.t = t;
+    pr.peer_tag = 500;
+    pr.p_peer_tag_in_G = p_tag + Eigen::Vector3d(3.0, 0.5, 0.2);
+    pr.cov_peer_tag_m2 = Eigen::Matrix3d::Identity() * 1e-6;
+    pr.range = RangeSample{t, 100, 500, UwbType::Tag, UwbType::Tag, 0.0, 0.0, 0.0, true};
+    pr.range.range_m = pr.range.range_corr_m = (pr.p_peer_tag_in_G - p_tag).norm();
+    good.onInput(pr);
+    dirty.onInput(pr);
+    auto later = [&](PeerRange x, int us) {  // another instant: not a duplicate of the good one
+      x.t = x.range.t = t + Duration{us};
+      return x;
+    };
+    PeerRange own = later(pr, 1);  // the same tag at both ends
+    own.peer_tag = 100;
+    own.range.id_responder = 100;
+    dirty.onInput(own);
+    PeerRange nan_pos = later(pr, 2);
+    nan_pos.p_peer_tag_in_G.x() = std::nan("");
+    dirty.onInput(nan_pos);
+    PeerRange negative = later(pr, 3);
+    negative.cov_peer_tag_m2 = -Eigen::Matrix3d::Identity();
+    dirty.onInput(negative);
+    PeerRange anchor = later(pr, 4);  // "peer" 101 is a known anchor of this vehicle
+    anchor.peer_tag = 101;
+    anchor.range.id_responder = 101;
+    dirty.onInput(anchor);
+    ++n_peer;
+  }
+  ASSERT_GT(n_peer, 10);
+  EXPECT_EQ(good.diagnostics().get("peer_range_fused"), n_peer);
+  EXPECT_EQ(dirty.diagnostics().get("bad_input"), 3 * n_peer);
+  EXPECT_EQ(dirty.diagnostics().get("peer_range_invalid"), n_peer);
+  EXPECT_EQ(test::stateDifference(*good.filter(), *dirty.filter()), 0.0);
 }
 
 TEST(EstimatorNode, OutputsAtTheirRates) {
