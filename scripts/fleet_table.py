@@ -9,8 +9,8 @@ position ANEES, and the mean error of the fly-by anchors when they were first fu
 at the end (final). Exit status 1 when a run fails or exits non-zero.
 
 Usage:
-  fleet_table.py [--seeds 1-6] [--vehicles 2] [--mission FILE|auto] [--out DIR] [--bin DIR]
-                 [--table-md FILE]
+  fleet_table.py [--seeds 1-6] [--vehicles 2] [--mission FILE|auto] [--inter-vehicle-hz F] [--out DIR]
+                 [--bin DIR] [--table-md FILE]
 """
 
 import argparse
@@ -46,6 +46,9 @@ def parse_args(argv):
     p.add_argument("--bin", default=os.path.join(os.environ.get("MESHNAV_BUILD_DIR", os.path.join(ROOT, "build")), "bin"),
                    help="folder of meshnav_sim, meshnav_run, meshnav_eval (default build/bin)")
     p.add_argument("--table-md", default="", help="also write the table as Markdown to this file")
+    p.add_argument("--inter-vehicle-hz", type=float, default=0.0,
+                   help="the vehicles also range tag to tag at this rate (meshnav_sim --inter-vehicle-hz), fused in "
+                        "the fleet run; alone, a vehicle counts them as unknown devices (default 0: none) [Hz]")
     a = p.parse_args(argv)
     try:
         a.seeds = parse_seeds(a.seeds)
@@ -55,6 +58,8 @@ def parse_args(argv):
         p.error("--vehicles must be 2-16")
     if a.mission != "auto" and not os.path.isfile(a.mission):
         p.error(f"--mission: no such file {a.mission}")
+    if not 0.0 <= a.inter_vehicle_hz <= 100.0:
+        p.error("--inter-vehicle-hz must be in [0, 100]")
     return a
 
 
@@ -81,8 +86,9 @@ def run_seed(a, seed):
     sim = os.path.join(base, "sim")
     os.makedirs(base, exist_ok=True)
     mission = [] if a.mission == "auto" else ["--mission", a.mission]
+    ranging = ["--inter-vehicle-hz", repr(a.inter_vehicle_hz)] if a.inter_vehicle_hz > 0 else []
     steps = [("sim", [os.path.join(a.bin, "meshnav_sim"), "--fleet", str(a.vehicles), "--seed", str(seed),
-                      "--out", sim]),
+                      "--out", sim] + ranging),
              # --allow-lost: a vehicle that ends lost is evaluated (its error shows it) instead of
              # stopping the whole table.
              ("fleet", [os.path.join(a.bin, "meshnav_run"), "--fleet", os.path.join(sim, "fleet.yaml"),

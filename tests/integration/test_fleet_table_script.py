@@ -45,6 +45,8 @@ class UsageTest(unittest.TestCase):
         self.assertIn("--seeds", self.refused(["--seeds", "5-2"]))
         self.assertIn("--vehicles", self.refused(["--vehicles", "1"]))
         self.assertIn("--mission", self.refused(["--mission", "/nonexistent/mission.yaml"]))
+        self.assertIn("--inter-vehicle-hz", self.refused(["--inter-vehicle-hz", "-1"]))
+        self.assertEqual(fleet_table.parse_args(["--inter-vehicle-hz", "10"]).inter_vehicle_hz, 10.0)
 
     def test_a_failing_step_is_exit_1_with_its_log(self):
         with tempfile.TemporaryDirectory() as d:
