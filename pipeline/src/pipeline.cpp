@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "common/skew.h"
 #include "pipeline/fleet.h"
 
 namespace meshnav::pipeline {
@@ -120,9 +121,7 @@ void Pipeline::routeInterVehicleRange(size_t vehicle, const RangeSample& r) {
   const Eigen::Vector3d& l = vehicles_[sender].setup.rel_tag_positions.at(peer_tag);
   const double dt = (r.t - ps.t).sec();
   const Eigen::Matrix3d R = ps.q_ItoG.toRotationMatrix();
-  Eigen::Matrix3d l_x;
-  l_x << 0, -l.z(), l.y(), l.z(), 0, -l.x(), -l.y(), l.x(), 0;
-  const Eigen::Matrix3d J = -R * l_x;
+  const Eigen::Matrix3d J = -R * skew(l);
   PeerRange pr;
   pr.t = r.t;
   pr.range = r;
