@@ -15,6 +15,7 @@
 #include "common/yaml_options.h"
 #include "estimator/core/estimator_options.h"
 #include "mission/mission.h"
+#include "sim/sensor_fault_cli.h"
 
 using namespace meshnav;
 
@@ -33,6 +34,7 @@ struct FlyOptions {
   double max_duration_s = 400.0;
   double gust_sigma_m_s = 0.0;
   std::vector<double> pose_outage;
+  sim::SensorFaultArgs faults;
   bool print_config = false;
 };
 
@@ -54,6 +56,7 @@ void declareOptions(Cli& cli, FlyOptions& o) {
                "failsafe drill: withhold POSE from the controller from A to B seconds (--pose-outage A,B)")
       ->delimiter(',')
       ->expected(2);
+  sim::declareSensorFaultOptions(cli, o.faults, /*with_imu_gap=*/true);
   cli.flag("print-config", o.print_config, "print the controller and vehicle options and exit");
 }
 
@@ -75,10 +78,12 @@ int run(const FlyOptions& o) {
   opts.calibrator_config = o.calib_config;
   opts.max_duration_s = o.max_duration_s;
   if (o.pose_outage.size() == 2) opts.pose_outages_s.push_back({o.pose_outage[0], o.pose_outage[1]});
+  opts.faults = o.faults.options();
   opts.progress = [](double t) {
     if (static_cast<int>(t) % 20 == 0) spdlog::info("t = {:.0f} s", t);
   };
-  spdlog::info("closed loop: mission {}, seed {}, strategy {}", o.mission, o.seed, opts.pipeline.estimator.strategy);
+  spdlog::info("closed loop: mission {}, seed {}, strategy {}, faults: {}", o.mission, o.seed,
+               opts.pipeline.estimator.strategy, opts.faults.toString());
   closed_loop::ClosedLoop loop(opts);
   const closed_loop::ClosedLoopResult r = loop.run();
   closed_loop::writeClosedLoopOutputs(r, o.out, o.seed, o.mission);
@@ -89,6 +94,8 @@ int run(const FlyOptions& o) {
                m.crashed ? "CRASHED (" + m.crash_reason + ")" : std::string("no crash"), m.landed_within_m,
                m.failsafe_events, m.flight_time_s, m.anchors_initial_mean_m, m.anchors_final_mean_m, o.out);
   spdlog::info("estimator counters: {}", r.estimator_summary);
+  if (opts.faults.any())
+    spdlog::info("faults: {} ({} IMU samples, {} ranges taken away)", r.faults, r.imu_dropped, r.ranges_dropped);
   if (m.crashed || !m.landed) {
     spdlog::error("the flight ended {}", m.crashed ? "in a crash" : "without landing");
     return 3;

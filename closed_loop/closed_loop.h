@@ -31,6 +31,7 @@
 #include "controller/controller_options.h"
 #include "mission/mission.h"
 #include "pipeline/pipeline.h"
+#include "sim/sensor_faults.h"
 #include "sim/simulated_vehicle.h"
 
 namespace meshnav::closed_loop {
@@ -45,6 +46,9 @@ struct ClosedLoopOptions {
   double after_touchdown_s = 2.0;             ///< keep running after the landing [s]
   /// POSE withheld from the controller in these [from, to) windows [s] (failsafe drills, tests).
   std::vector<std::pair<double, double>> pose_outages_s;
+  /// Sensor faults of a drill (IMU gaps, an anchor off, RANGE loss) between the vehicle and the
+  /// pipeline (sim/sensor_faults.h); none by default.
+  sim::SensorFaultOptions faults;
   /// Called about once per simulated second with the time [s] (progress).
   std::function<void(double)> progress;
 };
@@ -92,7 +96,15 @@ struct ClosedLoopResult {
   Truth truth;
   Eigen::Vector3d pad = Eigen::Vector3d::Zero();
   std::string estimator_summary;           ///< counters of the estimator at the end
+  std::string faults = "none";             ///< the sensor faults flown (SensorFaultOptions::toString)
+  int64_t imu_dropped = 0;                 ///< IMU samples the faults took away
+  int64_t ranges_dropped = 0;              ///< ranges the faults took away (anchor off, loss)
 };
+
+/// Sets the vehicle's pad and heading from the mission's `flight`. Throws std::invalid_argument
+/// when the mission has no `flight`, or a waypoint, the pad or the take-off height lies outside the
+/// vehicle's hall (the file, line and key in the message).
+void applyFlightPlan(const mission::Mission& mission, sim::SimulatedVehicleOptions& vehicle);
 
 class ClosedLoop {
  public:

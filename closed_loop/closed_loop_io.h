@@ -17,8 +17,9 @@ namespace meshnav::closed_loop {
 
 /// Writes the files above into `dir` (created). `seed` and `mission_file` go into closed_loop.yaml.
 /// Throws std::runtime_error naming the file that failed.
+/// `with_calibration` false: no calibration.yaml (over LCM the calibrator process writes its own).
 void writeClosedLoopOutputs(const ClosedLoopResult& result, const std::string& dir, uint64_t seed,
-                            const std::string& mission_file);
+                            const std::string& mission_file, bool with_calibration = true);
 
 /// closed_loop.yaml's text.
 std::string metricsYaml(const ClosedLoopMetrics& m, uint64_t seed, const std::string& mission_file);

@@ -199,6 +199,11 @@ def _flag(d, key, where):
 
 def _number(d, key, default, where, minimum, integer=False):
     v = d.get(key, default)
+    if isinstance(v, str):  # a number from a ${VAR} ("respawn_delay: ${DELAY:-0.2}")
+        try:
+            v = int(v) if integer else float(v)
+        except ValueError:
+            pass
     ok = isinstance(v, int) if integer else isinstance(v, (int, float))
     if isinstance(v, bool) or not ok or not math.isfinite(v) or v < minimum:
         raise LaunchError('%s: %s must be %s >= %s, got %r' % (where, key, 'an integer' if integer else 'a number',

@@ -20,6 +20,8 @@
 
 #include "common/messages.h"
 #include "common/types.h"
+#include "meshnav/control_cmd_t.hpp"
+#include "meshnav/control_status_t.hpp"
 #include "meshnav/time_sync_t.hpp"
 
 namespace meshnav::channels {
@@ -49,12 +51,16 @@ inline constexpr Channel<CalibStatus> kCalibStatus{"CALIB_STATUS"};           //
 inline constexpr Channel<MissionStatus> kMissionStatus{"MISSION_STATUS"};     ///< mission_status_t (heartbeat)
 inline constexpr Channel<time_sync_t> kTimeSyncRequest{"TIME_SYNC_REQUEST"};  ///< time_sync_t, bridges → estimator (clock reference)
 inline constexpr Channel<time_sync_t> kTimeSync{"TIME_SYNC"};                 ///< time_sync_t, estimator → bridges (replies)
+/// control_cmd_t, controller → vehicle_sim: thrust and body rates answering the IMU sample of its utime
+inline constexpr Channel<control_cmd_t> kControlCmd{"CONTROL_CMD"};
+/// control_status_t, controller → logging, view, vehicle_sim (mode, failsafe, setpoint, loop jitter)
+inline constexpr Channel<control_status_t> kControlStatus{"CONTROL_STATUS"};
 
 /// Every channel constant above, once: the list kAll and `find` are made from.
 inline constexpr auto kTyped =
     std::tuple{kImu,  kBaro,           kRange,     kFlightState, kGroundTruth,   kAnchorInit,      kPose,     kAnchors,
                kEstimatorStatus, kEstimatorCmd, kCalibCmd, kCalibStatus, kMissionStatus, kHeight, kTimeSyncRequest,
-               kTimeSync,        kPoseSmoothed};
+               kTimeSync,        kPoseSmoothed,    kControlCmd,   kControlStatus};
 
 /// The name of every channel above, for tools that list or record them.
 inline constexpr auto kAll =

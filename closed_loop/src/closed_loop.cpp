@@ -7,7 +7,9 @@
 #include <unordered_map>
 
 #include "calibrator/node/calibrator_config.h"
+#include "closed_loop/closed_loop_metrics.h"
 #include "estimator/node/estimator_input.h"
+#include "sim/sensor_faults.h"
 
 namespace meshnav::closed_loop {
 
@@ -29,26 +31,27 @@ std::vector<estimator::EstimatorInput> inputsOf(const sim::VehicleOutputs& out) 
 
 }  // namespace
 
-ClosedLoop::ClosedLoop(ClosedLoopOptions options) : options_(std::move(options)) {
-  if (!options_.mission.flight)
-    throw std::invalid_argument(options_.mission.source + ": the mission has no 'flight' (waypoints) to fly");
-  const auto& f = *options_.mission.flight;
+void applyFlightPlan(const mission::Mission& mission, sim::SimulatedVehicleOptions& vehicle) {
+  if (!mission.flight) throw std::invalid_argument(mission.source + ": the mission has no 'flight' (waypoints) to fly");
+  const auto& f = *mission.flight;
   // Every point of the plan inside the hall: a waypoint in a wall is a crash, not a flight.
-  const sim::QuadrotorOptions& dyn = options_.vehicle.dynamics;
+  const sim::QuadrotorOptions& dyn = vehicle.dynamics;
   const auto inside = [&](const Eigen::Vector3d& p) {
     return (p - dyn.hall_min_m).minCoeff() > 0.0 && (dyn.hall_max_m - p).minCoeff() > 0.0;
   };
-  const auto where = [&](int line) {
-    return options_.mission.source + (line > 0 ? ":" + std::to_string(line) : std::string());
-  };
+  const auto where = [&](int line) { return mission.source + (line > 0 ? ":" + std::to_string(line) : std::string()); };
   if (!inside(Eigen::Vector3d(f.pad_xy_m.x(), f.pad_xy_m.y(), f.takeoff_height_m)))
     throw std::invalid_argument(where(0) + ": key 'flight.pad' / 'flight.takeoff_height' is outside the hall");
   for (size_t i = 0; i < f.waypoints.size(); ++i)
     if (!inside(f.waypoints[i].p_IinG))
       throw std::invalid_argument(where(f.waypoints[i].line) + ": key 'flight.waypoints[" + std::to_string(i) +
                                   "].p' is outside the hall");
-  options_.vehicle.pad_p_m = Eigen::Vector3d(f.pad_xy_m.x(), f.pad_xy_m.y(), 0.0);
-  options_.vehicle.pad_yaw_rad = f.pad_yaw_deg * std::numbers::pi / 180.0;
+  vehicle.pad_p_m = Eigen::Vector3d(f.pad_xy_m.x(), f.pad_xy_m.y(), 0.0);
+  vehicle.pad_yaw_rad = f.pad_yaw_deg * std::numbers::pi / 180.0;
+}
+
+ClosedLoop::ClosedLoop(ClosedLoopOptions options) : options_(std::move(options)) {
+  applyFlightPlan(options_.mission, options_.vehicle);
 }
 
 ClosedLoopResult ClosedLoop::run() {
@@ -82,17 +85,17 @@ ClosedLoopResult ClosedLoop::run() {
   pipeline::Pipeline pipe(popts, res.setup, sinks);
 
   // Truth at the IMU instants (what the estimates are compared with).
-  struct TruthAt {
-    Eigen::Vector3d p;
-    bool airborne;
-  };
-  std::unordered_map<int64_t, TruthAt> truth_at;
+  TruthTimeline truth_at;
+  sim::SensorFaults faults(options_.faults, options_.vehicle.sensors.seed);
   std::optional<double> touchdown_s;
   double next_progress_s = 1.0;
 
   const auto take = [&](const sim::VehicleOutputs& out) {
     for (const auto& t : out.truth) truth_at[t.t.us] = {t.p_IinG, !vehicle.dynamics().landed()};
-    for (const auto& in : inputsOf(out)) pipe.onInput(in);
+    // The sensor faults of a drill act on the way to the pipeline; the controller keeps its clock.
+    std::optional<sim::VehicleOutputs> sensed;
+    if (faults.options().any()) faults.apply(sensed.emplace(out));
+    for (const auto& in : inputsOf(sensed ? *sensed : out)) pipe.onInput(in);
     for (const auto& fs : out.flight_states) ctrl.onFlightState(fs);
     for (const auto& imu : out.imu) {
       // One controller step per IMU sample, right after its POSE.
@@ -124,61 +127,21 @@ ClosedLoopResult ClosedLoop::run() {
   pipe.finish();
 
   // ---- metrics ----
-  ClosedLoopMetrics& m = res.metrics;
-  m.duration_s = vehicle.time();
-  m.crashed = vehicle.dynamics().crashed();
-  m.crash_reason = vehicle.dynamics().crashReason();
-  m.landed = vehicle.dynamics().landed() && ctrl.mode() == controller::ControlMode::Landed;
-  m.mission_complete = ctrl.status().mission_complete;
-  m.failsafe_events = ctrl.status().failsafe_events;
-  const Eigen::Vector3d p_end = vehicle.dynamics().state().p_IinG;
-  if (m.landed) m.landed_within_m = (p_end - res.pad).head<2>().norm();
-  double sum_e2 = 0.0;
-  size_t n_e = 0;
-  for (const auto& [t_us, idx] : estimate_at) {
-    const auto it = truth_at.find(t_us);
-    if (it == truth_at.end() || !it->second.airborne) continue;
-    const double e = (res.estimates[idx].p_IinG - it->second.p).norm();
-    sum_e2 += e * e;
-    ++n_e;
-    m.max_estimation_error_m = std::max(m.max_estimation_error_m, e);
-  }
-  m.estimation_rmse_m = n_e ? std::sqrt(sum_e2 / static_cast<double>(n_e)) : 0.0;
-  double sum_t2 = 0.0;
-  size_t n_t = 0, n_air = 0;
-  for (const auto& s : res.samples) {
-    n_air += s.airborne ? 1 : 0;
-    if (!s.airborne || s.status.mode != controller::ControlMode::Flying) continue;
-    if (s.status.phase != "takeoff" && s.status.phase != "waypoints" && s.status.phase != "return") continue;
-    sum_t2 += (s.p_true - s.status.setpoint.p_IinG).squaredNorm();
-    ++n_t;
-  }
-  m.tracking_rmse_m = n_t ? std::sqrt(sum_t2 / static_cast<double>(n_t)) : 0.0;
-  if (res.samples.size() > 1)
-    m.flight_time_s = static_cast<double>(n_air) * (res.samples[1].t_s - res.samples[0].t_s);
-
-  // Anchors: the calibration's initial beliefs and the estimator's last ones.
+  FlightEnd end;
+  end.duration_s = vehicle.time();
+  end.crashed = vehicle.dynamics().crashed();
+  end.crash_reason = vehicle.dynamics().crashReason();
+  end.landed = vehicle.dynamics().landed() && ctrl.mode() == controller::ControlMode::Landed;
+  end.mission_complete = ctrl.status().mission_complete;
+  end.failsafe_events = ctrl.status().failsafe_events;
+  end.p_end = vehicle.dynamics().state().p_IinG;
   res.anchor_inits = pipe.anchorInits();
   if (pipe.calibrator()) res.calibration = pipe.calibrator()->results();
   if (pipe.estimator().initialized()) res.final_anchors = pipe.estimator().anchors();
-  std::map<SensorId, AnchorResult> anchors;
-  for (const auto& a : res.anchor_inits) {
-    const auto it = res.truth.anchor_positions.find(a.id);
-    if (it == res.truth.anchor_positions.end()) continue;
-    anchors[a.id].id = a.id;
-    anchors[a.id].initial_error_m = (a.p_AinG - it->second).norm();
-  }
-  for (const auto& a : res.final_anchors)
-    if (anchors.count(a.id)) anchors[a.id].final_error_m = (a.p_AinG - res.truth.anchor_positions.at(a.id)).norm();
-  double s0 = 0.0, s1 = 0.0;
-  int n0 = 0, n1 = 0;
-  for (const auto& [id, a] : anchors) {
-    m.anchors.push_back(a);
-    if (a.initial_error_m >= 0.0) s0 += a.initial_error_m, ++n0;
-    if (a.final_error_m >= 0.0) s1 += a.final_error_m, ++n1;
-  }
-  if (n0) m.anchors_initial_mean_m = s0 / n0;
-  if (n1) m.anchors_final_mean_m = s1 / n1;
+  res.metrics = computeMetrics(res, truth_at, end);
+  res.faults = faults.options().toString();
+  res.imu_dropped = faults.imuDropped();
+  res.ranges_dropped = faults.rangesAnchorOff() + faults.rangesLost();
   std::string counters;
   for (const auto& [k, v] : pipe.estimator().status().counters) counters += k + "=" + std::to_string(v) + " ";
   res.estimator_summary = counters;

@@ -40,7 +40,7 @@ std::string metricsYaml(const ClosedLoopMetrics& m, uint64_t seed, const std::st
 }
 
 void writeClosedLoopOutputs(const ClosedLoopResult& r, const std::string& dir, uint64_t seed,
-                            const std::string& mission_file) {
+                            const std::string& mission_file, bool with_calibration) {
   const std::filesystem::path out(dir);
   std::filesystem::create_directories(out);
   writeFileAtomically((out / "closed_loop.yaml").string(),
@@ -71,7 +71,7 @@ void writeClosedLoopOutputs(const ClosedLoopResult& r, const std::string& dir, u
         << st.pose_age_s << ',' << st.position_cov_trace_m2 << ',' << (s.airborne ? 1 : 0) << '\n';
     }
   });
-  calib::writeCalibrationYaml(r.calibration, (out / "calibration.yaml").string());
+  if (with_calibration) calib::writeCalibrationYaml(r.calibration, (out / "calibration.yaml").string());
   saveSetup(r.setup, (out / "setup.yaml").string());
   saveTruth(r.truth, (out / "truth.yaml").string());
 }

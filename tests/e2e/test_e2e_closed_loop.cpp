@@ -114,3 +114,75 @@ TEST(ClosedLoopE2E, PoseOutageDrillLandsSoftlyByFailsafe) {
   EXPECT_EQ(r.metrics.failsafe_events, 1);
   EXPECT_LT(r.metrics.duration_s, 60.0);  // it came down soon after the outage began
 }
+
+// ---- Fault drills in one process (issue 37 item 4; the estimator kill is over LCM:
+// tests/integration/fly_lcm_test.sh). Each: no crash, landing within 0.5 m of the pad, the event on
+// CONTROL_STATUS (the controller's status in every sample). ----
+
+namespace {
+
+/// Mean trace of the POSE position covariance the controller reported from `from_s` to `to_s`.
+double meanCovTrace(const closed_loop::ClosedLoopResult& r, double from_s, double to_s) {
+  double sum = 0.0;
+  int n = 0;
+  for (const auto& s : r.samples)
+    if (s.t_s >= from_s && s.t_s < to_s) sum += s.status.position_cov_trace_m2, ++n;
+  return n ? sum / n : 0.0;
+}
+
+void expectLandedOnThePad(const closed_loop::ClosedLoopMetrics& m) {
+  EXPECT_FALSE(m.crashed) << m.crash_reason;
+  EXPECT_TRUE(m.landed);
+  EXPECT_TRUE(m.mission_complete);
+  EXPECT_GE(m.landed_within_m, 0.0);
+  EXPECT_LE(m.landed_within_m, 0.5);
+}
+
+}  // namespace
+
+TEST(ClosedLoopE2E, ImuGapDrillFailsafeThenRecoversAndLands) {
+  closed_loop::ClosedLoopOptions o = shortMission(1);
+  o.faults.imu_gaps_s = {{35.0, 38.0}};  // 3 s without IMU at about 2 m height
+  const closed_loop::ClosedLoopResult r = closed_loop::ClosedLoop(o).run();
+  expectLandedOnThePad(r.metrics);
+  EXPECT_EQ(r.imu_dropped, 600);
+  EXPECT_GE(r.metrics.failsafe_events, 1);
+  // On CONTROL_STATUS: failsafe for POSE late from within pose_timeout of the gap's start, and
+  // flying again before the end.
+  double failsafe_from = -1.0, flying_again = -1.0;
+  for (const auto& s : r.samples) {
+    if (failsafe_from < 0.0 && s.status.mode == controller::ControlMode::Failsafe) {
+      failsafe_from = s.t_s;
+      EXPECT_EQ(s.status.failsafe_reason, "POSE late");
+    }
+    if (failsafe_from >= 0.0 && flying_again < 0.0 && s.status.mode == controller::ControlMode::Flying)
+      flying_again = s.t_s;
+  }
+  EXPECT_GE(failsafe_from, 35.0);
+  EXPECT_LE(failsafe_from, 35.0 + 0.3 + 0.05);
+  EXPECT_GT(flying_again, 38.0);
+}
+
+TEST(ClosedLoopE2E, AnchorOffDrillLandsAndShowsInTheCovariance) {
+  closed_loop::ClosedLoopOptions o = shortMission(1);
+  o.faults.anchor_off = 101;
+  o.faults.anchor_off_from_s = 20.0;
+  const closed_loop::ClosedLoopResult r = closed_loop::ClosedLoop(o).run();
+  expectLandedOnThePad(r.metrics);
+  EXPECT_GT(r.ranges_dropped, 500);
+  const closed_loop::ClosedLoopResult nominal = closed_loop::ClosedLoop(shortMission(1)).run();
+  // Without anchor 101 the POSE the controller flies on is less certain (measured 0.013 vs 0.009 m²).
+  EXPECT_GT(meanCovTrace(r, 20.0, 58.0), 1.2 * meanCovTrace(nominal, 20.0, 58.0));
+  EXPECT_LE(r.metrics.estimation_rmse_m, 0.15);
+}
+
+TEST(ClosedLoopE2E, RangeLossDrillLandsAndShowsInTheCovariance) {
+  closed_loop::ClosedLoopOptions o = shortMission(1);
+  o.faults.range_loss_fraction = 0.2;
+  const closed_loop::ClosedLoopResult r = closed_loop::ClosedLoop(o).run();
+  expectLandedOnThePad(r.metrics);
+  EXPECT_GT(r.ranges_dropped, 1000);
+  const closed_loop::ClosedLoopResult nominal = closed_loop::ClosedLoop(shortMission(1)).run();
+  EXPECT_GT(meanCovTrace(r, 20.0, 58.0), meanCovTrace(nominal, 20.0, 58.0));  // measured 0.011 vs 0.009 m²
+  EXPECT_LE(r.metrics.estimation_rmse_m, 0.15);
+}

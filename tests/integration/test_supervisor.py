@@ -135,6 +135,7 @@ class Substitution(unittest.TestCase):
                           # found by fuzz/launch_yaml_fuzz.py: these raised TypeError/ValueError
                           ('stop_timeout:\nprocesses:\n  - {name: a, command: x}\n', 'stop_timeout must be a number'),
                           ('processes:\n  - {name: a, command: x, delay: soon}\n', 'delay must be a number'),
+                          ('processes:\n  - {name: a, command: x, delay: "${D:-nan}"}\n', 'delay must be a number'),
                           ('processes:\n  - {name: a, command: x, max_respawns: -2}\n', 'max_respawns must be an integer >= -1'),
                           ('processes:\n  - {name: a, command: x, env: [1]}\n', 'env must be a map'),
                           # 600 s fuzz run 2026-11-26: a key that YAML reads as a bool raised TypeError
@@ -143,6 +144,15 @@ class Substitution(unittest.TestCase):
             rc, out, err = run_launch(text)
             self.assertEqual(rc, 2, text)
             self.assertIn(msg, err, text)
+
+    def test_number_from_a_variable(self):
+        # config/launch/fly.yaml: respawn_delay: ${ESTIMATOR_RESPAWN_DELAY:-0.2}
+        text = 'processes:\n  - {name: a, command: x, respawn: on-failure, respawn_delay: "${D:-0.2}"}\n'
+        rc, out, err = run_launch(text, 'D=1.5', '--dry-run')
+        self.assertEqual(rc, 0, err)
+        rc, out, err = run_launch(text, 'D=later', '--dry-run')
+        self.assertEqual(rc, 2, err)
+        self.assertIn('respawn_delay must be a number', err)
 
     def test_launch_file_not_utf8(self):
         # found by fuzz/launch_yaml_fuzz.py: a UnicodeDecodeError traceback before
@@ -431,6 +441,9 @@ class ShippedLaunchFiles(unittest.TestCase):
             launch = supervisor.Launch(os.path.join(folder, name), variables)
             for p in launch.procs:
                 where = '%s: %s' % (name, p.name)
+                if p.name == 'vehicle_sim':  # fly.yaml: the simulated world; restarted it is another flight
+                    self.assertEqual(p.respawn, 'never', where)
+                    continue
                 self.assertNotEqual(p.respawn, 'never', where)
                 if p.max_respawns < 0:  # unlimited only with a bounded back-off
                     self.assertLessEqual(p.respawn_delay_max, 30.0, where)

@@ -27,5 +27,8 @@ class SystemClock final : public Clock {
 
 /// Current wall time [µs since the Unix epoch] (CLOCK_REALTIME).
 int64_t wallUtimeNow();
+/// A monotonic time [µs] from an arbitrary origin (std::chrono::steady_clock): for intervals
+/// (pacing, loop jitter), which a wall clock step would falsify.
+int64_t monotonicUsNow();
 
 }  // namespace meshnav::replay

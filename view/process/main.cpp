@@ -1,5 +1,5 @@
 /// view_server: the live web view (docs/view.md). Subscribes POSE, GROUND_TRUTH, ANCHORS, RANGE,
-/// ESTIMATOR_STATUS, CALIB_STATUS and MISSION_STATUS on LCM (or plays them from `--log FILE`,
+/// ESTIMATOR_STATUS, CALIB_STATUS, MISSION_STATUS and CONTROL_STATUS on LCM (or plays them from `--log FILE`,
 /// paced by the log's event times / `--speed`), gathers them in a view::ViewState, and serves the
 /// page of view/web/ and its state endpoint over HTTP on `--host` (127.0.0.1) `--port`.
 ///
@@ -18,6 +18,7 @@
 #include <thread>
 
 #include "common/setup.h"
+#include "controller/process/control_messages.h"
 #include "transport/channels.h"
 #include "transport/process_main.h"
 #include "transport/stop_signal.h"
@@ -96,6 +97,10 @@ void subscribeView(transport::LcmNode& lcm, std::mutex& mutex, view::ViewState& 
   on(channels::kEstimatorStatus, [](view::ViewState& v, const EstimatorStatus& m) { v.onEstimatorStatus(m); });
   on(channels::kCalibStatus, [](view::ViewState& v, const CalibStatus& m) { v.onCalibStatus(m); });
   on(channels::kMissionStatus, [](view::ViewState& v, const MissionStatus& m) { v.onMissionStatus(m); });
+  on(channels::kControlStatus, [](view::ViewState& v, const control_status_t& m) {
+    if (controller::invalidReason(m).empty())
+      v.onStatusFields("CONTROL_STATUS", Timestamp{m.utime}, controller::statusFields(m));
+  });
 }
 
 /// Plays `path` into `lcm` (memq://), paced by the events' time stamps divided by `speed` (0: no

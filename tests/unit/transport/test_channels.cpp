@@ -86,7 +86,7 @@ TEST(Channels, NamesAreDistinctAndUpperSnake) {
     EXPECT_TRUE(names.insert(s).second) << s << " twice";
     for (char c : s) EXPECT_TRUE((c >= 'A' && c <= 'Z') || c == '_') << s;
   }
-  EXPECT_EQ(names.size(), 17u);
+  EXPECT_EQ(names.size(), 19u);
 }
 
 TEST(Channels, TypedRoundTripOverMemq) {

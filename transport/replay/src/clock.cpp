@@ -12,6 +12,11 @@ int64_t wallUtimeNow() {
       .count();
 }
 
+int64_t monotonicUsNow() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
 int64_t SystemClock::nowUtime() { return wallUtimeNow(); }
 
 void SystemClock::sleepUntil(int64_t wall_utime, int64_t max_wait_us) {
