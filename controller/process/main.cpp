@@ -13,6 +13,7 @@
 #include "controller/process/control_messages.h"
 #include "mission/mission.h"
 #include "transport/channels.h"
+#include "transport/latency_recorder.h"
 #include "transport/process_main.h"
 
 namespace {
@@ -59,7 +60,11 @@ int main(int argc, char** argv) {
     if (!m.flight) throw std::runtime_error(o.mission_path + ": the mission has no 'flight' (waypoints) to fly");
     transport::LcmNode& lcm = process.lcm();
 
-    controller::LoopJitter jitter;
+    controller::LoopJitter jitter;      // of the updates (monotonic clock)
+    controller::LoopJitter imu_jitter;  // of the IMU samples' arrival (LCM's receive time)
+    // Where the time goes: IMU → POSE (estimator and two hops) and IMU → CONTROL_CMD (out of here),
+    // both from the receive time of the IMU sample here (transport/latency_recorder.h).
+    transport::LatencyRecorder to_pose, to_cmd;
     int64_t updates = 0;
     const auto statusMsg = [&](const controller::ControlStatus& s) {
       return controller::toLcm(s, updates, jitter.quantileMs(0.99), jitter.maxMs());
@@ -75,9 +80,18 @@ int main(int argc, char** argv) {
       jitter.add(c.t.us, replay::monotonicUsNow());
       ++updates;
       lcm.publish(channels::kControlCmd, controller::toLcm(c, node.mode()));
+      to_cmd.onPose(c.t.us, replay::wallUtimeNow());
     });
-    lcm.subscribe(channels::kPose, [&](const PoseEstimate& p) { loop.onPose(p); });
-    lcm.subscribe(channels::kImu, [&](const ImuSample& s) { loop.onImu(s.t); });
+    lcm.subscribeStamped(channels::kPose, [&](const PoseEstimate& p, int64_t recv_utime) {
+      to_pose.onPose(p.t.us, recv_utime);
+      loop.onPose(p);
+    });
+    lcm.subscribeStamped(channels::kImu, [&](const ImuSample& s, int64_t recv_utime) {
+      imu_jitter.add(s.t.us, recv_utime);
+      to_pose.onImu(s.t.us, recv_utime);
+      to_cmd.onImu(s.t.us, recv_utime);
+      loop.onImu(s.t);
+    });
     lcm.subscribe(channels::kFlightState, [&](const FlightStateSample& fs) { loop.onFlightState(fs); });
     lcm.setHeartbeat(Duration::fromSec(o.heartbeat_s), [&] {
       control_status_t msg = statusMsg(node.status());
@@ -100,6 +114,16 @@ int main(int argc, char** argv) {
         << "updates: " << loop.updates() << "\nimu_updates: " << loop.imuUpdates() << "\nintervals: " << jitter.count()
         << "\njitter_p50_ms: " << jitter.quantileMs(0.5) << "\njitter_p99_ms: " << jitter.quantileMs(0.99)
         << "\njitter_max_ms: " << jitter.maxMs() << "\nfailsafe_events: " << st.failsafe_events << "\n";
+      // The same measure of the IMU samples' arrival (what the vehicle and the bus give the loop),
+      // and the latencies from an IMU sample's arrival [ms].
+      const auto ms = [](const transport::LatencyStats& l) {
+        return fmt::format("{{n: {}, p50: {:.3f}, p99: {:.3f}, max: {:.3f}}}", l.n, l.median_us / 1e3, l.p99_us / 1e3,
+                           l.max_us / 1e3);
+      };
+      f << "imu_arrival_jitter_p50_ms: " << imu_jitter.quantileMs(0.5)
+        << "\nimu_arrival_jitter_p99_ms: " << imu_jitter.quantileMs(0.99)
+        << "\nimu_arrival_jitter_max_ms: " << imu_jitter.maxMs() << "\nimu_to_pose_ms: " << ms(to_pose.imuToPose())
+        << "\nimu_to_cmd_ms: " << ms(to_cmd.imuToPose()) << "\n";
       if (!f) spdlog::error("{}: cannot write", o.timing_out);
     }
     return rc;
