@@ -23,6 +23,8 @@
 #include "meshnav/pair_bias_t.hpp"
 #include "meshnav/pose_t.hpp"
 #include "meshnav/range_t.hpp"
+#include "meshnav/control_cmd_t.hpp"
+#include "meshnav/control_status_t.hpp"
 #include "meshnav/time_sync_t.hpp"
 #include "meshnav/timing_t.hpp"
 
@@ -153,8 +155,9 @@ TEST(LcmTypes, FingerprintsAreDistinct) {
       meshnav::mission_status_t::getHash(), meshnav::anchor_estimate_t::getHash(),
       meshnav::calib_anchor_status_t::getHash(), meshnav::counter_t::getHash(),
       meshnav::instance_status_t::getHash(), meshnav::pair_bias_t::getHash(),
-      meshnav::timing_t::getHash(),          meshnav::time_sync_t::getHash()};
-  ASSERT_EQ(hashes.size(), 21u);  // every type in lcmtypes/types
+      meshnav::timing_t::getHash(),          meshnav::time_sync_t::getHash(),
+      meshnav::control_cmd_t::getHash(),     meshnav::control_status_t::getHash()};
+  ASSERT_EQ(hashes.size(), 23u);  // every type in lcmtypes/types
   for (size_t i = 0; i < hashes.size(); ++i)
     for (size_t j = i + 1; j < hashes.size(); ++j) EXPECT_NE(hashes[i], hashes[j]) << i << " vs " << j;
 }
