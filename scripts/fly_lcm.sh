@@ -3,7 +3,8 @@
 # vehicle_sim, estimator, calibrator, mission, controller and logging from config/launch/fly.yaml
 # through scripts/supervisor.py, in a private network namespace (scripts/lcm_netns.sh). Writes
 # DIR/closed_loop.yaml (the metrics of the flight in one process, plus over_lcm, commands_late),
-# the flight's files, DIR/controller_timing.yaml (loop jitter), DIR/log (logger), DIR/launch.log.
+# the flight's files, DIR/controller_timing.yaml (loop jitter), DIR/cpu.yaml (CPU per process),
+# DIR/log (logger), DIR/launch.log.
 #   fly_lcm.sh --out DIR [--seed N] [--mission FILE] [--realtime] [--strategy S] [--gust-sigma S]
 #              [--kill-estimator-at T]          drill: kill -9 the estimator at simulated time T [s];
 #                                               the supervisor respawns it (from its checkpoint)
@@ -79,11 +80,34 @@ if [[ -n "$kill_at" ]]; then
   kill -KILL "$pid" || fail "cannot kill the estimator (pid $pid)"
   echo "[fly lcm] killed the estimator (pid $pid) at t = $kill_at s" | tee -a "$out/drill.log" >&2
 fi
+# CPU of each process (user + system seconds from /proc/PID/stat, last read while it ran; a
+# respawned process's pids add up), written to DIR/cpu.yaml as seconds and % of a core.
+declare -A CPU_S=()
+sample_cpu() {
+  local name pid
+  while read -r name pid; do
+    [[ -r "/proc/$pid/stat" ]] || continue
+    CPU_S["$name:$pid"]=$(awk -v hz="$(getconf CLK_TCK)" '{ print ($14 + $15) / hz }' "/proc/$pid/stat" 2>/dev/null || echo 0)
+  done < <(sed -n 's/^\[supervisor\] started \([a-z_]*\) (pid \([0-9]*\)).*/\1 \2/p' "$out/launch.log")
+}
+next_progress=$(( $(now_us) + 10000000 ))
 while kill -0 "$SUP" 2>/dev/null; do
+  sample_cpu
   (( $(now_us) - start < 1800000000 )) || fail "the launch still runs after 1800 s"
+  if (( $(now_us) >= next_progress )); then  # progress: the vehicle's newest 't = N s' line
+    line=$(grep "\[vehicle_sim\].* t = [0-9]* s (" "$out/launch.log" | tail -n 1 | sed 's/.*\] t = /t = /')
+    [[ -n "$line" ]] && echo "[fly lcm] $line" >&2
+    next_progress=$(( $(now_us) + 10000000 ))
+  fi
   sleep 0.2
 done
 wait "$SUP"; rc=$?; SUP=""
+wall_s=$(awk -v a="$start" -v b="$(now_us)" 'BEGIN { print (b - a) / 1e6 }')
+{
+  echo "# CPU per process over the ${wall_s} s of the launch (user + system, last sample while it ran)"
+  for key in "${!CPU_S[@]}"; do echo "${key%%:*} ${CPU_S[$key]}"; done | sort |
+    awk -v w="$wall_s" '{ s[$1] += $2 } END { for (n in s) printf "%s: {cpu_s: %.1f, percent_of_a_core: %.1f}\n", n, s[n], 100 * s[n] / w }' | sort
+} > "$out/cpu.yaml"
 grep -E "\[(vehicle_sim|controller)\].*(stopped|tracking RMSE)" "$out/launch.log" | cut -c1-400 >&2
 [[ -s "$out/closed_loop.yaml" ]] || fail "no closed_loop.yaml (supervisor exit $rc)"
 grep -q "^crashed: false" "$out/closed_loop.yaml" && grep -q "^landed: true" "$out/closed_loop.yaml" || exit 3
