@@ -124,10 +124,14 @@ int main(int argc, char** argv) {
       node.onCommand(Timestamp{c.utime}, {c.thrust_m_s2, Eigen::Vector3d(c.w_IinI[0], c.w_IinI[1], c.w_IinI[2])},
                      controller::modeOf(c.mode) == controller::ControlMode::Landed);
     });
-    // Mode changes and failsafe events of CONTROL_STATUS, logged (what a drill shows).
+    // CONTROL_STATUS (one subscription: a malformed message is counted once): mode changes and
+    // failsafe events logged (what a drill shows), and the evaluation's controller samples.
     controller::ControlStatus shown;
     lcm->subscribe(channels::kControlStatus, [&](const control_status_t& m) {
-      if (!controller::invalidReason(m).empty()) return;  // counted by the recorder's subscription
+      if (const std::string why = controller::invalidReason(m); !why.empty()) {
+        lcm->diagnostics().report("CONTROL_STATUS:invalid_message", "CONTROL_STATUS dropped: " + why);
+        return;
+      }
       const controller::ControlStatus s = controller::fromLcm(m);
       if (s.mode != shown.mode || s.failsafe_events != shown.failsafe_events)
         spdlog::info("CONTROL_STATUS t = {} s: {} -> {}{}, failsafe events {}", formatSeconds(s.t),
@@ -135,18 +139,12 @@ int main(int argc, char** argv) {
                      s.mode == controller::ControlMode::Failsafe ? " (" + s.failsafe_reason + ")" : std::string(),
                      s.failsafe_events);
       shown = s;
+      if (recorder) recorder->onControlStatus(s);
     });
     if (recorder) {
       lcm->subscribe(channels::kPose, [&](const PoseEstimate& e) { recorder->onPose(e); });
       lcm->subscribe(channels::kAnchorInit, [&](const AnchorInit& a) { recorder->onAnchorInit(a); });
       lcm->subscribe(channels::kAnchors, [&](const std::vector<AnchorEstimate>& a) { recorder->onAnchors(a); });
-      lcm->subscribe(channels::kControlStatus, [&](const control_status_t& s) {
-        if (const std::string why = controller::invalidReason(s); !why.empty()) {
-          lcm->diagnostics().report("CONTROL_STATUS:invalid_message", "CONTROL_STATUS dropped: " + why);
-          return;
-        }
-        recorder->onControlStatus(controller::fromLcm(s));
-      });
     }
     for (const std::string& ch : o.wait_for) {
       if (ch.empty()) continue;
