@@ -60,6 +60,8 @@ def parse_args(argv):
                    help="folder of meshnav_sim, meshnav_run, meshnav_eval (default build/bin)")
     p.add_argument("--table-md", default="", help="also write the tables as Markdown to this file")
     p.add_argument("--keep-going", action="store_true", help="a failed seed is reported and skipped")
+    p.add_argument("--from-results", action="store_true",
+                   help="only print the tables from the seeds' OUT/seedN/result.json of an earlier run")
     a = p.parse_args(argv)
     try:
         a.seeds = parse_seeds(a.seeds)
@@ -84,6 +86,20 @@ def run(cmd, log):
 def vehicle_of(tag):
     """Tags 99/100/105 + 1000 k belong to vehicle k (meshnav_sim --vehicles)."""
     return tag // 1000
+
+
+def peer_vehicles(sim, n, victim, t0, t1):
+    """Per other vehicle, the tag-to-tag ranges it exchanged with `victim` in [t0, t1]."""
+    counts = {}
+    for v in range(n):
+        with open(os.path.join(sim, f"v{v}", "ranges.csv")) as f:
+            for row in csv.DictReader(f):
+                if row["type_ID1"] == "T" and row["type_ID2"] == "T" and t0 <= float(row["t"]) <= t1:
+                    a, b = vehicle_of(int(row["UWB_ID1"])), vehicle_of(int(row["UWB_ID2"]))
+                    if victim in (a, b):
+                        other = b if a == victim else a
+                        counts[other] = counts.get(other, 0) + 1
+    return counts
 
 
 def tag_to_tag_counts(sim, n, t0, t1):
@@ -171,7 +187,8 @@ def run_seed(a, seed):
         start = time.time()
         run(cmd + ["--out", os.path.join(base, name)] + common, os.path.join(base, name + ".log"))
         wall[name] = time.time() - start
-    res = {"seed": seed, "victim": victim, "peer_ranges": counts[victim], "wall": wall, "vehicles": []}
+    res = {"seed": seed, "victim": victim, "peer_ranges": counts[victim], "wall": wall, "vehicles": [],
+           "peers": peer_vehicles(sim, a.vehicles, victim, t0, t1)}
     fleet_cal = os.path.join(base, "fleet", "calibration.yaml")
     fleet_from = contributors(fleet_cal)
     for v in range(a.vehicles):
@@ -231,10 +248,13 @@ def tables(results, a):
                  " |" * (a.vehicles + 1))
     lines += ["", f"Outage: the anchors silent for one vehicle over {t0:g}-{t1:g} s, its position error there "
               "(RMSE / largest) [m] with and without inter-vehicle ranges:", "",
-              "| seed | vehicle | tag-to-tag ranges in the window | with | without |", "| ---: | ---: | ---: | ---: | ---: |"]
+              "| seed | vehicle | tag-to-tag ranges in the window (per neighbour) | with | without |",
+              "| ---: | ---: | ---: | ---: | ---: |"]
     for r in results:
         w, wo = r["outage_with"], r["outage_without"]
-        lines.append(f"| {r['seed']} | v{r['victim']} | {r['peer_ranges']} | {w[0]:.3f} / {w[1]:.3f} | {wo[0]:.3f} / {wo[1]:.3f} |")
+        per = ", ".join(f"v{k}: {n}" for k, n in sorted(r["peers"].items(), key=lambda kv: int(kv[0])))
+        lines.append(f"| {r['seed']} | v{r['victim']} | {r['peer_ranges']} ({per}) | {w[0]:.3f} / {w[1]:.3f} "
+                     f"| {wo[0]:.3f} / {wo[1]:.3f} |")
     ok = sum(1 for r in results if r["outage_with"][0] <= 0.30)
     lines.append(f"| all | | | {ok} of {len(results)} <= 0.30 m, mean {mean([r['outage_with'][0] for r in results]):.3f} "
                  f"| mean {mean([r['outage_without'][0] for r in results]):.3f} |")
@@ -259,7 +279,18 @@ def tables(results, a):
 def main(argv):
     a = parse_args(argv)
     results = []
-    for i, seed in enumerate(a.seeds):
+    if a.from_results:
+        for seed in a.seeds:
+            path = os.path.join(a.out, f"seed{seed}", "result.json")
+            if not os.path.isfile(path):
+                print(f"[fleet-scale-table] no {path}", file=sys.stderr)
+                continue
+            with open(path) as f:
+                r = json.load(f)
+            if "peers" not in r:  # result.json of a version without the column
+                r["peers"] = peer_vehicles(os.path.join(a.out, f"seed{seed}", "sim"), a.vehicles, r["victim"], *a.window)
+            results.append(r)
+    for i, seed in enumerate([] if a.from_results else a.seeds):
         print(f"[fleet-scale-table] seed {seed} ({i + 1}/{len(a.seeds)}): 2 simulations, 3 fleet runs, "
               f"{a.vehicles} runs alone, evaluation", flush=True)
         start = time.time()
