@@ -202,7 +202,7 @@ SimulationResult ScenarioSimulator::run() const {
   const TdmaSchedule schedule(scenario_.uwbDeviceIds(), o.uwb.slot_s, facts.tdma_t0_s);
   const UwbHardwareBiases biases(scenario_.uwbDeviceIds(), o.hardware);
   UwbRangeSimulator uwb(scenario_, biases, o.uwb, o.seed);
-  result.ranges = uwb.simulate(trajectory, schedule, t_end);
+  if (o.mesh_ranges) result.ranges = uwb.simulate(trajectory, schedule, t_end);
   ds.ranges.reserve(result.ranges.size());
   for (const auto& r : result.ranges) ds.ranges.push_back(r.sample);
   facts.n_ranges = ds.ranges.size();

@@ -43,11 +43,17 @@ void SimulationOptions::validate() const {
   }
   require(tag_id_offset >= 0 && tag_id_offset <= 1000000 && tag_id_offset % 1000 == 0,
           "tag_id_offset must be a multiple of 1000 in [0, 1000000]");
+  if (flight_region) {
+    const Hall h = hall();
+    require((flight_region->min_m - h.min_m).minCoeff() >= -1e-9 && (h.max_m - flight_region->max_m).minCoeff() >= -1e-9 &&
+                (flight_region->size().array() >= 2.5).all(),
+            "flight_region must lie inside the hall and be at least 2.5 m along each axis");
+  }
   if (duration_s) require(*duration_s >= 30.0 && *duration_s <= 3600.0, "duration_s (--duration) must be in [30, 3600] s");
 }
 
 bool SimulationOptions::isPaperScenario() const {
-  return trajectory_kind == TrajectoryKind::Spiral && !hall_size_m && anchor_layout == AnchorLayoutKind::Paper &&
+  return trajectory_kind == TrajectoryKind::Spiral && !hall_size_m && !flight_region && mesh_ranges && anchor_layout == AnchorLayoutKind::Paper &&
          n_tags == 2 && n_known_anchors == 4 && n_unknown_anchors == 5 && tag_id_offset == 0;
 }
 

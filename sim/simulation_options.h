@@ -50,6 +50,12 @@ struct SimulationOptions {
   /// Seed of the anchor layout (a fleet's one world: every vehicle among the same anchors);
   /// nullopt: `seed`.
   std::optional<uint64_t> layout_seed;
+  /// The box the trajectory is fitted to, inside the hall (a scaled fleet's vehicle flies its own
+  /// part of a large hall, sim/scaled_fleet_simulation.h); nullopt: the hall.
+  std::optional<Hall> flight_region;
+  /// False: ScenarioSimulator writes no ranges (a caller simulates them: the cell TDMA of a scaled
+  /// fleet); its truth.yaml range counts are then 0.
+  bool mesh_ranges = true;
 
   /// The hall box: `Hall::ofSize(*hall_size_m)` or the paper's.
   Hall hall() const { return hall_size_m ? Hall::ofSize(*hall_size_m) : Hall::paper(); }

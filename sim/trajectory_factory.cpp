@@ -16,14 +16,14 @@ constexpr double kNominalDuration_s = 140.0;  ///< the paper's sequence length a
 }  // namespace
 
 std::unique_ptr<Trajectory> makeTrajectory(const SimulationOptions& o) {
-  const Hall hall = o.hall();
+  const Hall hall = o.flight_region.value_or(o.hall());
   const double duration_s = o.duration_s ? *o.duration_s : kNominalDuration_s * o.duration_scale;
   switch (o.trajectory_kind) {
     case TrajectoryKind::Spiral: {
       if (o.trajectory) return std::make_unique<SpiralTrajectory>(*o.trajectory);
       const double scale = o.duration_s ? *o.duration_s / kNominalDuration_s : o.duration_scale;
       TrajectoryOptions spiral = TrajectoryOptions::randomized(o.seed, scale);
-      if (o.hall_size_m) spiral = spiral.fittedTo(hall);
+      if (o.hall_size_m || o.flight_region) spiral = spiral.fittedTo(hall);
       return std::make_unique<SpiralTrajectory>(spiral);
     }
     case TrajectoryKind::Figure8: return std::make_unique<Figure8Trajectory>(hall, duration_s, o.seed);

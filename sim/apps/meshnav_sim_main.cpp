@@ -17,6 +17,7 @@
 #include "common/cli_main.h"
 #include "common/dataset.h"
 #include "sim/fleet_simulation.h"
+#include "sim/scaled_fleet_simulation.h"
 #include "sim/scenario_simulator.h"
 #include "sim/uncertain_anchors.h"
 
@@ -39,6 +40,8 @@ struct SimCli {
   double imu_scale_sigma = 0.0, imu_misalignment_deg = 0.0, vibration = 1.0;
   int fleet = 0;
   double inter_vehicle_hz = 0.0;
+  meshnav::sim::ScaledFleetOptions scaled;  ///< --vehicles: its base options are `sim`
+  std::string outage;
   bool no_initial_pose = false, uncertain_known = false;
 };
 
@@ -63,6 +66,30 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
       ->type_name("F")
       ->check(CLI::Range(0.0, 100.0))
       ->needs("--fleet");
+  auto* vehicles =
+      cli.optional("vehicles", c.scaled.n_vehicles,
+                   "a fleet of N vehicles (1-16) among --anchors anchors in TDMA cells in a large hall (--hall, default "
+                   "40,40,10): anchors on a grid (walls, pillars, ceiling), 2 x 2 grid points per cell, cells reusing "
+                   "slots 3 cells apart; vehicle k flies its own flight (spiral, figure8, lawnmower, helix in turn) in "
+                   "its part of the hall with seed --seed + k and tags 100/105 + 1000 k; writes --out/v0 ..., "
+                   "--out/fleet.yaml, --out/mission.yaml (calibrates the fly-by anchors) and --out/anchors_layout.csv "
+                   "(docs/scenarios.md, 'A hundred anchors in TDMA cells')")
+          ->type_name("N")
+          ->check(CLI::Range(1, 16))
+          ->group("Scaled fleet (--vehicles)");
+  cli.option("anchors", c.scaled.n_anchors, "with --vehicles: anchors on the hall's grid, 4-400")
+      ->type_name("M")->check(CLI::Range(4, 400))->needs(vehicles)->group("Scaled fleet (--vehicles)");
+  cli.optional("fly-by", c.scaled.n_fly_by,
+               "with --vehicles: anchors left out of setup.yaml (seeded choice), calibrated in flight by the "
+               "generated mission (default 20 % of --anchors)")
+      ->type_name("K")->check(CLI::NonNegativeNumber)->needs(vehicles)->group("Scaled fleet (--vehicles)");
+  cli.optional("outage", c.outage,
+               "with --vehicles: the anchors do not answer vehicle V's tags from T0 to T1 s (its tag-to-tag ranges "
+               "go on): a vehicle without anchors among its neighbours")
+      ->type_name("V,T0,T1")->needs(vehicles)->group("Scaled fleet (--vehicles)");
+  cli.option("tdma-slot", c.scaled.tdma.slot_s,
+             "with --vehicles: the cell TDMA's slot, one SDS-TWR exchange with guard time [s]")
+      ->type_name("S")->check(cli_checks::positive())->needs(vehicles)->group("Scaled fleet (--vehicles)");
   cli.optional("trajectory", c.trajectory,
                "spiral|figure8|lawnmower|helix|hover|walk (default spiral: the paper's flight). hover starts in the "
                "air; walk is a hand-held rig at 0.9-1.5 m with no take-off, no landed state and no barometer "
@@ -203,6 +230,19 @@ void applyScenarioOptions(const meshnav::Cli& cli, SimCli& c) {
     throw std::invalid_argument("--uncertain-anchors must be in (0, 10) m");
   if (cli.given("fleet") && cli.given("uncertain-anchors"))
     throw std::invalid_argument("--uncertain-anchors is not supported with --fleet (its a-priori pair biases are drawn per vehicle)");
+  if (cli.given("vehicles"))
+    for (const char* other : {"fleet", "inter-vehicle-hz", "trajectory", "anchor-layout", "tags", "known", "unknown",
+                              "uncertain-anchors", "range-correlation"})
+      if (cli.given(other))
+        throw std::invalid_argument(std::string("--") + other + " is not an option of a scaled fleet (--vehicles)");
+  if (cli.given("outage")) {
+    std::istringstream in(c.outage);
+    char s1 = 0, s2 = 0;
+    auto& out = c.scaled.outage;
+    if (!(in >> out.vehicle >> s1 >> out.t0_s >> s2 >> out.t1_s) || s1 != ',' || s2 != ',' || !(in >> std::ws).eof() ||
+        out.vehicle < 0)
+      throw std::invalid_argument("--outage expects V,T0,T1 (vehicle index, seconds), got '" + c.outage + "'");
+  }
   if (c.uncertain_known && !cli.given("uncertain-anchors"))
     throw std::invalid_argument("--uncertain-known-anchors needs --uncertain-anchors M");
   o.seed = static_cast<uint64_t>(c.seed);
@@ -232,6 +272,39 @@ int simulateFleet(const meshnav::sim::SimulationOptions& options, int n, double 
   return 0;
 }
 
+/// --vehicles N: the datasets out/v0 ..., out/fleet.yaml, out/mission.yaml, out/anchors_layout.csv.
+int simulateScaledFleet(meshnav::sim::ScaledFleetOptions options, const meshnav::sim::SimulationOptions& base,
+                        const std::string& out) {
+  options.base = base;
+  try {
+    options.validate();
+  } catch (const std::exception& e) {
+    std::cerr << "meshnav_sim: " << e.what() << "\n(see meshnav_sim --help)\n";
+    return 2;
+  }
+  spdlog::info("{}", options.toString());
+  const auto fleet = meshnav::sim::simulateScaledFleet(options);
+  std::filesystem::create_directories(out);
+  std::string list;
+  for (size_t k = 0; k < fleet.vehicles.size(); ++k) {
+    const std::string name = "v" + std::to_string(k);
+    spdlog::info("writing vehicle {} ({}/{})", name, k + 1, fleet.vehicles.size());
+    meshnav::writeDataset(fleet.vehicles[k].dataset, (std::filesystem::path(out) / name).string());
+    list += "  - {name: " + name + ", dataset: " + name + "}\n";
+  }
+  const std::filesystem::path dir(out);
+  meshnav::writeFileAtomically((dir / "fleet.yaml").string(), [&](std::ostream& file) {
+    file << "# a simulated fleet (meshnav_sim --vehicles " << options.n_vehicles << " --anchors " << options.n_anchors
+         << " --seed " << base.seed << "): one hall, one anchor map; docs/fleet.md\nvehicles:\n"
+         << list;
+  });
+  meshnav::writeFileAtomically((dir / "mission.yaml").string(), [&](std::ostream& file) { file << fleet.mission_yaml; });
+  meshnav::writeFileAtomically((dir / "anchors_layout.csv").string(), [&](std::ostream& file) { file << fleet.layout_csv; });
+  std::cout << fleet.description << "Fleet of " << options.n_vehicles << " written to " << out
+            << " (fleet.yaml, mission.yaml, anchors_layout.csv)" << std::endl;
+  return 0;
+}
+
 /// The work of main: the scenario options checked (a bad combination: exit 2), then the sequence
 /// simulated and written.
 int simulate(const meshnav::Cli& cli, SimCli& c) {
@@ -242,6 +315,7 @@ int simulate(const meshnav::Cli& cli, SimCli& c) {
     return 2;
   }
   const auto& options = c.sim;
+  if (cli.given("vehicles")) return simulateScaledFleet(c.scaled, options, c.out);
   spdlog::info("simulating: {}", options.toString());
   if (cli.given("fleet")) return simulateFleet(options, c.fleet, c.inter_vehicle_hz, c.out);
   const meshnav::sim::ScenarioSimulator simulator(options);
