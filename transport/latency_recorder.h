@@ -13,6 +13,12 @@
 ///    the POSE, without the wait for the next IMU sample (data time, not processing).
 /// Messages per second are counts over the first to the last receive time of all channels.
 ///
+/// Lost messages (`./meshnav bench lcm --fleet`): an IMU sample whose data time lies between the
+/// first and the last POSE and that no POSE answers (imusUnanswered: lost on its way to the
+/// estimator, or its POSE lost on the way back); a POSE whose IMU sample the probe never received
+/// (posesWithoutImu: an IMU lost on the way to the probe); RANGE unanswered (rangesUnanswered).
+/// One recorder per vehicle in a fleet (the probe's --channel-prefixes).
+///
 /// Free of LCM: fed with (data utime, receive utime) pairs; unit-tested.
 
 #include <cstdint>
@@ -43,6 +49,10 @@ class LatencyRecorder {
   /// (after the last POSE, before initialization) are counted in rangesUnanswered().
   LatencyStats rangeToPose() const;
   size_t rangesUnanswered() const;
+  /// IMU samples stamped within [first POSE, last POSE] that no POSE of the same stamp answers.
+  size_t imusUnanswered() const;
+  /// POSEs whose IMU sample (same stamp) was not received.
+  size_t posesWithoutImu() const;
   /// Messages per second per channel, over the span of all receive times.
   std::map<std::string, double> ratesHz() const;
   std::map<std::string, int64_t> counts() const { return counts_; }

@@ -47,6 +47,20 @@ LatencyStats LatencyRecorder::rangeToPose() const {
 
 size_t LatencyRecorder::rangesUnanswered() const { return ranges_.size() - rangeToPose().n; }
 
+size_t LatencyRecorder::imusUnanswered() const {
+  if (poses_.empty()) return 0;
+  const int64_t first = poses_.begin()->first, last = poses_.rbegin()->first;
+  size_t n = 0;
+  for (auto it = imu_.lower_bound(first); it != imu_.end() && it->first <= last; ++it) n += poses_.count(it->first) == 0;
+  return n;
+}
+
+size_t LatencyRecorder::posesWithoutImu() const {
+  size_t n = 0;
+  for (const auto& [u, recv] : poses_) n += imu_.count(u) == 0;
+  return n;
+}
+
 std::map<std::string, double> LatencyRecorder::ratesHz() const {
   std::map<std::string, double> out;
   const double span_s = static_cast<double>(last_recv_ - first_recv_) * 1e-6;

@@ -55,3 +55,18 @@ TEST(LatencyRecorder, ALateRangeIsAnsweredByTheFirstPoseAfterItCame) {
   ASSERT_EQ(range.n, 1u);
   EXPECT_DOUBLE_EQ(range.median_us, 40.0);  // POSE 15 ms at 15 040 − max(11 000, 15 000)
 }
+
+// Lost messages: IMU samples before the first POSE (the estimator initializing) are not lost; one
+// between the first and the last POSE without its POSE is; a POSE whose IMU sample the probe
+// never got counts that IMU as lost on the way to the probe.
+TEST(LatencyRecorder, CountsImuSamplesWithoutPoseAndPosesWithoutImu) {
+  LatencyRecorder r;
+  for (int k = 0; k < 10; ++k) {
+    const int64_t t = k * 5'000;
+    if (k != 7) r.onImu(t, t + 100);  // IMU 7 lost on the way to the probe
+    if (k >= 3 && k != 5) r.onPose(t, t + 130);  // none before 3 (initializing), POSE 5 lost
+  }
+  EXPECT_EQ(r.imusUnanswered(), 1u);   // IMU 5
+  EXPECT_EQ(r.posesWithoutImu(), 1u);  // POSE 7
+  EXPECT_EQ(r.imuToPose().n, 5u);      // POSE 3, 4, 6, 8, 9
+}
