@@ -80,12 +80,14 @@ run_fleet() {
   echo "[bench lcm] simulate $vehicles vehicles x $anchors anchors, hall $hall, seed $seed${duration:+, ${duration} s}" >&2
   rm -rf "$data"
   "$BIN/meshnav_sim" "${sim_args[@]}" --out "$data" > "$out/sim.log" 2>&1 || fail "meshnav_sim failed"
+  # 10 s after the data: an estimator behind (a loaded machine, --rate 10) answers all it was sent.
   "$BIN/meshnav_fleet_launch" --fleet "$data/fleet.yaml" --out "$launch" --no-logging --estimator-config "$config" \
+    --shutdown-delay 10 \
     > "$out/fleet_launch.log" 2>&1 || fail "meshnav_fleet_launch failed"
   local prefixes
   prefixes=$(python3 -c 'import sys, yaml; print(",".join(v["name"] for v in yaml.safe_load(open(sys.argv[1]))["vehicles"]))' \
     "$data/fleet.yaml") || fail "cannot read $data/fleet.yaml"
-  "$BIN/meshnav_lcm_probe" --channel-prefixes "$prefixes" --out "$out/probe.yaml" > "$out/probe.log" 2>&1 &
+  "$BIN/meshnav_lcm_probe" --fleet "$data/fleet.yaml" --out "$out/probe.yaml" > "$out/probe.log" 2>&1 &
   local probe=$!; PIDS+=("$probe")
   local load_start; load_start=$(cut -d' ' -f1-3 /proc/loadavg)
   echo "[bench lcm] launch $launch at ${rate}x (vehicles $prefixes; load average $load_start)" >&2
@@ -113,9 +115,14 @@ run_fleet() {
     fail "an estimator reported an error: these figures are not the estimators' at work"
   fi
   {
-    echo "cpu_percent_of_a_core:  # user + system over each process's own wall time (its start to its last sample)"
+    # The data's wall time: the flight (v0's imu.csv) over the rate. Each process's CPU seconds of
+    # its whole life (start-up, the wait for the data and the drain after it included) over it.
+    local span
+    span=$(awk -F, -v r="$rate" '$1 ~ /^[0-9.]+$/ { if (f == "") f = $1; l = $1 } END { print (l - f) / (r > 0 ? r : 1) }' \
+      "$data/v0/imu.csv")
+    echo "cpu_percent_of_a_core:  # user + system CPU seconds of each process's life over the ${span} s of wall time of the data"
     for name in $(printf '%s\n' "${!cpu[@]}" | sort); do
-      awk -v n="$name" -v c="${cpu[$name]}" -v w="${age[$name]}" 'BEGIN { printf "  %s: %.2f\n", n, (w > 0 ? 100 * c / w : 0) }'
+      awk -v n="$name" -v c="${cpu[$name]}" -v w="$span" 'BEGIN { printf "  %s: %.2f\n", n, (w > 0 ? 100 * c / w : 0) }'
     done
     echo "published:  # what each bridge said it published"
     for v in ${prefixes//,/ }; do
@@ -147,10 +154,11 @@ for v, f in probe["vehicles"].items():
     cpu = extra["cpu_percent_of_a_core"]
     msgs = sum(c["per_s"] for c in got.values())
     l = lost[v]
+    o = f.get("other_range_to_pose", {"n": 0, "p99_us": 0})
     rows.append(f"| {v} | {r['n']} | {r['median_us']:.0f} µs | {r['p99_us'] / 1e3:.2f} ms | {r['max_us'] / 1e3:.1f} ms "
                 f"| {i['p99_us'] / 1e3:.2f} ms | {cpu.get(v + '_estimator', 0):.1f} | {cpu.get(v + '_imu_bridge', 0):.1f} / "
                 f"{cpu.get(v + '_uwb_bridge', 0):.1f} | {msgs:.0f} | {l['IMU_not_received']} / {l['RANGE_not_received']} "
-                f"| {l['imus_unanswered']} / {l['ranges_unanswered']} |")
+                f"| {l['imus_unanswered']} / {l['ranges_unanswered']} | {o['n']}, p99 {o['p99_us'] / 1e3:.2f} ms |")
 with open(os.path.join(out, "bench_lcm.yaml"), "w") as y:
     y.write(head + "\n")
     y.write(open(os.path.join(out, "probe.yaml")).read())
@@ -161,9 +169,10 @@ with open(os.path.join(out, "bench_lcm.yaml"), "w") as y:
 with open(os.path.join(out, "table.md"), "w") as t:
     t.write(f"{head[2:]}; load average (1 min) during the run: mean {sum(loads) / len(loads):.1f}, "
             f"max {max(loads):.1f}\n\n")
-    t.write("| vehicle | RANGE | RANGE → POSE median | p99 | max | IMU → POSE p99 | estimator CPU [% of a core] "
-            "| imu / uwb bridge CPU | messages/s | lost to the probe IMU / RANGE | unanswered IMU / RANGE |\n")
-    t.write("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n")
+    t.write("| vehicle | tag-anchor RANGE | RANGE → POSE median | p99 | max | IMU → POSE p99 "
+            "| estimator CPU [% of a core] | imu / uwb bridge CPU | messages/s | lost to the probe IMU / RANGE "
+            "| unanswered IMU / RANGE | other RANGE (mesh, tag-tag) |\n")
+    t.write("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n")
     t.write("\n".join(rows) + "\n")
     t.write(f"\nprobe CPU {extra['cpu_percent_of_a_core'].get('lcm_probe', 0):.1f} % of a core; "
             f"all channels {sum(c['per_s'] for c in probe['channels'].values()):.0f} messages/s\n")

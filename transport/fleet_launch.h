@@ -29,6 +29,9 @@ struct FleetLaunchOptions {
   std::string estimator_config = "config/fleet_scale.yaml";
   bool logging = true;          ///< a logger per vehicle (`--channel-prefix`, writing ${OUT}/<vehicle>)
   double wait_timeout_s = 60.0;  ///< bridges give up when their estimator's ESTIMATOR_STATUS is not heard [s]
+  /// Wall time [s] between the last bridge's end and the stop of the others: what an estimator
+  /// still has queued is fused and published meanwhile (the bench waits longer than a run).
+  double shutdown_delay_s = 2.0;
   std::string source;            ///< the fleet file's path, named in the header comment
 };
 

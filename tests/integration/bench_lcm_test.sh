@@ -47,13 +47,16 @@ for v, f in y["vehicles"].items():
         if f"{v}_{p}" not in y["cpu_percent_of_a_core"]:
             sys.exit(f"FAIL: no CPU figure of {v}_{p}")
     r, i, lost, pub = f["range_to_pose"], f["imu_to_pose"], y["lost"][v], y["published"][v]
-    print(f"{v}: IMU published {pub['IMU']}, answered {i['n']}; RANGE published {pub['RANGE']}, answered {r['n']}; lost {lost}")
+    print(f"{v}: IMU published {pub['IMU']}, answered {i['n']}; RANGE published {pub['RANGE']}, tag-anchor ones answered {r['n']}; lost {lost}")
     if pub["IMU"] == 0 or pub["RANGE"] == 0:
         sys.exit(f"FAIL: {v}'s bridges published nothing")
     if i["n"] < pub["IMU"] / 2:
         sys.exit(f"FAIL: only {i['n']} of {pub['IMU']} IMU samples of {v} answered by a POSE")
-    if r["n"] != pub["RANGE"] or f["ranges_unanswered"] != 0:
-        sys.exit(f"FAIL: {r['n']} of {pub['RANGE']} RANGE of {v} answered")
+    other = f.get("other_range_to_pose", {"n": 0})["n"]
+    if r["n"] != f["fused_ranges"] or r["n"] + other != pub["RANGE"] or f["ranges_unanswered"] != 0:
+        sys.exit(f"FAIL: {r['n']} + {other} of {pub['RANGE']} RANGE of {v} answered")
+    if not 0 < r["n"] < pub["RANGE"]:
+        sys.exit(f"FAIL: {r['n']} of {pub['RANGE']} RANGE of {v} taken as its tags' to anchors")
     if any(n != 0 for n in lost.values()):
         sys.exit(f"FAIL: {v} lost messages: {lost}")
 rows = [l for l in open(os.path.join(out, "table.md")) if l.startswith("| v0 ") or l.startswith("| v1 ")]

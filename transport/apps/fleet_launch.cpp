@@ -32,6 +32,11 @@ int main(int argc, char** argv) {
   cli.option("wait-timeout", o.wait_timeout_s, "bridges give up when their estimator is not heard within S seconds")
       ->type_name("S")
       ->check(cli::positive());
+  cli.option("shutdown-delay", o.shutdown_delay_s,
+             "wall seconds from the end of the last bridge's data to the stop of the others (an estimator fuses what "
+             "it still has queued meanwhile)")
+      ->type_name("S")
+      ->check(cli::nonNegative());
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   setupLogging("meshnav_fleet_launch");

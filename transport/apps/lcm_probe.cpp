@@ -3,7 +3,9 @@
 /// (median, p99, max) from its own receive times, lost messages (IMU without POSE, POSE without
 /// IMU, RANGE without POSE) and messages per second per channel (transport/latency_recorder.h says
 /// what each figure is). With --channel-prefixes P1,P2,... (a fleet over LCM, `bench lcm --fleet`)
-/// it does so per vehicle, on each vehicle's channels (channels::prefixed). It runs until
+/// it does so per vehicle, on each vehicle's channels (channels::prefixed); with --fleet FILE the
+/// prefixes are the fleet's vehicle names and RANGE → POSE is over each vehicle's tag–anchor ranges
+/// (its setup.yaml's tags), the others (anchor mesh, tag to tag) measured apart. It runs until
 /// SIGINT/SIGTERM or --duration, then writes --out (YAML) and prints it.
 #include <chrono>
 #include <fstream>
@@ -14,6 +16,8 @@
 #include <sstream>
 
 #include "common/cli.h"
+#include "common/fleet_file.h"
+#include "common/setup.h"
 #include "transport/channels.h"
 #include "transport/convert.h"
 #include "transport/latency_recorder.h"
@@ -47,6 +51,8 @@ std::string figures(const LatencyRecorder& rec, const std::string& indent) {
   };
   stats("imu_to_pose", rec.imuToPose());
   stats("range_to_pose", rec.rangeToPose());
+  if (rec.otherRangeToPose().n > 0) stats("other_range_to_pose", rec.otherRangeToPose());
+  y << indent << "fused_ranges: " << rec.fusedRanges() << "  # RANGE the estimator updates with (all without --fleet)\n";
   y << indent << "ranges_unanswered: " << rec.rangesUnanswered() << "\n";
   y << indent << "imus_unanswered: " << rec.imusUnanswered() << "  # IMU between the first and the last POSE without its POSE\n";
   y << indent << "poses_without_imu: " << rec.posesWithoutImu() << "  # POSE whose IMU sample the probe did not receive\n";
@@ -64,7 +70,7 @@ int main(int argc, char** argv) {
           "Measures IMU -> POSE and RANGE -> POSE latency (median, p99, max, from this process's receive times), lost "
           "messages and messages per second per channel over LCM, for one vehicle or per vehicle of a fleet "
           "(--channel-prefixes), until SIGINT/SIGTERM or --duration; writes --out (YAML).");
-  std::string out, url, prefix_list;
+  std::string out, url, prefix_list, fleet_file;
   double duration_s = 0.0;
   cli.optional("out", out, "where to write the figures (YAML)")->type_name("FILE")->required();
   cli.option("duration", duration_s, "stop after S seconds of wall time (0: at SIGINT/SIGTERM) [s]")
@@ -87,14 +93,43 @@ int main(int argc, char** argv) {
             return seen.empty() ? std::string("no prefix given") : std::string();
           },
           "", "vehicle prefixes"));
+  cli.optional("fleet", fleet_file,
+               "a fleet file (docs/fleet.md): its vehicle names are the prefixes, and each vehicle's RANGE -> POSE is "
+               "over the ranges of its tags (its setup.yaml) to anchors; the others (anchor mesh, tag to tag) go to "
+               "other_range_to_pose")
+      ->type_name("FILE")
+      ->excludes("--channel-prefixes");
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   StopSignal::install();
   std::vector<std::string> prefixes;
+  std::map<std::string, std::set<SensorId>> tags;  // prefix -> its tags (--fleet)
+  std::set<SensorId> every_tag;
+  try {
+    if (!fleet_file.empty()) {
+      for (const FleetEntry& v : loadFleetFile(fleet_file)) {
+        prefixes.push_back(v.name);
+        for (const auto& [id, p] : loadSetup(v.dataset + "/setup.yaml").rel_tag_positions) {
+          tags[v.name].insert(id);
+          every_tag.insert(id);
+        }
+      }
+    }
+  } catch (const std::exception& ex) {
+    std::cerr << "meshnav_lcm_probe: " << ex.what() << "\n";
+    return 1;
+  }
   {
     std::stringstream ss(prefix_list);
     for (std::string p; std::getline(ss, p, ',');) prefixes.push_back(p);
   }
+  // A range the estimator of `prefix` fuses: one of its tags to a device that is no tag (with --fleet).
+  auto fused = [&](const std::string& prefix, const RangeSample& r) {
+    const auto it = tags.find(prefix);
+    if (it == tags.end()) return true;
+    const bool a = it->second.count(r.id_initiator) > 0, b = it->second.count(r.id_responder) > 0;
+    return (a && !every_tag.count(r.id_responder)) || (b && !every_tag.count(r.id_initiator));
+  };
   const bool fleet = !prefixes.empty();
   if (!fleet) prefixes.push_back("");
   std::map<std::string, LatencyRecorder> per_vehicle;  // prefix -> its recorder
@@ -108,8 +143,13 @@ int main(int argc, char** argv) {
       node.subscribeRaw(imu, [&rec](const lcm::ReceiveBuffer& rb, const std::string&) {
         if (auto u = utimeOf(channels::kImu, rb)) rec.onImu(*u, rb.recv_utime);
       });
-      node.subscribeRaw(range, [&rec](const lcm::ReceiveBuffer& rb, const std::string&) {
-        if (auto u = utimeOf(channels::kRange, rb)) rec.onRange(*u, rb.recv_utime);
+      node.subscribeRaw(range, [&rec, &fused, p](const lcm::ReceiveBuffer& rb, const std::string&) {
+        WireType<RangeSample> msg;
+        try {
+          if (decodeAnyVersion(rb.data, rb.data_size, msg) < 0) return;
+          rec.onRange(msg.utime, rb.recv_utime, fused(p, fromWire<RangeSample>(msg)));
+        } catch (const std::exception&) {
+        }
       });
       node.subscribeRaw(pose, [&rec](const lcm::ReceiveBuffer& rb, const std::string&) {
         if (auto u = utimeOf(channels::kPose, rb)) rec.onPose(*u, rb.recv_utime);

@@ -52,7 +52,7 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
   y << YAML::Key << "stop_timeout" << YAML::Value << 5;
   y << YAML::Key << "t0_margin" << YAML::Value << 3.0;
   y << YAML::Key << "shutdown_after" << YAML::Value << YAML::Flow << bridges;
-  y << YAML::Key << "shutdown_delay" << YAML::Value << 2.0;
+  y << YAML::Key << "shutdown_delay" << YAML::Value << o.shutdown_delay_s;
   if (o.logging) y << YAML::Key << "stop_last" << YAML::Value << YAML::Flow << loggers;
   y << YAML::Key << "processes" << YAML::Value << YAML::BeginSeq;
   const std::string wait = fmtSeconds(o.wait_timeout_s);

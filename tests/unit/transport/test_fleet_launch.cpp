@@ -39,6 +39,7 @@ TEST(FleetLaunch, EveryVehicleRunsItsBridgesAndEstimatorOnItsOwnPrefix) {
   EXPECT_EQ(strings(y["shutdown_after"]),
             (std::vector<std::string>{"v0_imu_bridge", "v0_uwb_bridge", "v1_imu_bridge", "v1_uwb_bridge"}));
   EXPECT_EQ(strings(y["stop_last"]), (std::vector<std::string>{"v0_logging", "v1_logging"}));
+  EXPECT_DOUBLE_EQ(y["shutdown_delay"].as<double>(), 2.0);
   for (const std::string v : {"v0", "v1"}) {
     const auto est = strings(by_name.at(v + "_estimator")["args"]);
     EXPECT_EQ(by_name.at(v + "_estimator")["command"].as<std::string>(), "${BIN:-build/bin}/estimator");

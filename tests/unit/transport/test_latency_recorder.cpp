@@ -70,3 +70,20 @@ TEST(LatencyRecorder, CountsImuSamplesWithoutPoseAndPosesWithoutImu) {
   EXPECT_EQ(r.posesWithoutImu(), 1u);  // POSE 7
   EXPECT_EQ(r.imuToPose().n, 5u);      // POSE 3, 4, 6, 8, 9
 }
+
+// Ranges the estimator does not fuse (anchor mesh, another vehicle's tag) are kept apart: RANGE →
+// POSE is over the fused ones only, and every range counts when it is unanswered.
+TEST(LatencyRecorder, RangesNotFusedAreMeasuredApart) {
+  LatencyRecorder r;
+  r.onImu(10'000, 10'000);
+  r.onRange(9'000, 9'500, true);
+  r.onRange(9'100, 9'600, false);
+  r.onPose(10'000, 10'300);
+  r.onRange(11'000, 11'000, false);  // after the last POSE
+  EXPECT_EQ(r.fusedRanges(), 1u);
+  EXPECT_EQ(r.rangeToPose().n, 1u);
+  EXPECT_DOUBLE_EQ(r.rangeToPose().median_us, 300.0);
+  EXPECT_EQ(r.otherRangeToPose().n, 1u);
+  EXPECT_EQ(r.rangesUnanswered(), 1u);
+  EXPECT_EQ(r.counts().at("RANGE"), 3);
+}
