@@ -149,6 +149,7 @@ for v, f in probe["vehicles"].items():
     lost[v] = {"IMU_not_received": pub["IMU"] - got.get("IMU", {}).get("messages", 0),
                "RANGE_not_received": pub["RANGE"] - got.get("RANGE", {}).get("messages", 0),
                "imus_unanswered": f["imus_unanswered"], "ranges_unanswered": f["ranges_unanswered"],
+               "ranges_after_last_pose": f["ranges_after_last_pose"],
                "poses_without_imu": f["poses_without_imu"]}
     r, i = f["range_to_pose"], f["imu_to_pose"]
     cpu = extra["cpu_percent_of_a_core"]

@@ -20,7 +20,8 @@
 /// Lost messages (`./meshnav bench lcm --fleet`): an IMU sample whose data time lies between the
 /// first and the last POSE and that no POSE answers (imusUnanswered: lost on its way to the
 /// estimator, or its POSE lost on the way back); a POSE whose IMU sample the probe never received
-/// (posesWithoutImu: an IMU lost on the way to the probe); RANGE unanswered (rangesUnanswered).
+/// (posesWithoutImu: an IMU lost on the way to the probe); RANGE unanswered (rangesUnanswered),
+/// apart from those received after the last POSE (rangesAfterLastPose).
 /// One recorder per vehicle in a fleet (the probe's --channel-prefixes).
 ///
 /// Free of LCM: fed with (data utime, receive utime) pairs; unit-tested.
@@ -57,8 +58,11 @@ class LatencyRecorder {
   LatencyStats rangeToPose() const;
   /// The same over the ranges not marked `fused` (empty when every range was).
   LatencyStats otherRangeToPose() const;
-  /// RANGE, fused or not, that no later POSE answers.
+  /// RANGE, fused or not, that no later POSE answers, not counting those received after the last
+  /// POSE (rangesAfterLastPose: no POSE could answer them).
   size_t rangesUnanswered() const;
+  /// RANGE received after the last POSE was (the end of the data: their IMU sample's POSE had left).
+  size_t rangesAfterLastPose() const;
   /// How many RANGE were marked `fused`.
   size_t fusedRanges() const { return ranges_.size(); }
   /// IMU samples stamped within [first POSE, last POSE] that no POSE of the same stamp answers.

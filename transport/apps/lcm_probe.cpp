@@ -53,7 +53,8 @@ std::string figures(const LatencyRecorder& rec, const std::string& indent) {
   stats("range_to_pose", rec.rangeToPose());
   if (rec.otherRangeToPose().n > 0) stats("other_range_to_pose", rec.otherRangeToPose());
   y << indent << "fused_ranges: " << rec.fusedRanges() << "  # RANGE the estimator updates with (all without --fleet)\n";
-  y << indent << "ranges_unanswered: " << rec.rangesUnanswered() << "\n";
+  y << indent << "ranges_unanswered: " << rec.rangesUnanswered() << "  # received before the last POSE, answered by none\n";
+  y << indent << "ranges_after_last_pose: " << rec.rangesAfterLastPose() << "  # the end of the data: no POSE could answer them\n";
   y << indent << "imus_unanswered: " << rec.imusUnanswered() << "  # IMU between the first and the last POSE without its POSE\n";
   y << indent << "poses_without_imu: " << rec.posesWithoutImu() << "  # POSE whose IMU sample the probe did not receive\n";
   y << indent << "channels:\n";

@@ -50,8 +50,17 @@ LatencyStats LatencyRecorder::toPose(const std::vector<Stamped>& ranges, const s
   return LatencyStats::of(std::move(s));
 }
 
+size_t LatencyRecorder::rangesAfterLastPose() const {
+  int64_t last = 0;
+  for (const auto& [u, recv] : poses_) last = std::max(last, recv);
+  size_t n = 0;
+  for (const auto* v : {&ranges_, &other_ranges_})
+    for (const Stamped& r : *v) n += r.recv_utime > last;
+  return n;
+}
+
 size_t LatencyRecorder::rangesUnanswered() const {
-  return ranges_.size() + other_ranges_.size() - rangeToPose().n - otherRangeToPose().n;
+  return ranges_.size() + other_ranges_.size() - rangeToPose().n - otherRangeToPose().n - rangesAfterLastPose();
 }
 
 size_t LatencyRecorder::imusUnanswered() const {

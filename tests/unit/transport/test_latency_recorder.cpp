@@ -35,8 +35,9 @@ TEST(LatencyRecorder, ImuAndRangeToPoseWithoutTheWaitForTheNextImuSample) {
   EXPECT_DOUBLE_EQ(imu.median_us, 30.0);
   EXPECT_DOUBLE_EQ(imu.max_us, 30.0);
   const LatencyStats range = r.rangeToPose();
-  EXPECT_EQ(range.n, 99u);  // the last RANGE has no later POSE
-  EXPECT_EQ(r.rangesUnanswered(), 1u);
+  EXPECT_EQ(range.n, 99u);  // the last RANGE has no later POSE: it came after the last one
+  EXPECT_EQ(r.rangesUnanswered(), 0u);
+  EXPECT_EQ(r.rangesAfterLastPose(), 1u);
   EXPECT_DOUBLE_EQ(range.median_us, 30.0);
   EXPECT_EQ(r.counts().at("IMU"), 100);
   EXPECT_NEAR(r.ratesHz().at("IMU"), 100.0 / 0.497, 0.5);  // over 100 µs … 497 ms + 130 µs of receive times
@@ -84,6 +85,20 @@ TEST(LatencyRecorder, RangesNotFusedAreMeasuredApart) {
   EXPECT_EQ(r.rangeToPose().n, 1u);
   EXPECT_DOUBLE_EQ(r.rangeToPose().median_us, 300.0);
   EXPECT_EQ(r.otherRangeToPose().n, 1u);
-  EXPECT_EQ(r.rangesUnanswered(), 1u);
+  EXPECT_EQ(r.rangesUnanswered(), 0u);
+  EXPECT_EQ(r.rangesAfterLastPose(), 1u);
   EXPECT_EQ(r.counts().at("RANGE"), 3);
+}
+
+// A RANGE whose POSE was lost (received before the last POSE, none after it at or past its time)
+// is unanswered; one received after the last POSE is not (nothing could answer it).
+TEST(LatencyRecorder, ARangeBeforeTheLastPoseWithoutAnswerIsUnanswered) {
+  LatencyRecorder r;
+  r.onImu(10'000, 10'000);
+  r.onPose(10'000, 10'100);
+  r.onRange(12'000, 12'050);  // its POSE (of a later IMU sample) never came
+  r.onPose(5'000, 13'000);    // a late re-published older POSE: the last one received
+  r.onRange(13'000, 13'500);  // after the last POSE
+  EXPECT_EQ(r.rangesUnanswered(), 1u);
+  EXPECT_EQ(r.rangesAfterLastPose(), 1u);
 }
