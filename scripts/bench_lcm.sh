@@ -17,6 +17,9 @@
 #   --fleet                5 vehicles x 100 anchors in a 40 x 40 x 10 m hall unless given:
 #   --vehicles N  --anchors M  --hall X,Y,Z  --duration S (seconds of flight, meshnav_sim's)
 #   --config FILE          estimator options (default config/fleet_scale.yaml)
+# With --fleet, RANGE -> POSE is over each vehicle's tag-anchor ranges; CPU = CPU seconds of a
+# process's life over the wall seconds of the data; lost = published but not received, or not
+# answered by a POSE. `chrt -f 20 ./meshnav bench lcm --fleet` runs every process under SCHED_FIFO.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${MESHNAV_BUILD_DIR:-$ROOT/build}/bin"
@@ -35,7 +38,7 @@ while [[ $# -gt 0 ]]; do
     --hall) hall="$2"; shift 2 ;;
     --duration) duration="$2"; shift 2 ;;
     --config) config="$2"; shift 2 ;;
-    -h|--help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     *) echo "bench_lcm: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
