@@ -17,6 +17,8 @@
 #   --fleet                5 vehicles x 100 anchors in a 40 x 40 x 10 m hall unless given:
 #   --vehicles N  --anchors M  --hall X,Y,Z  --duration S (seconds of flight, meshnav_sim's)
 #   --config FILE          estimator options (default config/fleet_scale.yaml)
+#   --calibrator-for NAME  a calibrator and the fleet's mission.yaml serving vehicle NAME alone over
+#                          LCM, so that it gets its fly-by anchors (none serves the whole fleet yet)
 # With --fleet, RANGE -> POSE is over each vehicle's tag-anchor ranges; CPU = CPU seconds of a
 # process's life over the wall seconds of the data; lost = published but not received, or not
 # answered by a POSE. `chrt -f 20 ./meshnav bench lcm --fleet` runs every process under SCHED_FIFO.
@@ -24,7 +26,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${MESHNAV_BUILD_DIR:-$ROOT/build}/bin"
 seed=1; scale=""; rate=1; out="$ROOT/out/bench-lcm"
-fleet=0; vehicles=5; anchors=100; hall=40,40,10; duration=""; config="$ROOT/config/fleet_scale.yaml"
+fleet=0; vehicles=5; anchors=100; hall=40,40,10; duration=""; config="$ROOT/config/fleet_scale.yaml"; calib_for=""
 args=("$@")
 while [[ $# -gt 0 ]]; do
   case "$1" in
@@ -38,12 +40,13 @@ while [[ $# -gt 0 ]]; do
     --hall) hall="$2"; shift 2 ;;
     --duration) duration="$2"; shift 2 ;;
     --config) config="$2"; shift 2 ;;
+    --calibrator-for) calib_for="$2"; shift 2 ;;
     -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     *) echo "bench_lcm: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
 if (( ! fleet )); then
-  for o in --vehicles --anchors --hall --duration --config; do
+  for o in --vehicles --anchors --hall --duration --config --calibrator-for; do
     [[ " ${args[*]} " == *" $o "* ]] && { echo "bench_lcm: $o needs --fleet" >&2; exit 2; }
   done
 fi
@@ -83,9 +86,12 @@ run_fleet() {
   echo "[bench lcm] simulate $vehicles vehicles x $anchors anchors, hall $hall, seed $seed${duration:+, ${duration} s}" >&2
   rm -rf "$data"
   "$BIN/meshnav_sim" "${sim_args[@]}" --out "$data" > "$out/sim.log" 2>&1 || fail "meshnav_sim failed"
+  local calib_args=()
+  [[ -n "$calib_for" ]] && calib_args=(--calibrator-for "$calib_for" --mission "$data/mission.yaml"
+                                       --calibrator-config "$ROOT/config/calibrator.yaml")
   # 10 s after the data: an estimator behind (a loaded machine, --rate 10) answers all it was sent.
   "$BIN/meshnav_fleet_launch" --fleet "$data/fleet.yaml" --out "$launch" --no-logging --estimator-config "$config" \
-    --shutdown-delay 10 \
+    --shutdown-delay 10 "${calib_args[@]}" \
     > "$out/fleet_launch.log" 2>&1 || fail "meshnav_fleet_launch failed"
   local prefixes
   prefixes=$(python3 -c 'import sys, yaml; print(",".join(v["name"] for v in yaml.safe_load(open(sys.argv[1]))["vehicles"]))' \
@@ -136,14 +142,15 @@ run_fleet() {
     done
     echo "load_average: {start: \"$load_start\", end: \"$(cut -d' ' -f1-3 /proc/loadavg)\", 1min_samples: [$(paste -sd, "$out/load.txt")]}"
   } > "$out/fleet_extra.yaml"
-  python3 - "$out" "$seed" "$vehicles" "$anchors" "$hall" "${duration:-default}" "$rate" "$config" <<'PY'
+  python3 - "$out" "$seed" "$vehicles" "$anchors" "$hall" "${duration:-default}" "$rate" "$config" "$calib_for" <<'PY'
 import datetime, os, sys, yaml
-out, seed, nv, na, hall, duration, rate, config = sys.argv[1:]
+out, seed, nv, na, hall, duration, rate, config, calib_for = sys.argv[1:]
 probe = yaml.safe_load(open(os.path.join(out, "probe.yaml")))
 extra = yaml.safe_load(open(os.path.join(out, "fleet_extra.yaml")))
 loads = extra["load_average"]["1min_samples"] or [0.0]
 head = (f"# ./meshnav bench lcm --fleet, {datetime.datetime.utcnow():%Y-%m-%dT%H:%M:%SZ}, {nv} vehicles x {na} anchors, "
-        f"hall {hall}, seed {seed}, duration {duration}, rate {rate}x, estimator config {config}, {os.cpu_count()} cores")
+        f"hall {hall}, seed {seed}, duration {duration}, rate {rate}x, estimator config {config}, "
+        f"{'a calibrator and mission for ' + calib_for + ', ' if calib_for else ''}{os.cpu_count()} cores")
 lost = {}
 rows = []
 for v, f in probe["vehicles"].items():

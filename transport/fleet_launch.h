@@ -9,7 +9,7 @@
 /// `meshnav_fleet_launch`). No calibrator and no mission (docs/fleet.md, "Not done yet").
 ///
 /// Process names are `<vehicle>_estimator`, `<vehicle>_imu_bridge`, `<vehicle>_uwb_bridge`,
-/// `<vehicle>_logging`; the launch stops when every bridge has played its data
+/// `<vehicle>_logging` (and `<vehicle>_calibrator`, `<vehicle>_mission` for `calibrator_for`); the launch stops when every bridge has played its data
 /// (`shutdown_after`), the loggers last (`stop_last`). Variables of the generated file: BIN
 /// (default build/bin), RATE (default 1), DATA_T0 (default 0), ESTIMATOR_CONFIG (default the
 /// generator's `estimator_config`), OUT (only with `logging`: OUT/<vehicle>/ gets the logger's files
@@ -33,10 +33,18 @@ struct FleetLaunchOptions {
   /// still has queued is fused and published meanwhile (the bench waits longer than a run).
   double shutdown_delay_s = 2.0;
   std::string source;            ///< the fleet file's path, named in the header comment
+  /// Non-empty: a calibrator and (with `mission`) a mission serving this one vehicle over LCM
+  /// (`--channel-prefix` it: its RANGE, POSE, ANCHORS in, its ANCHOR_INIT out; CALIB_CMD and
+  /// CALIB_STATUS are the fleet's), so that it gets its fly-by anchors; a calibrator serving the
+  /// whole fleet over LCM does not exist (docs/fleet.md).
+  std::string calibrator_for;
+  std::string mission;                                  ///< mission file of that vehicle's mission ("" none)
+  std::string calibrator_config = "config/calibrator.yaml";  ///< the calibrator's options
 };
 
 /// The launch file (YAML text) of `vehicles`. Throws std::invalid_argument for a vehicle name that
-/// is no channel prefix (channels::prefixProblem; loadFleetFile already refuses those).
+/// is no channel prefix (channels::prefixProblem; loadFleetFile already refuses those) and for a
+/// `calibrator_for` that names no vehicle.
 std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const FleetLaunchOptions& options);
 
 }  // namespace meshnav::transport

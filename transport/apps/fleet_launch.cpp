@@ -37,6 +37,15 @@ int main(int argc, char** argv) {
              "it still has queued meanwhile)")
       ->type_name("S")
       ->check(cli::nonNegative());
+  cli.optional("calibrator-for", o.calibrator_for,
+               "a calibrator serving this vehicle alone over LCM (its fly-by anchors; a calibrator serving the fleet "
+               "does not exist yet)")
+      ->type_name("NAME");
+  cli.optional("mission", o.mission, "with --calibrator-for: that vehicle's mission file (e.g. the fleet's mission.yaml)")
+      ->type_name("FILE")
+      ->needs("--calibrator-for");
+  cli.option("calibrator-config", o.calibrator_config, "with --calibrator-for: the calibrator's options; made absolute when it exists")
+      ->type_name("FILE");
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   setupLogging("meshnav_fleet_launch");
@@ -45,13 +54,16 @@ int main(int argc, char** argv) {
     for (FleetEntry& v : vehicles) v.dataset = fs::absolute(v.dataset).lexically_normal().string();
     if (fs::exists(o.estimator_config)) o.estimator_config = fs::absolute(o.estimator_config).lexically_normal().string();
     o.logging = !no_logging;
+    if (fs::exists(o.calibrator_config)) o.calibrator_config = fs::absolute(o.calibrator_config).lexically_normal().string();
+    if (!o.mission.empty()) o.mission = fs::absolute(o.mission).lexically_normal().string();
     o.source = fs::absolute(fleet).lexically_normal().string();
     const std::string text = transport::fleetLaunchYaml(vehicles, o);
     std::ofstream f(out);
     f << text;
     f.close();
     if (!f) throw std::runtime_error("cannot write " + out);
-    spdlog::info("{}: {} vehicles, {} processes", out, vehicles.size(), vehicles.size() * (o.logging ? 4 : 3));
+    spdlog::info("{}: {} vehicles{}", out, vehicles.size(),
+                 o.calibrator_for.empty() ? std::string() : ", a calibrator for " + o.calibrator_for);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 
@@ -40,6 +41,9 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
   for (const FleetEntry& v : vehicles)
     if (const std::string why = channels::prefixProblem(v.name); !why.empty())
       throw std::invalid_argument("fleet launch: vehicle name " + why);
+  if (!o.calibrator_for.empty() &&
+      std::none_of(vehicles.begin(), vehicles.end(), [&](const FleetEntry& v) { return v.name == o.calibrator_for; }))
+    throw std::invalid_argument("fleet launch: --calibrator-for '" + o.calibrator_for + "' is no vehicle of the fleet");
   std::vector<std::string> bridges, loggers;
   for (const FleetEntry& v : vehicles) {
     bridges.push_back(v.name + "_imu_bridge");
@@ -65,6 +69,16 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
       est.push_back("${OUT}/" + p + "/estimator_state");  // a respawn resumes from it
     }
     emitProcess(y, p + "_estimator", "estimator", est, true, 0.2, 5);
+    if (p == o.calibrator_for) {
+      // Not required: navigation goes on without it (as in config/launch/flyby.yaml).
+      emitProcess(y, p + "_calibrator", "calibrator",
+                  {"--channel-prefix", p, "--setup", v.dataset + "/setup.yaml", "--config",
+                   "${CALIBRATOR_CONFIG:-" + o.calibrator_config + "}"},
+                  false, 0.0, 5);
+      if (!o.mission.empty())
+        emitProcess(y, p + "_mission", "mission", {"--channel-prefix", p, "--mission", o.mission, "--t0", "${MISSION_T0:-0}"},
+                    false, 0.0, 3);
+    }
     if (o.logging)
       emitProcess(y, p + "_logging", "logging",
                   {"--channel-prefix", p, "--out", "${OUT}/" + p, "--channels", p + "/.*", "--run-id", "${T0_UTIME}"},

@@ -78,6 +78,31 @@ TEST(FleetLaunch, WithoutLoggingNoLoggerAndNoOutVariable) {
   EXPECT_EQ(text.find("${OUT}"), std::string::npos);
 }
 
+// A calibrator and mission serving one vehicle: its channels only, after its estimator.
+TEST(FleetLaunch, CalibratorAndMissionForOneVehicle) {
+  FleetLaunchOptions o;
+  o.logging = false;
+  o.calibrator_for = "v1";
+  o.mission = "/d/mission.yaml";
+  o.calibrator_config = "/cfg/calibrator.yaml";
+  const YAML::Node y = YAML::Load(fleetLaunchYaml({{"v0", "/d/v0"}, {"v1", "/d/v1"}}, o));
+  std::vector<std::string> names;
+  std::map<std::string, std::vector<std::string>> args;
+  for (const auto& p : y["processes"]) {
+    names.push_back(p["name"].as<std::string>());
+    args[names.back()] = strings(p["args"]);
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"v0_estimator", "v0_imu_bridge", "v0_uwb_bridge", "v1_estimator",
+                                             "v1_calibrator", "v1_mission", "v1_imu_bridge", "v1_uwb_bridge"}));
+  EXPECT_EQ(after(args["v1_calibrator"], "--channel-prefix"), "v1");
+  EXPECT_EQ(after(args["v1_calibrator"], "--setup"), "/d/v1/setup.yaml");
+  EXPECT_EQ(after(args["v1_calibrator"], "--config"), "${CALIBRATOR_CONFIG:-/cfg/calibrator.yaml}");
+  EXPECT_EQ(after(args["v1_mission"], "--channel-prefix"), "v1");
+  EXPECT_EQ(after(args["v1_mission"], "--mission"), "/d/mission.yaml");
+  o.calibrator_for = "v7";
+  EXPECT_THROW(fleetLaunchYaml({{"v0", "/d/v0"}}, o), std::invalid_argument);
+}
+
 TEST(FleetLaunch, RefusesANameThatIsNoChannelPrefixAndAnEmptyFleet) {
   EXPECT_THROW(fleetLaunchYaml({{"a/b", "/d"}}, {}), std::invalid_argument);
   EXPECT_THROW(fleetLaunchYaml({}, {}), std::invalid_argument);
