@@ -11,13 +11,22 @@
 /// message has one (converted by transport/convert.h), else the LCM type itself (time_sync_t).
 /// A plain string is left only where a name is really dynamic: the logger's raw regex, and the
 /// mission's --time-channels, which it matches against these constants.
+///
+/// Fleets (docs/channels.md, "Vehicle prefixes"): each vehicle's channels carry its prefix on the
+/// wire, `v0/POSE`, `UAV1/IMU`; the few the fleet shares (kFleetShared: the one calibrator's and
+/// the one mission's) do not. `prefixed(channel, prefix)` is the only place that makes such a
+/// name; LcmNode applies it to every typed publish and subscribe of a process started with
+/// `--channel-prefix P` (transport/process_main.h).
 
 #include <array>
+#include <stdexcept>
+#include <string>
 #include <string_view>
 #include <tuple>
 #include <type_traits>
 #include <vector>
 
+#include "common/fleet_file.h"
 #include "common/messages.h"
 #include "common/types.h"
 #include "meshnav/control_cmd_t.hpp"
@@ -80,6 +89,49 @@ constexpr bool hasOnePublisher(std::string_view name) {
   for (const char* c : kAll)
     if (name == c) return true;
   return false;
+}
+
+/// Channels a fleet shares on one LCM network, never prefixed: the fleet's one calibrator takes
+/// commands and reports on them for every vehicle, the one mission reports on MISSION_STATUS.
+/// Every other channel belongs to one vehicle (its sensors, its estimator, its ANCHOR_INIT, which
+/// the calibrator addresses to it alone, as pipeline/fleet.h's restrictToVehicle does in one
+/// process).
+inline constexpr std::array<const char*, 3> kFleetShared{"CALIB_CMD", "CALIB_STATUS", "MISSION_STATUS"};
+
+/// True for a channel of kFleetShared.
+constexpr bool isFleetShared(std::string_view name) {
+  for (const char* s : kFleetShared)
+    if (name == s) return true;
+  return false;
+}
+
+/// Empty when `prefix` can prefix a vehicle's channels (a fleet file's vehicle name: 1-64 of
+/// [A-Za-z0-9_-]), else why not, e.g. "'a/b' must be 1-64 letters, digits, '_' or '-'".
+inline std::string prefixProblem(std::string_view prefix) {
+  if (isVehicleName(prefix)) return "";
+  return "'" + std::string(prefix) + "' must be 1-64 letters, digits, '_' or '-' (a vehicle name of the fleet file)";
+}
+
+/// The name on the wire of the channel named `name` for the vehicle `prefix`: "PREFIX/NAME", or
+/// NAME itself for a shared channel (kFleetShared) or an empty prefix (one vehicle, no fleet).
+/// Throws std::invalid_argument for a prefix that prefixProblem refuses.
+inline std::string prefixedName(std::string_view name, std::string_view prefix) {
+  if (prefix.empty() || isFleetShared(name)) return std::string(name);
+  if (const std::string why = prefixProblem(prefix); !why.empty())
+    throw std::invalid_argument("channel prefix " + why);
+  return std::string(prefix) + "/" + std::string(name);
+}
+
+/// prefixedName of a typed channel: `prefixed(kPose, "v0")` is "v0/POSE".
+template <class Msg>
+std::string prefixed(Channel<Msg> channel, std::string_view prefix) {
+  return prefixedName(channel.name, prefix);
+}
+
+/// The channel name without its vehicle prefix: "v0/POSE" -> "POSE", "POSE" -> "POSE".
+constexpr std::string_view unprefixedName(std::string_view wire) {
+  const size_t slash = wire.rfind('/');
+  return slash == std::string_view::npos ? wire : wire.substr(slash + 1);
 }
 
 /// The channel constant of message type `Msg` named `name`, found at compile time (a Channel with

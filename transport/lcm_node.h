@@ -27,6 +27,11 @@
 /// other; the older one only counts it, and after the window neither is stopped (a process that
 /// has run for a while is never stopped by another one appearing).
 ///
+/// Vehicle prefix: a node made with a channel prefix P (a process's `--channel-prefix`, a vehicle
+/// of a fleet) publishes and subscribes every typed channel under channels::prefixed(channel, P)
+/// (`P/POSE`; the fleet's shared channels unchanged), and waitForMessage prefixes the name it is
+/// given the same way. Raw subscriptions (regexes) are left as given.
+///
 /// Size: meshnav's messages are small (the largest, ANCHORS or a status with many counters, is a
 /// few KiB). Over udpm, LCM itself drops a message larger than its receive ring buffer (about
 /// 1000 KiB in LCM 1.3) before any subscriber sees it, with a line on stderr only; such a message
@@ -69,14 +74,23 @@ std::string fingerprintMismatch(const lcm::ReceiveBuffer& rbuf, int64_t expected
 class LcmNode {
  public:
   /// `url` "" means LCM's default (LCM_DEFAULT_URL, else udpm://239.255.76.67:7667?ttl=0).
-  /// Throws std::runtime_error when LCM cannot be initialised (bad URL, no multicast route).
-  LcmNode(std::string name, const std::string& url);
+  /// `channel_prefix` "" means none (one vehicle); else a vehicle's prefix (channels::prefixProblem
+  /// refuses it: std::invalid_argument). Throws std::runtime_error when LCM cannot be initialised
+  /// (bad URL, no multicast route).
+  LcmNode(std::string name, const std::string& url, std::string channel_prefix = "");
   ~LcmNode();
   LcmNode(const LcmNode&) = delete;
   LcmNode& operator=(const LcmNode&) = delete;
 
   const std::string& name() const { return name_; }
   const std::string& url() const { return url_; }
+  /// The vehicle prefix of this node's channels ("" for none).
+  const std::string& channelPrefix() const { return prefix_; }
+  /// The name on the wire of `channel` for this node: channels::prefixed(channel, channelPrefix()).
+  template <class T>
+  std::string wireName(channels::Channel<T> channel) const {
+    return channels::prefixed(channel, prefix_);
+  }
   /// The random instance id stamped into the `sender_id` of every message this node publishes.
   int64_t instanceId() const { return instance_id_; }
   /// How long after its first publication on a channel of its own (from spin()) a node that hears
@@ -106,8 +120,8 @@ class LcmNode {
   /// subscription with another type does not compile.
   template <class T>
   void subscribe(channels::Channel<T> channel, std::type_identity_t<std::function<void(const T&)>> fn) {
-    watch<T>(channel.name);
-    subscribeRaw(channel.name, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+    watch<T>(channel);
+    subscribeRaw(wireName(channel), [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
       WireType<T> msg;
       if (!decode(rbuf, ch, msg)) return;
       guarded(ch, [&] { fn(fromWire<T>(msg)); });
@@ -119,8 +133,8 @@ class LcmNode {
   template <class T>
   void subscribeStamped(channels::Channel<T> channel,
                         std::type_identity_t<std::function<void(const T&, int64_t recv_utime)>> fn) {
-    watch<T>(channel.name);
-    subscribeRaw(channel.name, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+    watch<T>(channel);
+    subscribeRaw(wireName(channel), [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
       WireType<T> msg;
       if (!decode(rbuf, ch, msg)) return;
       guarded(ch, [&] { fn(fromWire<T>(msg), rbuf.recv_utime); });
@@ -132,10 +146,11 @@ class LcmNode {
   template <class T>
   bool publish(channels::Channel<T> channel, const std::type_identity_t<T>& value) {
     if (!second_instance_.empty()) return false;  // it yields the channel: nothing more from it
-    if (serving_ && !watch_.published(channel.name)) watchOwn<T>(channel.name);
+    const std::string wire = wireName(channel);
+    if (serving_ && !watch_.published(wire)) watchOwn<T>(channel);
     auto msg = toWire(value);
     msg.sender_id = instance_id_;
-    return publishWire(channel.name, msg);
+    return publishWire(wire, msg);
   }
 
   /// Calls `fn` every `period` of wall time from spin() (the process heartbeat / status).
@@ -147,8 +162,9 @@ class LcmNode {
   /// Handles at most one batch of messages, waiting up to `timeout_ms`; runs a due heartbeat.
   /// Returns > 0 when something was handled, 0 on timeout, < 0 on an LCM error.
   int spinOnce(int timeout_ms);
-  /// Waits until a message arrives on `channel` (a heartbeat, typically), a stop is requested or
-  /// `timeout` passes (≤ 0: no limit). Returns true when the message was seen.
+  /// Waits until a message arrives on `channel` (a heartbeat, typically; with a channel prefix,
+  /// channels::prefixedName(channel, prefix): this vehicle's), a stop is requested or `timeout`
+  /// passes (≤ 0: no limit). Returns true when the message was seen.
   bool waitForMessage(const std::string& channel, Duration timeout);
 
   void requestStop() { stop_ = true; }
@@ -205,8 +221,9 @@ class LcmNode {
   /// or implausible one is left to the typed subscription to count) and hands its sender to the
   /// PublisherWatch.
   template <class T>
-  void watch(const std::string& channel) {
-    if (!channels::hasOnePublisher(channel) || !watched_.insert(channel).second) return;
+  void watch(channels::Channel<T> typed) {
+    const std::string channel = wireName(typed);
+    if (!channels::hasOnePublisher(typed.name) || !watched_.insert(channel).second) return;
     subscribeRaw(channel, [this](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
       if (rbuf.data_size > kMaxMessageBytes) return;
       WireType<T> msg;
@@ -223,8 +240,8 @@ class LcmNode {
   /// that only publishes never handles its own messages, so it does not watch them): every other
   /// sender on it is a second publisher. The first one starts the kSecondInstanceWindow_s.
   template <class T>
-  void watchOwn(const std::string& channel) {
-    watch_.markPublished(channel);
+  void watchOwn(channels::Channel<T> channel) {
+    watch_.markPublished(wireName(channel));
     if (announced_wall_us_ == 0) announced_wall_us_ = replay::wallUtimeNow();
     watch<T>(channel);
   }
@@ -245,6 +262,7 @@ class LcmNode {
 
   std::string name_;
   std::string url_;
+  std::string prefix_;  ///< vehicle prefix of the typed channels ("" none)
   int64_t instance_id_;
   int64_t announced_wall_us_ = 0;  ///< first publication on a watched channel of its own (0: none yet)
   bool serving_ = false;           ///< spin() was called: the node handles what it receives

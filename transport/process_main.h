@@ -2,7 +2,7 @@
 /// @file process_main.h
 /// @brief The start-up every LCM process shares, so that a process main is its node's wiring
 /// only: the command line (common/cli.h) with the options every process has (`--lcm-url`,
-/// `--log-level`, `--help`), logging, SIGINT/SIGTERM (StopSignal), the LCM instance, exceptions
+/// `--log-level`, `--channel-prefix`, `--help`), logging, SIGINT/SIGTERM (StopSignal), the LCM instance, exceptions
 /// turned into a logged error and exit 1, and the heartbeat that publishes the node's status
 /// stamped with the wall time and the process's own counters (malformed messages per channel).
 ///
@@ -29,7 +29,10 @@ namespace meshnav::transport {
 
 class ProcessMain {
  public:
-  /// Declares --lcm-url and --log-level on cli(); the process adds its own options.
+  /// Declares --lcm-url, --log-level and --channel-prefix on cli(); the process adds its own options.
+  /// `--channel-prefix P` (a vehicle of a fleet, docs/channels.md "Vehicle prefixes"): every typed
+  /// channel of the process goes on the wire as channels::prefixed(channel, P); a malformed P is
+  /// refused (exit 2) with the reason.
   ProcessMain(std::string name, const std::string& description);
 
   Cli& cli() { return cli_; }
@@ -57,7 +60,10 @@ class ProcessMain {
   /// option the process cannot run without but --print-config can (so CLI11 may not require it).
   void require(bool given, const std::string& option) const;
 
-  /// The LCM instance on --lcm-url (created on first use; throws when LCM cannot start).
+  /// The vehicle prefix of --channel-prefix ("" when not given).
+  const std::string& channelPrefix() const { return channel_prefix_; }
+  /// The LCM instance on --lcm-url with --channel-prefix (created on first use; throws when LCM
+  /// cannot start).
   LcmNode& lcm();
 
   /// `status` as published: stamped with the wall time, and with the process's own counters
@@ -90,6 +96,7 @@ class ProcessMain {
   Cli cli_;
   std::string lcm_url_;
   std::string log_level_;
+  std::string channel_prefix_;
   std::unique_ptr<LcmNode> lcm_;
 };
 

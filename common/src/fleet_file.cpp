@@ -11,16 +11,12 @@
 
 namespace meshnav {
 
-namespace {
-
-bool validName(const std::string& s) {
+bool isVehicleName(std::string_view s) {
   if (s.empty() || s.size() > 64) return false;
   return std::all_of(s.begin(), s.end(), [](char c) {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
   });
 }
-
-}  // namespace
 
 std::vector<FleetEntry> loadFleetFile(const std::string& path) {
   YamlOptions root(YamlOptions::loadFile(path), path);
@@ -38,7 +34,7 @@ std::vector<FleetEntry> loadFleetFile(const std::string& path) {
     v.require("name", e.name);
     v.require("dataset", e.dataset);
     v.rejectUnknown();
-    if (!validName(e.name)) v.fail("name", "'" + e.name + "' must be 1-64 letters, digits, '_' or '-' (it names a folder)");
+    if (!isVehicleName(e.name)) v.fail("name", "'" + e.name + "' must be 1-64 letters, digits, '_' or '-' (it names a folder)");
     if (!names.insert(e.name).second) v.fail("name", "'" + e.name + "' is the name of an earlier vehicle");
     if (e.dataset.empty()) v.fail("dataset", "is empty");
     const std::filesystem::path d(e.dataset);

@@ -21,8 +21,8 @@ namespace {
 constexpr int64_t kDatasetLogSenderId = 0x10617;
 
 template <class T>
-bool writeEvent(lcm::LogFile& log, meshnav::channels::Channel<T> channel, int64_t utime, const std::type_identity_t<T>& value,
-                std::vector<uint8_t>& buf) {
+bool writeEvent(lcm::LogFile& log, meshnav::channels::Channel<T> channel, const std::string& prefix, int64_t utime,
+                const std::type_identity_t<T>& value, std::vector<uint8_t>& buf) {
   auto msg = meshnav::transport::toWire(value);
   msg.sender_id = kDatasetLogSenderId;
   const int n = msg.getEncodedSize();
@@ -31,7 +31,7 @@ bool writeEvent(lcm::LogFile& log, meshnav::channels::Channel<T> channel, int64_
   lcm::LogEvent ev;
   ev.eventnum = 0;
   ev.timestamp = utime;
-  ev.channel = channel.name;
+  ev.channel = meshnav::channels::prefixed(channel, prefix);
   ev.datalen = n;
   ev.data = buf.data();
   return log.writeEvent(&ev) == 0;
@@ -57,7 +57,7 @@ constexpr char kDescription[] =
     "`lcm-logplayer FILE.lcmlog`.";
 
 struct Options {
-  std::string dataset, out;
+  std::string dataset, out, channel_prefix;
   bool no_ground_truth = false;
 };
 
@@ -65,6 +65,10 @@ void declareOptions(meshnav::Cli& cli, Options& o) {
   cli.optional("dataset", o.dataset, "dataset folder (setup.yaml and ranges.csv required)")->type_name("DIR")->required();
   cli.optional("out", o.out, "output log file (overwritten)")->type_name("FILE")->required();
   cli.flag("no-ground-truth", o.no_ground_truth, "leave GROUND_TRUTH out");
+  cli.optional("channel-prefix", o.channel_prefix,
+               "the channels of vehicle P of a fleet: P/IMU, P/RANGE, ... (docs/channels.md, \"Vehicle prefixes\")")
+      ->type_name("P")
+      ->check(CLI::Validator([](std::string& p) { return meshnav::channels::prefixProblem(p); }, "", "vehicle prefix"));
 }
 
 /// The work of main: the dataset's streams merged in time order and written as one log.
@@ -95,12 +99,12 @@ int writeLog(const Options& o) {
   for (const auto& ev : events) {
     bool ok = false;
     switch (ev.stream) {
-      case kFlightStateStream: ok = writeEvent(log, channels::kFlightState, ev.t.us, ds.flight_states[ev.index], buf); break;
-      case kImuStream: ok = writeEvent(log, channels::kImu, ev.t.us, ds.imu[ev.index], buf); break;
-      case kBaroStream: ok = writeEvent(log, channels::kBaro, ev.t.us, ds.baro[ev.index], buf); break;
-      case kRangeStream: ok = writeEvent(log, channels::kRange, ev.t.us, ds.ranges[ev.index], buf); break;
-      case kGroundTruthStream: ok = writeEvent(log, channels::kGroundTruth, ev.t.us, ds.ground_truth[ev.index], buf); break;
-      case kHeightStream: ok = writeEvent(log, channels::kHeight, ev.t.us, ds.heights[ev.index], buf); break;
+      case kFlightStateStream: ok = writeEvent(log, channels::kFlightState, o.channel_prefix, ev.t.us, ds.flight_states[ev.index], buf); break;
+      case kImuStream: ok = writeEvent(log, channels::kImu, o.channel_prefix, ev.t.us, ds.imu[ev.index], buf); break;
+      case kBaroStream: ok = writeEvent(log, channels::kBaro, o.channel_prefix, ev.t.us, ds.baro[ev.index], buf); break;
+      case kRangeStream: ok = writeEvent(log, channels::kRange, o.channel_prefix, ev.t.us, ds.ranges[ev.index], buf); break;
+      case kGroundTruthStream: ok = writeEvent(log, channels::kGroundTruth, o.channel_prefix, ev.t.us, ds.ground_truth[ev.index], buf); break;
+      case kHeightStream: ok = writeEvent(log, channels::kHeight, o.channel_prefix, ev.t.us, ds.heights[ev.index], buf); break;
       default: break;
     }
     if (!ok) {

@@ -30,22 +30,52 @@ LatencyStats LatencyRecorder::imuToPose() const {
   return LatencyStats::of(std::move(s));
 }
 
-LatencyStats LatencyRecorder::rangeToPose() const {
+LatencyStats LatencyRecorder::rangeToPose() const { return toPose(ranges_, poses_, imu_); }
+
+LatencyStats LatencyRecorder::otherRangeToPose() const { return toPose(other_ranges_, poses_, imu_); }
+
+LatencyStats LatencyRecorder::toPose(const std::vector<Stamped>& ranges, const std::map<int64_t, int64_t>& poses,
+                                     const std::map<int64_t, int64_t>& imu) {
   std::vector<double> s;
-  for (const Stamped& r : ranges_) {
+  for (const Stamped& r : ranges) {
     // The first POSE at or after r that left after the RANGE came (a RANGE received after the
     // POSE of its time was out is in a later one: the estimator re-ran it as a late input).
-    auto pose = poses_.lower_bound(r.utime);
-    while (pose != poses_.end() && pose->second < r.recv_utime) ++pose;
-    if (pose == poses_.end()) continue;
-    const auto imu = imu_.find(pose->first);
-    if (imu == imu_.end()) continue;
-    s.push_back(static_cast<double>(pose->second - std::max(r.recv_utime, imu->second)));
+    auto pose = poses.lower_bound(r.utime);
+    while (pose != poses.end() && pose->second < r.recv_utime) ++pose;
+    if (pose == poses.end()) continue;
+    const auto sample = imu.find(pose->first);
+    if (sample == imu.end()) continue;
+    s.push_back(static_cast<double>(pose->second - std::max(r.recv_utime, sample->second)));
   }
   return LatencyStats::of(std::move(s));
 }
 
-size_t LatencyRecorder::rangesUnanswered() const { return ranges_.size() - rangeToPose().n; }
+size_t LatencyRecorder::rangesAfterLastPose() const {
+  int64_t last = 0;
+  for (const auto& [u, recv] : poses_) last = std::max(last, recv);
+  size_t n = 0;
+  for (const auto* v : {&ranges_, &other_ranges_})
+    for (const Stamped& r : *v) n += r.recv_utime > last;
+  return n;
+}
+
+size_t LatencyRecorder::rangesUnanswered() const {
+  return ranges_.size() + other_ranges_.size() - rangeToPose().n - otherRangeToPose().n - rangesAfterLastPose();
+}
+
+size_t LatencyRecorder::imusUnanswered() const {
+  if (poses_.empty()) return 0;
+  const int64_t first = poses_.begin()->first, last = poses_.rbegin()->first;
+  size_t n = 0;
+  for (auto it = imu_.lower_bound(first); it != imu_.end() && it->first <= last; ++it) n += poses_.count(it->first) == 0;
+  return n;
+}
+
+size_t LatencyRecorder::posesWithoutImu() const {
+  size_t n = 0;
+  for (const auto& [u, recv] : poses_) n += imu_.count(u) == 0;
+  return n;
+}
 
 std::map<std::string, double> LatencyRecorder::ratesHz() const {
   std::map<std::string, double> out;

@@ -49,10 +49,14 @@ std::string withReceiveBuffer(const std::string& url) {
          std::to_string(kUdpmReceiveBufferBytes);
 }
 
-LcmNode::LcmNode(std::string name, const std::string& url)
+LcmNode::LcmNode(std::string name, const std::string& url, std::string channel_prefix)
     : name_(std::move(name)),
       url_(withReceiveBuffer(resolveLcmUrl(url))),
+      prefix_(std::move(channel_prefix)),
       instance_id_(PublisherWatch::newInstanceId(replay::wallUtimeNow())) {
+  if (!prefix_.empty())
+    if (const std::string why = channels::prefixProblem(prefix_); !why.empty())
+      throw std::invalid_argument(name_ + ": channel prefix " + why);
   lcm_ = std::make_unique<lcm::LCM>(url_);
   if (!lcm_->good())
     throw std::runtime_error(name_ + ": cannot initialise LCM with URL '" + url_ +
@@ -155,7 +159,7 @@ int LcmNode::spin(const std::function<bool()>& until) {
 bool LcmNode::waitForMessage(const std::string& channel, Duration timeout) {
   bool seen = false;
   lcm::Subscription* sub = lcm_->subscribeFunction(
-      channel, +[](const lcm::ReceiveBuffer*, const std::string&, bool* flag) { *flag = true; }, &seen);
+      channels::prefixedName(channel, prefix_), +[](const lcm::ReceiveBuffer*, const std::string&, bool* flag) { *flag = true; }, &seen);
   const int64_t deadline = timeout.us > 0 ? replay::wallUtimeNow() + timeout.us : 0;
   while (!seen && !stopRequested()) {
     if (deadline && replay::wallUtimeNow() >= deadline) break;

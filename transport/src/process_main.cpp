@@ -17,6 +17,14 @@ ProcessMain::ProcessMain(std::string name, const std::string& description)
   cli_.optional("log-level", log_level_, "log level (default: $MESHNAV_LOG_LEVEL, else info)")
       ->type_name("LEVEL")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "warning", "error", "critical", "off"}));
+  cli_.optional("channel-prefix", channel_prefix_,
+                "vehicle prefix of this process's channels in a fleet: P/IMU, P/RANGE, P/POSE, ... (the fleet's "
+                "shared CALIB_CMD, CALIB_STATUS, MISSION_STATUS stay unprefixed; docs/channels.md); 1-64 letters, "
+                "digits, '_' or '-', e.g. a vehicle name of the fleet file (default: none)")
+      ->type_name("P")
+      ->check(CLI::Validator(
+          [](std::string& p) { return channels::prefixProblem(p); },
+          "", "vehicle prefix"));
 }
 
 namespace {
@@ -56,7 +64,7 @@ int ProcessMain::run(int argc, char** argv, const std::function<int()>& body) {
 }
 
 LcmNode& ProcessMain::lcm() {
-  if (!lcm_) lcm_ = std::make_unique<LcmNode>(name_, lcm_url_);
+  if (!lcm_) lcm_ = std::make_unique<LcmNode>(name_, lcm_url_, channel_prefix_);
   return *lcm_;
 }
 

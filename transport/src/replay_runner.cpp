@@ -51,14 +51,15 @@ ReplayProcessOptions replayOptionsFrom(const Cli& cli, const ReplayCliValues& v)
 
 bool waitForStart(LcmNode& node, const ReplayProcessOptions& o) {
   if (!o.wait_for.empty()) {
-    spdlog::info("{}: waiting for a message on {}{}", node.name(), o.wait_for,
+    const std::string wire = channels::prefixedName(o.wait_for, node.channelPrefix());  // this vehicle's
+    spdlog::info("{}: waiting for a message on {}{}", node.name(), wire,
                  o.wait_timeout.us > 0 ? fmt::format(" (at most {:.1f} s)", o.wait_timeout.sec()) : "");
     if (!node.waitForMessage(o.wait_for, o.wait_timeout)) {
       if (!node.stopRequested())
-        spdlog::error("{}: nothing on {} within {:.1f} s", node.name(), o.wait_for, o.wait_timeout.sec());
+        spdlog::error("{}: nothing on {} within {:.1f} s", node.name(), wire, o.wait_timeout.sec());
       return false;
     }
-    spdlog::info("{}: {} seen, starting", node.name(), o.wait_for);
+    spdlog::info("{}: {} seen, starting", node.name(), wire);
   }
   if (o.start_delay.us > 0) {
     replay::SystemClock clock;

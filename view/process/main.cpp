@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
 
     // A log plays through an LCM of this process only; live data comes from --lcm-url.
     std::unique_ptr<transport::LcmNode> memq;
-    if (summary) memq = std::make_unique<transport::LcmNode>("view_server", "memq://");
+    if (summary) memq = std::make_unique<transport::LcmNode>("view_server", "memq://", process.channelPrefix());
     transport::LcmNode& lcm = summary ? *memq : process.lcm();
     source.description = summary ? o.log_path : lcm.url();
     view.setSource(source);

@@ -108,5 +108,74 @@ TEST(Channels, TypedRoundTripOverMemq) {
   EXPECT_EQ(node.received(channels::kBaro.name), 1);
 }
 
+// Vehicle prefixes (docs/channels.md): every channel but the fleet's shared ones goes on the wire
+// as PREFIX/NAME; no prefix leaves every name as it is.
+TEST(ChannelPrefix, PerVehicleChannelsArePrefixedAndSharedOnesNot) {
+  EXPECT_EQ(channels::prefixed(channels::kPose, "UAV1"), "UAV1/POSE");
+  EXPECT_EQ(channels::prefixed(channels::kImu, "v0"), "v0/IMU");
+  EXPECT_EQ(channels::prefixed(channels::kRange, "v4"), "v4/RANGE");
+  EXPECT_EQ(channels::prefixed(channels::kEstimatorStatus, "v0"), "v0/ESTIMATOR_STATUS");
+  EXPECT_EQ(channels::prefixed(channels::kAnchorInit, "v0"), "v0/ANCHOR_INIT");  // the calibrator addresses one vehicle
+  EXPECT_EQ(channels::prefixed(channels::kTimeSync, "v0"), "v0/TIME_SYNC");
+  EXPECT_EQ(channels::prefixed(channels::kCalibCmd, "v0"), "CALIB_CMD");
+  EXPECT_EQ(channels::prefixed(channels::kCalibStatus, "v0"), "CALIB_STATUS");
+  EXPECT_EQ(channels::prefixed(channels::kMissionStatus, "v0"), "MISSION_STATUS");
+  EXPECT_EQ(channels::prefixed(channels::kPose, ""), "POSE");
+  EXPECT_EQ(channels::prefixedName("ESTIMATOR_STATUS", "ifo-001_a"), "ifo-001_a/ESTIMATOR_STATUS");
+  // Exactly three channels are shared; every other one of the table is a vehicle's.
+  int shared = 0;
+  for (const char* n : channels::kAll) {
+    const std::string wire = channels::prefixedName(n, "v1");
+    if (channels::isFleetShared(n)) {
+      ++shared;
+      EXPECT_EQ(wire, n);
+    } else {
+      EXPECT_EQ(wire, std::string("v1/") + n);
+    }
+    EXPECT_EQ(channels::unprefixedName(wire), n);
+  }
+  EXPECT_EQ(shared, 3);
+}
+
+TEST(ChannelPrefix, MalformedPrefixesAreRefusedWithTheReason) {
+  EXPECT_EQ(channels::prefixProblem("UAV1"), "");
+  EXPECT_EQ(channels::prefixProblem(std::string(64, 'a')), "");
+  for (const std::string& bad : std::vector<std::string>{"", "a/b", "v 0", "v0.", "ä", std::string(65, 'a'), "POSE|IMU"}) {
+    EXPECT_NE(channels::prefixProblem(bad), "") << bad;
+    EXPECT_THROW(channels::prefixedName("POSE", bad.empty() ? "/" : bad), std::invalid_argument) << bad;
+  }
+  EXPECT_EQ(channels::prefixProblem("a/b"), "'a/b' must be 1-64 letters, digits, '_' or '-' (a vehicle name of the fleet file)");
+  EXPECT_THROW(LcmNode("test", "memq://", "a/b"), std::invalid_argument);
+}
+
+// Two vehicles' nodes on one bus: each hears its own POSE only, never the other's; a shared
+// channel reaches both; waitForMessage waits for the node's own vehicle's channel.
+TEST(ChannelPrefix, NodesOfTwoVehiclesDoNotHearEachOther) {
+  LcmNode v0("v0", "memq://", "v0");
+  LcmNode v1("v1", "memq://", "v1");
+  // memq:// is one bus per LCM instance: publish and receive within each node, and check what
+  // went on the wire by name with a raw subscription.
+  std::vector<std::string> wire;
+  v0.subscribeRaw(".*", [&](const lcm::ReceiveBuffer&, const std::string& ch) { wire.push_back(ch); });
+  int poses = 0, calib = 0;
+  v0.subscribe(channels::kPose, [&](const PoseEstimate&) { ++poses; });
+  v0.subscribe(channels::kCalibStatus, [&](const CalibStatus&) { ++calib; });
+  PoseEstimate p;
+  p.t = Timestamp{1000};
+  ASSERT_TRUE(v0.publish(channels::kPose, p));
+  ASSERT_TRUE(v0.publish(channels::kCalibStatus, CalibStatus{}));
+  // What v1 would publish, by its wire name: a raw POSE on "v1/POSE" is not v0's POSE.
+  pose_t other = toLcm(p);
+  v0.lcm().publish("v1/POSE", &other);
+  v0.lcm().publish("POSE", &other);
+  while (v0.spinOnce(0) > 0) {
+  }
+  EXPECT_EQ(poses, 1);
+  EXPECT_EQ(calib, 1);
+  EXPECT_EQ(wire, (std::vector<std::string>{"v0/POSE", "CALIB_STATUS", "v1/POSE", "POSE"}));
+  EXPECT_EQ(v0.received("v0/POSE"), 1);
+  EXPECT_EQ(v1.wireName(channels::kImu), "v1/IMU");
+}
+
 }  // namespace
 }  // namespace meshnav::transport

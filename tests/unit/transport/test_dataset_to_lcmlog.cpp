@@ -42,10 +42,11 @@ Dataset withTagAndAnchor() {
 }
 
 /// Writes `ds` into `dir` and converts it; the log's path, "" when dataset_to_lcmlog failed.
-std::string convert(const Dataset& ds, const fs::path& dir) {
+std::string convert(const Dataset& ds, const fs::path& dir, const std::string& more_args = "") {
   writeDataset(ds, dir.string());
   const std::string log_path = (dir / "seq.lcmlog").string();
-  const std::string cmd = std::string(DATASET_TO_LCMLOG) + " --dataset " + dir.string() + " --out " + log_path;
+  const std::string cmd =
+      std::string(DATASET_TO_LCMLOG) + " --dataset " + dir.string() + " --out " + log_path + more_args;
   return std::system(cmd.c_str()) == 0 ? log_path : std::string();
 }
 
@@ -89,6 +90,29 @@ TEST(DatasetToLcmlog, WritesEverySampleTimeSorted) {
   EXPECT_EQ(counts["FLIGHT_STATE"], 1);
   EXPECT_EQ(counts["RANGE"], 3);
   EXPECT_EQ(counts["GROUND_TRUTH"], 4);
+  fs::remove_all(dir);
+}
+
+// --channel-prefix P: the log of vehicle P of a fleet, every channel named P/NAME (docs/channels.md).
+TEST(DatasetToLcmlog, ChannelPrefixNamesEveryChannelForTheVehicle) {
+  const fs::path dir = freshDir("meshnav_d2l_prefix");
+  Dataset ds = withTagAndAnchor();
+  ds.imu.push_back({Timestamp{0}, {0, 0, 9.81}, {0, 0, 0}});
+  RangeSample r;
+  r.t = Timestamp{7};
+  r.id_initiator = 100;
+  r.id_responder = 101;
+  r.range_m = 2.0;
+  ds.ranges.push_back(r);
+  ds.ground_truth.push_back({Timestamp{0}, {0, 0, 0}, Eigen::Quaterniond::Identity()});
+  const std::string log_path = convert(ds, dir, " --channel-prefix UAV1");
+  ASSERT_FALSE(log_path.empty());
+  lcm::LogFile log(log_path, "r");
+  ASSERT_TRUE(log.good());
+  std::vector<std::string> names;
+  while (const lcm::LogEvent* ev = log.readNextEvent()) names.push_back(ev->channel);
+  EXPECT_EQ(names, (std::vector<std::string>{"UAV1/IMU", "UAV1/GROUND_TRUTH", "UAV1/RANGE"}));
+  EXPECT_TRUE(convert(ds, dir, " --channel-prefix UAV/1 2>/dev/null").empty());  // refused
   fs::remove_all(dir);
 }
 

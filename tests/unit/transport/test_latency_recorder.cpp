@@ -35,8 +35,9 @@ TEST(LatencyRecorder, ImuAndRangeToPoseWithoutTheWaitForTheNextImuSample) {
   EXPECT_DOUBLE_EQ(imu.median_us, 30.0);
   EXPECT_DOUBLE_EQ(imu.max_us, 30.0);
   const LatencyStats range = r.rangeToPose();
-  EXPECT_EQ(range.n, 99u);  // the last RANGE has no later POSE
-  EXPECT_EQ(r.rangesUnanswered(), 1u);
+  EXPECT_EQ(range.n, 99u);  // the last RANGE has no later POSE: it came after the last one
+  EXPECT_EQ(r.rangesUnanswered(), 0u);
+  EXPECT_EQ(r.rangesAfterLastPose(), 1u);
   EXPECT_DOUBLE_EQ(range.median_us, 30.0);
   EXPECT_EQ(r.counts().at("IMU"), 100);
   EXPECT_NEAR(r.ratesHz().at("IMU"), 100.0 / 0.497, 0.5);  // over 100 µs … 497 ms + 130 µs of receive times
@@ -54,4 +55,50 @@ TEST(LatencyRecorder, ALateRangeIsAnsweredByTheFirstPoseAfterItCame) {
   const LatencyStats range = r.rangeToPose();
   ASSERT_EQ(range.n, 1u);
   EXPECT_DOUBLE_EQ(range.median_us, 40.0);  // POSE 15 ms at 15 040 − max(11 000, 15 000)
+}
+
+// Lost messages: IMU samples before the first POSE (the estimator initializing) are not lost; one
+// between the first and the last POSE without its POSE is; a POSE whose IMU sample the probe
+// never got counts that IMU as lost on the way to the probe.
+TEST(LatencyRecorder, CountsImuSamplesWithoutPoseAndPosesWithoutImu) {
+  LatencyRecorder r;
+  for (int k = 0; k < 10; ++k) {
+    const int64_t t = k * 5'000;
+    if (k != 7) r.onImu(t, t + 100);  // IMU 7 lost on the way to the probe
+    if (k >= 3 && k != 5) r.onPose(t, t + 130);  // none before 3 (initializing), POSE 5 lost
+  }
+  EXPECT_EQ(r.imusUnanswered(), 1u);   // IMU 5
+  EXPECT_EQ(r.posesWithoutImu(), 1u);  // POSE 7
+  EXPECT_EQ(r.imuToPose().n, 5u);      // POSE 3, 4, 6, 8, 9
+}
+
+// Ranges the estimator does not fuse (anchor mesh, another vehicle's tag) are kept apart: RANGE →
+// POSE is over the fused ones only, and every range counts when it is unanswered.
+TEST(LatencyRecorder, RangesNotFusedAreMeasuredApart) {
+  LatencyRecorder r;
+  r.onImu(10'000, 10'000);
+  r.onRange(9'000, 9'500, true);
+  r.onRange(9'100, 9'600, false);
+  r.onPose(10'000, 10'300);
+  r.onRange(11'000, 11'000, false);  // after the last POSE
+  EXPECT_EQ(r.fusedRanges(), 1u);
+  EXPECT_EQ(r.rangeToPose().n, 1u);
+  EXPECT_DOUBLE_EQ(r.rangeToPose().median_us, 300.0);
+  EXPECT_EQ(r.otherRangeToPose().n, 1u);
+  EXPECT_EQ(r.rangesUnanswered(), 0u);
+  EXPECT_EQ(r.rangesAfterLastPose(), 1u);
+  EXPECT_EQ(r.counts().at("RANGE"), 3);
+}
+
+// A RANGE whose POSE was lost (received before the last POSE, none after it at or past its time)
+// is unanswered; one received after the last POSE is not (nothing could answer it).
+TEST(LatencyRecorder, ARangeBeforeTheLastPoseWithoutAnswerIsUnanswered) {
+  LatencyRecorder r;
+  r.onImu(10'000, 10'000);
+  r.onPose(10'000, 10'100);
+  r.onRange(12'000, 12'050);  // its POSE (of a later IMU sample) never came
+  r.onPose(5'000, 13'000);    // a late re-published older POSE: the last one received
+  r.onRange(13'000, 13'500);  // after the last POSE
+  EXPECT_EQ(r.rangesUnanswered(), 1u);
+  EXPECT_EQ(r.rangesAfterLastPose(), 1u);
 }

@@ -1,0 +1,112 @@
+/// @file test_fleet_launch.cpp
+/// @brief The launch file of a fleet over LCM (transport/fleet_launch.h): exactly which processes
+/// it runs, each on its vehicle's prefixed channels, and what stops the launch.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "transport/fleet_launch.h"
+
+namespace meshnav::transport {
+namespace {
+
+std::vector<std::string> strings(const YAML::Node& n) { return n.as<std::vector<std::string>>(); }
+
+/// The value after `flag` in `args` ("" when absent).
+std::string after(const std::vector<std::string>& args, const std::string& flag) {
+  for (size_t i = 0; i + 1 < args.size(); ++i)
+    if (args[i] == flag) return args[i + 1];
+  return "";
+}
+
+TEST(FleetLaunch, EveryVehicleRunsItsBridgesAndEstimatorOnItsOwnPrefix) {
+  const std::vector<FleetEntry> fleet = {{"v0", "/d/v0"}, {"v1", "/d/v1"}};
+  FleetLaunchOptions o;
+  o.estimator_config = "/cfg/fleet_scale.yaml";
+  const YAML::Node y = YAML::Load(fleetLaunchYaml(fleet, o));
+  EXPECT_EQ(y["name"].as<std::string>(), "fleet");
+  std::vector<std::string> names;
+  std::map<std::string, YAML::Node> by_name;
+  for (const auto& p : y["processes"]) {
+    names.push_back(p["name"].as<std::string>());
+    by_name.emplace(names.back(), static_cast<const YAML::Node&>(p));
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"v0_estimator", "v0_logging", "v0_imu_bridge", "v0_uwb_bridge",
+                                             "v1_estimator", "v1_logging", "v1_imu_bridge", "v1_uwb_bridge"}));
+  EXPECT_EQ(strings(y["shutdown_after"]),
+            (std::vector<std::string>{"v0_imu_bridge", "v0_uwb_bridge", "v1_imu_bridge", "v1_uwb_bridge"}));
+  EXPECT_EQ(strings(y["stop_last"]), (std::vector<std::string>{"v0_logging", "v1_logging"}));
+  EXPECT_DOUBLE_EQ(y["shutdown_delay"].as<double>(), 2.0);
+  for (const std::string v : {"v0", "v1"}) {
+    const auto est = strings(by_name.at(v + "_estimator")["args"]);
+    EXPECT_EQ(by_name.at(v + "_estimator")["command"].as<std::string>(), "${BIN:-build/bin}/estimator");
+    EXPECT_EQ(after(est, "--channel-prefix"), v);
+    EXPECT_EQ(after(est, "--setup"), "/d/" + v + "/setup.yaml");
+    EXPECT_EQ(after(est, "--config"), "${ESTIMATOR_CONFIG:-/cfg/fleet_scale.yaml}");
+    EXPECT_EQ(after(est, "--state-dir"), "${OUT}/" + v + "/estimator_state");
+    EXPECT_TRUE(by_name.at(v + "_estimator")["required"].as<bool>());
+    const auto log = strings(by_name.at(v + "_logging")["args"]);
+    EXPECT_EQ(after(log, "--channel-prefix"), v);
+    EXPECT_EQ(after(log, "--out"), "${OUT}/" + v);
+    EXPECT_EQ(after(log, "--channels"), v + "/.*");
+    for (const std::string b : {"_imu_bridge", "_uwb_bridge"}) {
+      const YAML::Node& p = by_name.at(v + b);
+      const auto args = strings(p["args"]);
+      EXPECT_EQ(p["command"].as<std::string>(), "${BIN:-build/bin}/" + b.substr(1));
+      EXPECT_EQ(after(args, "--channel-prefix"), v);
+      EXPECT_EQ(after(args, "--dataset"), "/d/" + v);
+      EXPECT_EQ(after(args, "--wait-for"), "ESTIMATOR_STATUS");  // the node waits for v/ESTIMATOR_STATUS
+      EXPECT_EQ(after(args, "--t0-utime"), "${T0_UTIME}");
+      EXPECT_EQ(after(args, "--rate"), "${RATE:-1}");
+      EXPECT_FALSE(p["required"]);
+    }
+  }
+}
+
+TEST(FleetLaunch, WithoutLoggingNoLoggerAndNoOutVariable) {
+  FleetLaunchOptions o;
+  o.logging = false;
+  const std::string text = fleetLaunchYaml({{"UAV1", "/d/a"}}, o);
+  const YAML::Node y = YAML::Load(text);
+  std::vector<std::string> names;
+  for (const auto& p : y["processes"]) names.push_back(p["name"].as<std::string>());
+  EXPECT_EQ(names, (std::vector<std::string>{"UAV1_estimator", "UAV1_imu_bridge", "UAV1_uwb_bridge"}));
+  EXPECT_FALSE(y["stop_last"]);
+  EXPECT_EQ(text.find("${OUT}"), std::string::npos);
+}
+
+// A calibrator and mission serving one vehicle: its channels only, after its estimator.
+TEST(FleetLaunch, CalibratorAndMissionForOneVehicle) {
+  FleetLaunchOptions o;
+  o.logging = false;
+  o.calibrator_for = "v1";
+  o.mission = "/d/mission.yaml";
+  o.calibrator_config = "/cfg/calibrator.yaml";
+  const YAML::Node y = YAML::Load(fleetLaunchYaml({{"v0", "/d/v0"}, {"v1", "/d/v1"}}, o));
+  std::vector<std::string> names;
+  std::map<std::string, std::vector<std::string>> args;
+  for (const auto& p : y["processes"]) {
+    names.push_back(p["name"].as<std::string>());
+    args[names.back()] = strings(p["args"]);
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{"v0_estimator", "v0_imu_bridge", "v0_uwb_bridge", "v1_estimator",
+                                             "v1_calibrator", "v1_mission", "v1_imu_bridge", "v1_uwb_bridge"}));
+  EXPECT_EQ(after(args["v1_calibrator"], "--channel-prefix"), "v1");
+  EXPECT_EQ(after(args["v1_calibrator"], "--setup"), "/d/v1/setup.yaml");
+  EXPECT_EQ(after(args["v1_calibrator"], "--config"), "${CALIBRATOR_CONFIG:-/cfg/calibrator.yaml}");
+  EXPECT_EQ(after(args["v1_mission"], "--channel-prefix"), "v1");
+  EXPECT_EQ(after(args["v1_mission"], "--mission"), "/d/mission.yaml");
+  o.calibrator_for = "v7";
+  EXPECT_THROW(fleetLaunchYaml({{"v0", "/d/v0"}}, o), std::invalid_argument);
+}
+
+TEST(FleetLaunch, RefusesANameThatIsNoChannelPrefixAndAnEmptyFleet) {
+  EXPECT_THROW(fleetLaunchYaml({{"a/b", "/d"}}, {}), std::invalid_argument);
+  EXPECT_THROW(fleetLaunchYaml({}, {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace meshnav::transport

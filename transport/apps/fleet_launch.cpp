@@ -1,0 +1,72 @@
+/// meshnav_fleet_launch: a fleet file -> the launch file that runs the fleet over LCM, each vehicle
+/// on its own prefixed channels (transport/fleet_launch.h; `./meshnav up --fleet FILE` runs it).
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <spdlog/spdlog.h>
+
+#include "common/cli.h"
+#include "common/fleet_file.h"
+#include "transport/fleet_launch.h"
+
+int main(int argc, char** argv) {
+  using namespace meshnav;
+  namespace fs = std::filesystem;
+  Cli cli("meshnav_fleet_launch",
+          "Writes the launch file (scripts/supervisor.py) of a fleet over LCM: per vehicle of --fleet its estimator, "
+          "imu_bridge and uwb_bridge (and a logger unless --no-logging), each with --channel-prefix <vehicle name>; "
+          "run it with ./meshnav up FILE OUT=DIR [RATE=X] (docs/fleet.md, \"A fleet over LCM\").");
+  std::string fleet, out;
+  bool no_logging = false;
+  transport::FleetLaunchOptions o;
+  cli.optional("fleet", fleet, "fleet file (docs/fleet.md), e.g. DIR/fleet.yaml of meshnav_sim --vehicles N")
+      ->type_name("FILE")
+      ->required();
+  cli.optional("out", out, "the launch file to write")->type_name("FILE")->required();
+  cli.option("estimator-config", o.estimator_config,
+             "estimator options of every vehicle (the launch's ESTIMATOR_CONFIG overrides it); made absolute when it "
+             "exists")
+      ->type_name("FILE");
+  cli.flag("no-logging", no_logging, "no logger per vehicle (the launch then needs no OUT)");
+  cli.option("wait-timeout", o.wait_timeout_s, "bridges give up when their estimator is not heard within S seconds")
+      ->type_name("S")
+      ->check(cli::positive());
+  cli.option("shutdown-delay", o.shutdown_delay_s,
+             "wall seconds from the end of the last bridge's data to the stop of the others (an estimator fuses what "
+             "it still has queued meanwhile)")
+      ->type_name("S")
+      ->check(cli::nonNegative());
+  cli.optional("calibrator-for", o.calibrator_for,
+               "a calibrator serving this vehicle alone over LCM (its fly-by anchors; a calibrator serving the fleet "
+               "does not exist yet)")
+      ->type_name("NAME");
+  cli.optional("mission", o.mission, "with --calibrator-for: that vehicle's mission file (e.g. the fleet's mission.yaml)")
+      ->type_name("FILE")
+      ->needs("--calibrator-for");
+  cli.option("calibrator-config", o.calibrator_config, "with --calibrator-for: the calibrator's options; made absolute when it exists")
+      ->type_name("FILE");
+  int code = 0;
+  if (!cli.parse(argc, argv, code)) return code;
+  setupLogging("meshnav_fleet_launch");
+  try {
+    std::vector<FleetEntry> vehicles = loadFleetFile(fleet);
+    for (FleetEntry& v : vehicles) v.dataset = fs::absolute(v.dataset).lexically_normal().string();
+    if (fs::exists(o.estimator_config)) o.estimator_config = fs::absolute(o.estimator_config).lexically_normal().string();
+    o.logging = !no_logging;
+    if (fs::exists(o.calibrator_config)) o.calibrator_config = fs::absolute(o.calibrator_config).lexically_normal().string();
+    if (!o.mission.empty()) o.mission = fs::absolute(o.mission).lexically_normal().string();
+    o.source = fs::absolute(fleet).lexically_normal().string();
+    const std::string text = transport::fleetLaunchYaml(vehicles, o);
+    std::ofstream f(out);
+    f << text;
+    f.close();
+    if (!f) throw std::runtime_error("cannot write " + out);
+    spdlog::info("{}: {} vehicles{}", out, vehicles.size(),
+                 o.calibrator_for.empty() ? std::string() : ", a calibrator for " + o.calibrator_for);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+  return 0;
+}

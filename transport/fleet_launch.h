@@ -1,0 +1,50 @@
+#pragma once
+/// @file fleet_launch.h
+/// @brief A fleet over LCM (docs/fleet.md, "A fleet over LCM"): the launch file
+/// (config/launch/README.md, run by scripts/supervisor.py) that starts, per vehicle of a fleet
+/// file, its imu_bridge and uwb_bridge replaying its dataset and its estimator, each with
+/// `--channel-prefix NAME` (the vehicle's name: `v0/IMU`, `v0/POSE`; transport/channels.h), and
+/// optionally a logger per vehicle. Generated, not written by hand, so that a fleet file of any
+/// size becomes one launch of the existing supervisor (`./meshnav up --fleet FILE`,
+/// `meshnav_fleet_launch`). No calibrator and no mission (docs/fleet.md, "Not done yet").
+///
+/// Process names are `<vehicle>_estimator`, `<vehicle>_imu_bridge`, `<vehicle>_uwb_bridge`,
+/// `<vehicle>_logging` (and `<vehicle>_calibrator`, `<vehicle>_mission` for `calibrator_for`); the launch stops when every bridge has played its data
+/// (`shutdown_after`), the loggers last (`stop_last`). Variables of the generated file: BIN
+/// (default build/bin), RATE (default 1), DATA_T0 (default 0), ESTIMATOR_CONFIG (default the
+/// generator's `estimator_config`), OUT (only with `logging`: OUT/<vehicle>/ gets the logger's files
+/// and the estimator's checkpoint).
+
+#include <string>
+#include <vector>
+
+#include "common/fleet_file.h"
+
+namespace meshnav::transport {
+
+/// What the generated launch runs besides the bridges and estimators.
+struct FleetLaunchOptions {
+  /// Estimator options of every vehicle (`--config`; ESTIMATOR_CONFIG overrides it at launch).
+  /// config/fleet_scale.yaml: what 100 anchors need (docs/fleet.md, "The estimator's cost").
+  std::string estimator_config = "config/fleet_scale.yaml";
+  bool logging = true;          ///< a logger per vehicle (`--channel-prefix`, writing ${OUT}/<vehicle>)
+  double wait_timeout_s = 60.0;  ///< bridges give up when their estimator's ESTIMATOR_STATUS is not heard [s]
+  /// Wall time [s] between the last bridge's end and the stop of the others: what an estimator
+  /// still has queued is fused and published meanwhile (the bench waits longer than a run).
+  double shutdown_delay_s = 2.0;
+  std::string source;            ///< the fleet file's path, named in the header comment
+  /// Non-empty: a calibrator and (with `mission`) a mission serving this one vehicle over LCM
+  /// (`--channel-prefix` it: its RANGE, POSE, ANCHORS in, its ANCHOR_INIT out; CALIB_CMD and
+  /// CALIB_STATUS are the fleet's), so that it gets its fly-by anchors; a calibrator serving the
+  /// whole fleet over LCM does not exist (docs/fleet.md).
+  std::string calibrator_for;
+  std::string mission;                                  ///< mission file of that vehicle's mission ("" none)
+  std::string calibrator_config = "config/calibrator.yaml";  ///< the calibrator's options
+};
+
+/// The launch file (YAML text) of `vehicles`. Throws std::invalid_argument for a vehicle name that
+/// is no channel prefix (channels::prefixProblem; loadFleetFile already refuses those) and for a
+/// `calibrator_for` that names no vehicle.
+std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const FleetLaunchOptions& options);
+
+}  // namespace meshnav::transport
