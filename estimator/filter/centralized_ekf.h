@@ -49,6 +49,8 @@ class CentralizedEkf final : public FusionStrategy {
   NominalState x_;
   StateLayout layout_;
   Eigen::MatrixXd P_;
+  /// Φ P_I· of the propagation (a member: no allocation per IMU step once the state stops growing).
+  Eigen::Matrix<double, ImuErr::kDim, Eigen::Dynamic> rows_;
 };
 
 }  // namespace meshnav::estimator
