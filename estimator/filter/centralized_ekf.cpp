@@ -125,10 +125,11 @@ void CentralizedEkf::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vec
   // transpose of its rows. (The columns' product over all n rows, as before, computed rows that
   // the transpose then overwrote: 15 × 15 × n multiplications a step for nothing.)
   const BlockSparseImuMatrix phi(Phi);
-  phi.times(P_.topRows<kI>(), rows_);
-  P_.topRows<kI>() = rows_;
+  auto& rows = scratch_.rows;
+  phi.times(P_.topRows<kI>(), rows);
+  P_.topRows<kI>() = rows;
   Eigen::Matrix<double, kI, Eigen::Dynamic> PiiT;  // (Φ P_II) Φᵀ = (Φ (Φ P_II)ᵀ)ᵀ
-  phi.times(rows_.leftCols<kI>().transpose(), PiiT);
+  phi.times(rows.leftCols<kI>().transpose(), PiiT);
   ImuMatrix Pii = PiiT.transpose();
   Pii += Q;
   // Keep the touched rows/columns exactly symmetric.

@@ -49,8 +49,15 @@ class CentralizedEkf final : public FusionStrategy {
   NominalState x_;
   StateLayout layout_;
   Eigen::MatrixXd P_;
-  /// Φ P_I· of the propagation (a member: no allocation per IMU step once the state stops growing).
-  Eigen::Matrix<double, ImuErr::kDim, Eigen::Dynamic> rows_;
+  /// Working memory of propagate(): no allocation per IMU step once the state stops growing, and
+  /// not copied with the filter (every stored input keeps a copy of it, FilterContext).
+  struct Scratch {
+    Eigen::Matrix<double, ImuErr::kDim, Eigen::Dynamic> rows;  ///< Φ P_I·
+    Scratch() = default;
+    Scratch(const Scratch&) {}
+    Scratch& operator=(const Scratch&) { return *this; }
+  };
+  Scratch scratch_;
 };
 
 }  // namespace meshnav::estimator
