@@ -10,66 +10,56 @@ namespace meshnav::estimator {
 
 namespace {
 
-/// The IMU transition Φ by 3 × 3 blocks (ImuPropagator: identity on the diagonal but for θθ, ten of
-/// the 25 blocks zero, the bias rows the identity): Φ M costs 81 of the 225 multiply-adds per column
-/// a dense product takes, with no packing. Each block's type is read from Φ, so any Φ is exact.
-class BlockSparseImuMatrix {
+/// The IMU transition Φ by its nonzero entries (ImuPropagator: 87 of the 225, 15 of them ones):
+/// L Φᵀ for an n × 15 L is, column by column, out.col(i) = Σ_{Φ(i,j) ≠ 0} Φ(i,j) L.col(j): long
+/// contiguous columns, no packing, no product of a zero, no multiplication by a one. The entries
+/// are read from Φ, so any Φ is exact.
+class SparseImuTransition {
  public:
-  explicit BlockSparseImuMatrix(const ImuMatrix& Phi) {
-    for (int i = 0; i < kB; ++i) {
-      first_[i] = n_blocks_;
-      for (int j = 0; j < kB; ++j) {
-        const auto b = Phi.block<3, 3>(3 * i, 3 * j);
-        if (b.isZero(0.0)) continue;
-        Block& e = blocks_[n_blocks_++];
-        e.col = 3 * j;
-        e.identity = b.isIdentity(0.0);
-        for (int r = 0; r < 3; ++r)
-          for (int k = 0; k < 3; ++k) e.a[r][k] = b(r, k);
-      }
+  explicit SparseImuTransition(const ImuMatrix& Phi) {
+    for (int i = 0; i < kI; ++i) {
+      first_[i] = n_;
+      for (int j = 0; j < kI; ++j)
+        if (Phi(i, j) != 0.0) entries_[n_++] = Entry{j, Phi(i, j)};
     }
-    first_[kB] = n_blocks_;
+    first_[kI] = n_;
   }
-  /// out = Φ M for a 15-row M.
-  template <typename Derived>
-  void times(const Eigen::MatrixBase<Derived>& M, Eigen::Matrix<double, ImuErr::kDim, Eigen::Dynamic>& out) const {
-    out.resize(ImuErr::kDim, M.cols());
-    for (Eigen::Index c = 0; c < M.cols(); ++c) {
-      double m[ImuErr::kDim];
-      for (int k = 0; k < ImuErr::kDim; ++k) m[k] = M(k, c);
-      double* o = out.col(c).data();
-      for (int i = 0; i < kB; ++i) {  // block row i: its blocks are blocks_[first_[i], first_[i + 1])
-        double y0 = 0.0, y1 = 0.0, y2 = 0.0;
-        for (int b = first_[i]; b < first_[i + 1]; ++b) {
-          const Block& e = blocks_[b];
-          const double* x = m + e.col;
-          if (e.identity) {
-            y0 += x[0];
-            y1 += x[1];
-            y2 += x[2];
-          } else {
-            y0 += e.a[0][0] * x[0] + e.a[0][1] * x[1] + e.a[0][2] * x[2];
-            y1 += e.a[1][0] * x[0] + e.a[1][1] * x[1] + e.a[1][2] * x[2];
-            y2 += e.a[2][0] * x[0] + e.a[2][1] * x[1] + e.a[2][2] * x[2];
-          }
+  /// out = L Φᵀ for a 15-column L (out must not alias L).
+  template <typename Derived, typename Out>
+  void timesTransposed(const Eigen::MatrixBase<Derived>& L, Out& out) const {
+    out.resize(L.rows(), kI);
+    for (int i = 0; i < kI; ++i) {
+      auto o = out.col(i);
+      if (first_[i] == first_[i + 1]) {
+        o.setZero();
+        continue;
+      }
+      for (int k = first_[i]; k < first_[i + 1]; ++k) {
+        const Entry& e = entries_[k];
+        const bool first = k == first_[i];
+        if (e.value == 1.0) {
+          if (first)
+            o = L.col(e.col);
+          else
+            o += L.col(e.col);
+        } else if (first) {
+          o = e.value * L.col(e.col);
+        } else {
+          o += e.value * L.col(e.col);
         }
-        o[3 * i] = y0;
-        o[3 * i + 1] = y1;
-        o[3 * i + 2] = y2;
       }
     }
   }
 
  private:
-  static constexpr int kB = ImuErr::kDim / 3;
-  struct Block {
+  static constexpr int kI = ImuErr::kDim;
+  struct Entry {
     int col = 0;
-    bool identity = false;
-    double a[3][3] = {};
+    double value = 0.0;
   };
-  Block blocks_[kB * kB];  ///< the nonzero blocks by block row
-  int first_[kB + 1] = {};
-  int n_blocks_ = 0;
+  Entry entries_[kI * kI];  ///< the nonzero entries by row
+  int first_[kI + 1] = {};
+  int n_ = 0;
 };
 
 }  // namespace
@@ -120,21 +110,22 @@ void CentralizedEkf::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vec
   x_.t = t_to;
   constexpr int kI = ImuErr::kDim;  // the IMU block is always first
   const int n = layout_.dim();
-  // P ← Φ_full P Φ_fullᵀ with Φ_full = diag(Φ, I): the IMU rows Φ P_I· (their blocks P_Ij,
-  // j ≠ I, are final), then the IMU block (Φ P_II) Φᵀ + Q; the IMU columns below it are the
-  // transpose of its rows. (The columns' product over all n rows, as before, computed rows that
-  // the transpose then overwrote: 15 × 15 × n multiplications a step for nothing.)
-  const BlockSparseImuMatrix phi(Phi);
-  auto& rows = scratch_.rows;
-  phi.times(P_.topRows<kI>(), rows);
-  P_.topRows<kI>() = rows;
-  Eigen::Matrix<double, kI, Eigen::Dynamic> PiiT;  // (Φ P_II) Φᵀ = (Φ (Φ P_II)ᵀ)ᵀ
-  phi.times(rows.leftCols<kI>().transpose(), PiiT);
-  ImuMatrix Pii = PiiT.transpose();
+  // P ← Φ_full P Φ_fullᵀ with Φ_full = diag(Φ, I): the IMU columns P Φ_fullᵀ (their blocks
+  // P_jI Φᵀ, j ≠ I, are final; the IMU rows take their transpose), then the IMU block
+  // Φ (P_II Φᵀ) + Q. (Before, two dense products over all n rows and columns, of which the mirror
+  // overwrote the second's rows below the IMU block: 15 × 15 × n multiplications a step for nothing.)
+  const SparseImuTransition phi(Phi);
+  auto& cols = scratch_.cols;
+  phi.timesTransposed(P_.leftCols<kI>(), cols);
+  ImuMatrix Pii;  // Φ P_II Φᵀ = (P_II Φᵀ)ᵀ Φᵀ, P_II symmetric
+  phi.timesTransposed(cols.topRows<kI>().transpose(), Pii);
   Pii += Q;
   // Keep the touched rows/columns exactly symmetric.
   P_.topLeftCorner<kI, kI>() = 0.5 * (Pii + Pii.transpose());
-  if (n > kI) P_.bottomLeftCorner(n - kI, kI) = P_.topRightCorner(kI, n - kI).transpose();
+  if (n > kI) {
+    P_.bottomLeftCorner(n - kI, kI) = cols.bottomRows(n - kI);
+    P_.topRightCorner(kI, n - kI) = cols.bottomRows(n - kI).transpose();
+  }
   for (const StateBlock& b : layout_.blocks()) {
     const double sigma = random_walks_.of(b.kind);
     if (sigma <= 0.0 || b.kind == kindOf<ImuKind>) continue;  // the IMU's noise is Q

@@ -52,7 +52,7 @@ class CentralizedEkf final : public FusionStrategy {
   /// Working memory of propagate(): no allocation per IMU step once the state stops growing, and
   /// not copied with the filter (every stored input keeps a copy of it, FilterContext).
   struct Scratch {
-    Eigen::Matrix<double, ImuErr::kDim, Eigen::Dynamic> rows;  ///< Φ P_I·
+    Eigen::Matrix<double, Eigen::Dynamic, ImuErr::kDim> cols;  ///< P_·I Φᵀ
     Scratch() = default;
     Scratch(const Scratch&) {}
     Scratch& operator=(const Scratch&) { return *this; }
