@@ -22,10 +22,14 @@ std::string trim(const std::string& s) {
 std::vector<std::string> splitFields(const std::string& line) {
   std::vector<std::string> out;
   if (line.find(',') != std::string::npos) {
-    std::string field;
-    std::istringstream is(line);
-    while (std::getline(is, field, ',')) out.push_back(trim(field));
-    if (!line.empty() && line.back() == ',') out.push_back("");
+    // Every piece between commas, an empty one after a trailing comma too (a stream per line,
+    // as before, was most of reading a dataset).
+    for (size_t b = 0;;) {
+      const size_t e = line.find(',', b);
+      out.push_back(trim(line.substr(b, e == std::string::npos ? std::string::npos : e - b)));
+      if (e == std::string::npos) break;
+      b = e + 1;
+    }
   } else {
     std::istringstream is(line);
     std::string field;
@@ -66,7 +70,9 @@ std::string CsvRow::text(const std::string& name) const {
 }
 
 std::optional<double> CsvRow::number(const std::string& name) const {
-  const std::string s = text(name);
+  auto it = columns_->find(name);
+  if (it == columns_->end() || it->second >= static_cast<int>(fields_.size())) return std::nullopt;
+  const std::string& s = fields_[it->second];  // text(name) without its copy
   if (s.empty()) return std::nullopt;
   char* end = nullptr;
   const double v = std::strtod(s.c_str(), &end);

@@ -1,13 +1,16 @@
 #include "common/estimate_io.h"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdint>
 #include <cerrno>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
+#include <utility>
 
 #include "common/csv.h"
 #include "common/dataset.h"
@@ -29,6 +32,20 @@ std::ofstream openOut(const std::string& path, const char* header, bool append) 
 
 const char* kEstimateHeader = "t,tx,ty,tz,qx,qy,qz,qw,pxx,pxy,pxz,pyy,pyz,pzz,qrr,qrp,qry,qpp,qpy,qyy\n";
 const char* kAnchorsHeader = "t,id,x,y,z,pxx,pxy,pxz,pyy,pyz,pzz\n";
+
+/// Appends ",<v>" as printf's "%.<precision>g" writes v (std::to_chars with a precision is
+/// specified so; it formats exactly, without snprintf's format parsing and multi-precision path,
+/// which were 9 % of a `meshnav run`).
+char* appendG(char* p, char* end, double v, int precision) {
+  *p++ = ',';
+  return std::to_chars(p, end, v, std::chars_format::general, precision).ptr;
+}
+
+/// Appends the 6 upper-triangle values of `m` with 6 significant digits.
+char* appendUpper(char* p, char* end, const Eigen::Matrix3d& m) {
+  for (const auto& [r, c] : {std::pair{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}}) p = appendG(p, end, m(r, c), 6);
+  return p;
+}
 
 /// Reads the 6 upper-triangle values `names` into a symmetric matrix.
 std::optional<Eigen::Matrix3d> upper(const CsvRow& r, const char* const names[6]) {
@@ -68,18 +85,21 @@ EstimateCsvWriter::EstimateCsvWriter(const std::string& path, bool append)
     : path_(path), out_(openOut(path, kEstimateHeader, append)) {}
 
 void EstimateCsvWriter::write(const PoseEstimate& e) {
-  const auto& P = e.cov_p_m2;
-  const auto& Q = e.cov_theta_rad2;
+  // t,tx,ty,tz,qx,qy,qz,qw with 9 significant digits, the covariances' upper triangles with 6.
+  const std::string t = formatSeconds(e.t);
   char buf[512];
-  std::snprintf(buf, sizeof(buf),
-                "%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n",
-                formatSeconds(e.t).c_str(), e.p_IinG.x(), e.p_IinG.y(), e.p_IinG.z(), e.q_ItoG.x(), e.q_ItoG.y(),
-                e.q_ItoG.z(), e.q_ItoG.w(), P(0, 0), P(0, 1), P(0, 2), P(1, 1), P(1, 2), P(2, 2), Q(0, 0), Q(0, 1),
-                Q(0, 2), Q(1, 1), Q(1, 2), Q(2, 2));
+  char* const end = buf + sizeof(buf);
+  char* p = std::copy(t.begin(), t.end(), buf);
+  for (const double v : {e.p_IinG.x(), e.p_IinG.y(), e.p_IinG.z(), e.q_ItoG.x(), e.q_ItoG.y(), e.q_ItoG.z(),
+                         e.q_ItoG.w()})
+    p = appendG(p, end, v, 9);
+  p = appendUpper(p, end, e.cov_p_m2);
+  p = appendUpper(p, end, e.cov_theta_rad2);
+  *p++ = '\n';
   errno = 0;
-  out_ << buf;
+  out_.write(buf, p - buf);
   if (!out_ && errno_ == 0) errno_ = errno;
-  tally_.wrote(formatSeconds(e.t), std::strlen(buf));
+  tally_.wrote(t, static_cast<size_t>(p - buf));
 }
 
 void EstimateCsvWriter::flush() { checkedFlush(out_, path_, errno_, &tally_); }
@@ -88,14 +108,20 @@ AnchorsCsvWriter::AnchorsCsvWriter(const std::string& path, bool append)
     : path_(path), out_(openOut(path, kAnchorsHeader, append)) {}
 
 void AnchorsCsvWriter::write(const AnchorEstimate& a) {
-  const auto& P = a.cov_p_m2;
+  // t,id,x,y,z with 9 significant digits, the covariance's upper triangle with 6.
+  const std::string t = formatSeconds(a.t);
   char buf[384];
-  std::snprintf(buf, sizeof(buf), "%s,%d,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", formatSeconds(a.t).c_str(),
-                a.id, a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z(), P(0, 0), P(0, 1), P(0, 2), P(1, 1), P(1, 2), P(2, 2));
+  char* const end = buf + sizeof(buf);
+  char* p = std::copy(t.begin(), t.end(), buf);
+  *p++ = ',';
+  p = std::to_chars(p, end, a.id).ptr;
+  for (const double v : {a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z()}) p = appendG(p, end, v, 9);
+  p = appendUpper(p, end, a.cov_p_m2);
+  *p++ = '\n';
   errno = 0;
-  out_ << buf;
+  out_.write(buf, p - buf);
   if (!out_ && errno_ == 0) errno_ = errno;
-  tally_.wrote(formatSeconds(a.t), std::strlen(buf));
+  tally_.wrote(t, static_cast<size_t>(p - buf));
 }
 
 void AnchorsCsvWriter::flush() { checkedFlush(out_, path_, errno_, &tally_); }

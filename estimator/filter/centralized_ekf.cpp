@@ -8,6 +8,62 @@
 
 namespace meshnav::estimator {
 
+namespace {
+
+/// The IMU transition Φ by its nonzero entries (ImuPropagator: 87 of the 225, 15 of them ones):
+/// L Φᵀ for an n × 15 L is, column by column, out.col(i) = Σ_{Φ(i,j) ≠ 0} Φ(i,j) L.col(j): long
+/// contiguous columns, no packing, no product of a zero, no multiplication by a one. The entries
+/// are read from Φ, so any Φ is exact.
+class SparseImuTransition {
+ public:
+  explicit SparseImuTransition(const ImuMatrix& Phi) {
+    for (int i = 0; i < kI; ++i) {
+      first_[i] = n_;
+      for (int j = 0; j < kI; ++j)
+        if (Phi(i, j) != 0.0) entries_[n_++] = Entry{j, Phi(i, j)};
+    }
+    first_[kI] = n_;
+  }
+  /// out = L Φᵀ for a 15-column L (out must not alias L).
+  template <typename Derived, typename Out>
+  void timesTransposed(const Eigen::MatrixBase<Derived>& L, Out& out) const {
+    out.resize(L.rows(), kI);
+    for (int i = 0; i < kI; ++i) {
+      auto o = out.col(i);
+      if (first_[i] == first_[i + 1]) {
+        o.setZero();
+        continue;
+      }
+      for (int k = first_[i]; k < first_[i + 1]; ++k) {
+        const Entry& e = entries_[k];
+        const bool first = k == first_[i];
+        if (e.value == 1.0) {
+          if (first)
+            o = L.col(e.col);
+          else
+            o += L.col(e.col);
+        } else if (first) {
+          o = e.value * L.col(e.col);
+        } else {
+          o += e.value * L.col(e.col);
+        }
+      }
+    }
+  }
+
+ private:
+  static constexpr int kI = ImuErr::kDim;
+  struct Entry {
+    int col = 0;
+    double value = 0.0;
+  };
+  Entry entries_[kI * kI];  ///< the nonzero entries by row
+  int first_[kI + 1] = {};
+  int n_ = 0;
+};
+
+}  // namespace
+
 CentralizedEkf::CentralizedEkf(const ImuPropagator& propagator, const KindRandomWalks& random_walks, bool joseph_form)
     : propagator_(propagator), random_walks_(random_walks), joseph_form_(joseph_form) {}
 
@@ -54,14 +110,22 @@ void CentralizedEkf::propagate(const Eigen::Vector3d& acc_m_s2, const Eigen::Vec
   x_.t = t_to;
   constexpr int kI = ImuErr::kDim;  // the IMU block is always first
   const int n = layout_.dim();
-  // P ← Φ_full P Φ_fullᵀ with Φ_full = diag(Φ, I): rows, then columns.
-  P_.topRows<kI>() = (Phi * P_.topRows<kI>()).eval();
-  P_.leftCols<kI>() = (P_.leftCols<kI>() * Phi.transpose()).eval();
-  P_.topLeftCorner<kI, kI>() += Q;
+  // P ← Φ_full P Φ_fullᵀ with Φ_full = diag(Φ, I): the IMU columns P Φ_fullᵀ (their blocks
+  // P_jI Φᵀ, j ≠ I, are final; the IMU rows take their transpose), then the IMU block
+  // Φ (P_II Φᵀ) + Q. (Before, two dense products over all n rows and columns, of which the mirror
+  // overwrote the second's rows below the IMU block: 15 × 15 × n multiplications a step for nothing.)
+  const SparseImuTransition phi(Phi);
+  auto& cols = scratch_.cols;
+  phi.timesTransposed(P_.leftCols<kI>(), cols);
+  ImuMatrix Pii;  // Φ P_II Φᵀ = (P_II Φᵀ)ᵀ Φᵀ, P_II symmetric
+  phi.timesTransposed(cols.topRows<kI>().transpose(), Pii);
+  Pii += Q;
   // Keep the touched rows/columns exactly symmetric.
-  const ImuMatrix Pii = P_.topLeftCorner<kI, kI>();
   P_.topLeftCorner<kI, kI>() = 0.5 * (Pii + Pii.transpose());
-  if (n > kI) P_.bottomLeftCorner(n - kI, kI) = P_.topRightCorner(kI, n - kI).transpose();
+  if (n > kI) {
+    P_.bottomLeftCorner(n - kI, kI) = cols.bottomRows(n - kI);
+    P_.topRightCorner(kI, n - kI) = cols.bottomRows(n - kI).transpose();
+  }
   for (const StateBlock& b : layout_.blocks()) {
     const double sigma = random_walks_.of(b.kind);
     if (sigma <= 0.0 || b.kind == kindOf<ImuKind>) continue;  // the IMU's noise is Q

@@ -49,6 +49,15 @@ class CentralizedEkf final : public FusionStrategy {
   NominalState x_;
   StateLayout layout_;
   Eigen::MatrixXd P_;
+  /// Working memory of propagate(): no allocation per IMU step once the state stops growing, and
+  /// not copied with the filter (every stored input keeps a copy of it, FilterContext).
+  struct Scratch {
+    Eigen::Matrix<double, Eigen::Dynamic, ImuErr::kDim> cols;  ///< P_·I Φᵀ
+    Scratch() = default;
+    Scratch(const Scratch&) {}
+    Scratch& operator=(const Scratch&) { return *this; }
+  };
+  Scratch scratch_;
 };
 
 }  // namespace meshnav::estimator

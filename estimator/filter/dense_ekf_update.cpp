@@ -36,6 +36,29 @@ DenseUpdateOutput denseEkfUpdate(Eigen::MatrixXd& P, const StateLayout& layout, 
   }
   out.K = ldlt.solve(U.transpose()).transpose();  // n × m
   out.dx = out.K * lin.residual;
+  if (m == 1) {
+    // One row of H (a range, the baro): K Uᵀ and K S Kᵀ are outer products. The form and the
+    // symmetrization below in one pass over the pairs (i ≥ j), in place, with the arithmetic of the
+    // matrix expressions per coefficient (the same values, without their three n × n temporaries).
+    const double s = S(0, 0);
+    const double* k = out.K.data();
+    const double* u = U.data();
+    for (Eigen::Index j = 0; j < n; ++j)
+      for (Eigen::Index i = j; i < n; ++i) {
+        double a, b;  // the new P(i, j) and P(j, i) before the symmetrization
+        if (joseph_form) {
+          a = P(i, j) + ((-(k[i] * u[j]) - k[j] * u[i]) + (k[i] * s) * k[j]);
+          b = P(j, i) + ((-(k[j] * u[i]) - k[i] * u[j]) + (k[j] * s) * k[i]);
+        } else {
+          a = P(i, j) - k[i] * u[j];
+          b = P(j, i) - k[j] * u[i];
+        }
+        P(i, j) = P(j, i) = 0.5 * (a + b);
+      }
+    out.S = std::move(S);
+    out.accepted = true;
+    return out;
+  }
   if (joseph_form) {
     const Eigen::MatrixXd KU = out.K * U.transpose();
     P += -KU - KU.transpose() + out.K * S * out.K.transpose();

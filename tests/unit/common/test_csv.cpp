@@ -142,3 +142,19 @@ TEST(Csv, AByteOrderMarkBeforeTheHeaderIsNotPartOfTheFirstColumn) {
   EXPECT_EQ(n, 1);
   EXPECT_EQ(diag.total(), 0);
 }
+
+// Fields are the pieces between commas, trimmed, empty ones included (after a trailing comma too):
+// an empty field is no number, and a row with a trailing comma has one field more.
+TEST(Csv, EmptyAndTrailingFieldsArePieces) {
+  const test::TempDir d("csv_pieces");
+  auto f = test::writeFile(d / "a.csv", "a,b,c\n 1 ,\t2,\n,,3\n4,5,6,\n7,8\n");
+  CsvReader r(f, {"a", "b", "c"});
+  Diagnostics diag;
+  std::vector<std::string> rows;
+  r.forEach([&](const CsvRow& row) {
+    auto show = [&](const char* c) { return row.number(c) ? std::to_string(static_cast<int>(*row.number(c))) : "-"; };
+    rows.push_back(show("a") + show("b") + show("c") + "|" + row.text("a"));
+  }, diag);
+  EXPECT_EQ(rows, (std::vector<std::string>{"12-|1", "--3|"}));
+  EXPECT_EQ(diag.get("a.csv:bad_row"), 2);  // 4 fields, then 2
+}

@@ -4,6 +4,10 @@
 #include "common/estimate_io.h"
 #include "tests/support/test_util.h"
 
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+
 using namespace meshnav;
 
 // Found by fuzz target estimate_csv (UBSan: 1e+20 cast to int): an anchors.csv id that is not a
@@ -77,4 +81,68 @@ TEST(EstimateIo, FlushOfAGoodFileDoesNotThrow) {
   w.write(e);
   EXPECT_NO_THROW(w.flush());
   EXPECT_NO_THROW(w.flush());
+}
+
+namespace {
+std::string fileText(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+}  // namespace
+
+// The writers format with std::to_chars: each row as the former snprintf "%.9g" / "%.6g" wrote it,
+// byte for byte, for values that are hard to print (estimate.csv of a run must not change).
+TEST(EstimateIo, RowsAreWhatPrintfWrites) {
+  const test::TempDir d("estimate_io_printf");
+  const double tricky[] = {0.0, -0.0, 1.0, -1.5, 1e-300, 4.9e-324, 1.7976931348623157e308, 0.1, 123456789.5,
+                           1234567895.0, 9.9999999949999, 2.5e-7, -3.0000000049e5, 1.0 / 3.0, 6.02214076e23};
+  std::vector<PoseEstimate> poses;
+  std::vector<AnchorEstimate> anchors;
+  const int n = static_cast<int>(std::size(tricky));
+  for (int k = 0; k < n; ++k) {
+    auto v = [&](int i) { return tricky[(k + i) % n]; };
+    PoseEstimate e;
+    e.t = Timestamp{(k % 2 ? -1 : 1) * static_cast<int64_t>(k) * 1234567};
+    e.p_IinG = {v(0), v(1), v(2)};
+    e.q_ItoG.coeffs() << v(3), v(4), v(5), v(6);  // x, y, z, w: not a rotation, printed as given
+    for (int i = 0; i < 9; ++i) e.cov_p_m2.data()[i] = v(7 + i);
+    for (int i = 0; i < 9; ++i) e.cov_theta_rad2.data()[i] = v(16 + i);
+    poses.push_back(e);
+    AnchorEstimate a;
+    a.t = e.t;
+    a.id = 100 + k;
+    a.p_AinG = e.p_IinG;
+    a.cov_p_m2 = e.cov_theta_rad2;
+    anchors.push_back(a);
+  }
+  {
+    EstimateCsvWriter w((d / "estimate.csv").string());
+    for (const auto& e : poses) w.write(e);
+    w.flush();
+    AnchorsCsvWriter wa((d / "anchors.csv").string());
+    for (const auto& a : anchors) wa.write(a);
+    wa.flush();
+  }
+  std::string expected_e = "t,tx,ty,tz,qx,qy,qz,qw,pxx,pxy,pxz,pyy,pyz,pzz,qrr,qrp,qry,qpp,qpy,qyy\n";
+  std::string expected_a = "t,id,x,y,z,pxx,pxy,pxz,pyy,pyz,pzz\n";
+  char buf[512];
+  for (const auto& e : poses) {
+    const auto& P = e.cov_p_m2;
+    const auto& Q = e.cov_theta_rad2;
+    std::snprintf(buf, sizeof(buf),
+                  "%s,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n",
+                  formatSeconds(e.t).c_str(), e.p_IinG.x(), e.p_IinG.y(), e.p_IinG.z(), e.q_ItoG.x(), e.q_ItoG.y(),
+                  e.q_ItoG.z(), e.q_ItoG.w(), P(0, 0), P(0, 1), P(0, 2), P(1, 1), P(1, 2), P(2, 2), Q(0, 0), Q(0, 1),
+                  Q(0, 2), Q(1, 1), Q(1, 2), Q(2, 2));
+    expected_e += buf;
+  }
+  for (const auto& a : anchors) {
+    const auto& P = a.cov_p_m2;
+    std::snprintf(buf, sizeof(buf), "%s,%d,%.9g,%.9g,%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n", formatSeconds(a.t).c_str(),
+                  a.id, a.p_AinG.x(), a.p_AinG.y(), a.p_AinG.z(), P(0, 0), P(0, 1), P(0, 2), P(1, 1), P(1, 2),
+                  P(2, 2));
+    expected_a += buf;
+  }
+  EXPECT_EQ(fileText(d / "estimate.csv"), expected_e);
+  EXPECT_EQ(fileText(d / "anchors.csv"), expected_a);
 }

@@ -35,6 +35,10 @@ TEST(Time, ValuesThatDoNotFitAreRefused) {
 
 TEST(Time, FormatSecondsHandlesEveryInt64) {
   EXPECT_EQ(formatSeconds(Timestamp{-1500000}), "-1.500000");
+  EXPECT_EQ(formatSeconds(Timestamp{0}), "0.000000");
+  EXPECT_EQ(formatSeconds(Timestamp{1}), "0.000001");
+  EXPECT_EQ(formatSeconds(Timestamp{-1}), "-0.000001");
+  EXPECT_EQ(formatSeconds(Timestamp{140010000}), "140.010000");
   EXPECT_EQ(formatSeconds(Timestamp{std::numeric_limits<int64_t>::min()}), "-9223372036854.775808");
   EXPECT_EQ(formatSeconds(Timestamp{std::numeric_limits<int64_t>::max()}), "9223372036854.775807");
 }

@@ -99,3 +99,44 @@ TEST(CentralizedEkf, CloneIsIndependent) {
   EXPECT_NE(copy->fullCovariance(), ekf.fullCovariance());
   EXPECT_EQ(copy->state().imu.p_IinG, Eigen::Vector3d(1, 2, 3));
 }
+
+TEST(CentralizedEkf, PropagationEqualsTheDenseTransition) {
+  // P ← Φ_full P Φ_fullᵀ + diag(Q, σ_k² Δt) with Φ_full = diag(Φ, I), on a fully correlated P: the
+  // block-sparse product of the filter against the dense one.
+  CentralizedEkf ekf = makeFilter(true);
+  ekf.update(rangeLike(0.2), 0.0);
+  const Eigen::MatrixXd P = ekf.fullCovariance();
+  const int n = static_cast<int>(P.rows());
+  ImuState x = ekf.state().imu;
+  x.q_ItoG = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, -0.5, 0.8).normalized()));
+  x.bias_gyro_rad_s = {0.01, -0.02, 0.005};
+  x.bias_acc_m_s2 = {0.05, 0.02, -0.03};
+  ekf.reset(1, x, P.topLeftCorner<15, 15>(), Timestamp{});  // the rotated attitude, then the blocks back
+  ekf.addInstance<BaroBiasKind>(2, 0.5, P.block(15, 15, 1, 1));
+  ekf.addInstance<AnchorKind>(106, AnchorState{Eigen::Vector3d(0, 0, 2)}, P.block(16, 16, 3, 3));
+  // Cross-covariances back through an update that correlates every block.
+  Linearization lin = rangeLike(0.1);
+  lin.blocks[0].H = Eigen::MatrixXd(Eigen::RowVectorXd::LinSpaced(15, -0.7, 0.8));  // every error state
+  lin.blocks[1].H = Eigen::MatrixXd(Eigen::RowVector3d(0.6, 0.7, 0.4));
+  lin.blocks.push_back({2, Eigen::MatrixXd::Constant(1, 1, 1.0)});
+  ASSERT_TRUE(ekf.update(lin, 0.0).accepted);
+  const Eigen::MatrixXd P0 = ekf.fullCovariance();
+  ASSERT_GT(P0.block(0, 15, 15, n - 15).cwiseAbs().minCoeff(), 0.0);
+
+  const Eigen::Vector3d acc(0.3, -0.2, 9.7), gyro(0.2, -0.1, 0.4);
+  const ImuPropagator prop(9.81, ImuNoiseOptions{});
+  ImuState xp = ekf.state().imu;
+  ImuMatrix Phi, Q;
+  prop.propagate(xp, acc, gyro, 0.005, &Phi, &Q);
+  Eigen::MatrixXd F = Eigen::MatrixXd::Identity(n, n);
+  F.topLeftCorner<15, 15>() = Phi;
+  Eigen::MatrixXd expected = F * P0 * F.transpose();
+  expected.topLeftCorner<15, 15>() += Q;
+  expected(15, 15) += 0.02 * 0.02 * 0.005;  // the baro bias's random walk
+
+  ekf.propagate(acc, gyro, Timestamp::fromSec(0.005));
+  const Eigen::MatrixXd& P1 = ekf.fullCovariance();
+  EXPECT_LT((P1 - expected).cwiseAbs().maxCoeff(), 1e-15 * expected.cwiseAbs().maxCoeff() * n);
+  EXPECT_EQ(P1, P1.transpose());
+  EXPECT_TRUE(ekf.state().imu.p_IinG.isApprox(xp.p_IinG, 1e-15));
+}
