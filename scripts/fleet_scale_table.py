@@ -316,7 +316,7 @@ def tables(results, a):
         mf, ma = mean(an["multi_fleet"]), mean(an["multi_alone"])
         lines.append(f"| {r['seed']} | {an['n_calibrated']} ({an['n_multi']}) | {mf:.3f} / {ma:.3f} ({mf / ma if ma else float('nan'):.2f}) "
                      f"| {sum(an['nees_all'])} / {len(an['nees_all'])} | {sum(an['nees_multi'])} / {len(an['nees_multi'])} "
-                     f"| {ok_of(an.get('shared_nees', []))} / {ok_of(an.get('shared_nees_multi', []))} |")
+                     f"| {ok_of(an.get('shared_nees', []))}; {ok_of(an.get('shared_nees_multi', []))} |")
     mf = [x for r in results for x in r["anchors"]["multi_fleet"]]
     ma = [x for r in results for x in r["anchors"]["multi_alone"]]
     na = [x for r in results for x in r["anchors"]["nees_all"]]
