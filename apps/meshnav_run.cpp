@@ -5,6 +5,7 @@
 /// mission nodes run in one `pipeline::Pipeline`, wired as the processes are over LCM. With
 /// `--fleet FILE` several vehicles' datasets run in one pipeline that shares the anchor map.
 
+#include <algorithm>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -25,6 +26,7 @@
 #include "estimator/node/estimator_node.h"
 #include "calibrator/calibration_io.h"
 #include "calibrator/node/calibrator_config.h"
+#include "pipeline/anchor_belief_intersection.h"
 #include "pipeline/fleet.h"
 #include "pipeline/pipeline.h"
 
@@ -48,6 +50,7 @@ struct RunOptions {
   bool no_calibration = false, allow_lost = false, print_config = false, print_model_parameters = false;
   bool calibrate_on_smoothed = false;
   bool no_inter_vehicle_ranges = false;
+  bool peer_truth = false;
 };
 
 void declareOptions(Cli& cli, RunOptions& o) {
@@ -82,6 +85,11 @@ void declareOptions(Cli& cli, RunOptions& o) {
            "with --fleet: count and drop the ranges between two vehicles' tags instead of fusing each in one of "
            "the two vehicles with the other's estimated tag (docs/fleet.md, inter-vehicle ranges)")
       ->needs("--fleet");
+  cli.flag("peer-truth", o.peer_truth,
+           "analysis only, with --fleet: fuse each inter-vehicle range in both vehicles with the other's TRUE tag "
+           "(its dataset's groundtruth.csv) as an exact point: the bound of what the ranges allow (docs/fleet.md)")
+      ->needs("--fleet")
+      ->excludes("--no-inter-vehicle-ranges");
   cli.optional("calib-config", o.calib_config,
                "calibrator options YAML (default: built-in = config/calibrator.yaml); calibration results are "
                "written to calibration.yaml in --out")
@@ -303,6 +311,24 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
   std::vector<pipeline::Vehicle> vehicles;
   for (const auto& r : runs) vehicles.push_back({r.name, r.ds.setup});
   const SystemSetup fleet_setup = o.fleet.empty() ? runs[0].ds.setup : pipeline::mergeFleetSetups(vehicles, o.fleet);
+  if (o.peer_truth) {
+    for (const auto& r : runs)
+      if (r.ds.ground_truth.empty())
+        throw std::runtime_error(r.dataset + ": --peer-truth needs groundtruth.csv");
+    popts.peer_truth = [&runs](size_t v, Timestamp t) -> std::optional<PoseSample> {
+      const std::vector<PoseSample>& gt = runs.at(v).ds.ground_truth;
+      auto it = std::lower_bound(gt.begin(), gt.end(), t, [](const PoseSample& p, Timestamp x) { return p.t < x; });
+      if (it == gt.end() || it == gt.begin()) return std::nullopt;  // outside the ground truth
+      const PoseSample& b = *it;
+      const PoseSample& a = *std::prev(it);
+      const double w = (t - a.t).sec() / std::max((b.t - a.t).sec(), 1e-9);
+      PoseSample p;
+      p.t = t;
+      p.p_IinG = (1.0 - w) * a.p_IinG + w * b.p_IinG;
+      p.q_ItoG = a.q_ItoG.slerp(w, b.q_ItoG);
+      return p;
+    };
+  }
 
   std::vector<std::vector<EstimatorInput>> per_vehicle;
   for (size_t v = 0; v < runs.size(); ++v) {
@@ -365,6 +391,16 @@ int runPipeline(const RunOptions& o, const EstimatorOptions& options) {
     runs[v].anchors->flush();
     if (runs[v].smoothed) runs[v].smoothed->flush();
     writeTimings(node.timings(), (runs[v].out / "timings.csv").string());
+  }
+  if (runs.size() > 1) {
+    // The fleet's one belief of each estimated anchor: the covariance intersection of every
+    // vehicle's final belief (they share the calibration: docs/decisions/016-fleet-sharing.md).
+    std::vector<std::vector<AnchorEstimate>> per_vehicle(runs.size());
+    for (size_t v = 0; v < runs.size(); ++v)
+      if (pipe.estimator(v).initialized()) per_vehicle[v] = pipe.estimator(v).anchors();
+    AnchorsCsvWriter shared((std::filesystem::path(o.out) / "shared_anchors.csv").string());
+    for (const AnchorEstimate& a : pipeline::AnchorBeliefIntersection::fuseVehicles(per_vehicle)) shared.write(a);
+    shared.flush();
   }
   if (pipe.diagnostics().total() > 0) spdlog::info("fleet: {}", pipe.diagnostics().summary());
   if (const auto* cal = pipe.calibrator()) {

@@ -40,6 +40,7 @@
 #include "estimator/node/estimator_node.h"
 #include "mission/mission.h"
 #include "mission/mission_node.h"
+#include "pipeline/peer_range_router.h"
 
 namespace meshnav::pipeline {
 
@@ -59,6 +60,13 @@ struct PipelineOptions {
   /// A fleet's ranges between two vehicles' tags: fused (true) as a range to the other vehicle's
   /// estimated tag (docs/fleet.md "Inter-vehicle ranges"), or counted and dropped (false).
   bool inter_vehicle_ranges = true;
+  /// Which vehicle fuses an inter-vehicle range (PeerRangeRouter; docs/decisions/016-fleet-sharing.md).
+  PeerRangeRoutingOptions peer_routing;
+  /// Analysis only, never a default (meshnav_run --peer-truth, docs/fleet.md "What the data
+  /// allows"): the true pose of vehicle `vehicle` at `t` (nullopt: none). When set, each
+  /// inter-vehicle range is fused in **both** vehicles, each with the other's true tag as an exact
+  /// point (zero covariance): the bound of what the tag-to-tag ranges can give.
+  std::function<std::optional<PoseSample>(size_t vehicle, Timestamp t)> peer_truth;
 };
 
 /// One vehicle of a fleet: a name (its output folder) and its setup. The anchors of every vehicle's
@@ -134,7 +142,7 @@ class Pipeline {
   /// False for an anchor–anchor range another vehicle's dataset already gave the calibrator (within
   /// 10 s; counted "mesh_range_from_another_vehicle").
   bool firstInFleet(const RangeSample& r);
-  /// ANCHORS of vehicle v towards the calibrator: per anchor the tightest of the vehicles' latest.
+  /// ANCHORS of vehicle v towards the calibrator: per anchor the CI of the vehicles' latest.
   void forwardAnchors(size_t v, const std::vector<AnchorEstimate>& anchors);
 
   PipelineOptions options_;
@@ -150,6 +158,8 @@ class Pipeline {
   Diagnostics diag_;
   std::set<std::tuple<int64_t, SensorId, SensorId>> mesh_ranges_;  ///< (µs, ids) given to the calibrator
   std::set<std::tuple<int64_t, SensorId, SensorId>> peer_ranges_;  ///< (µs, ids) of inter-vehicle ranges fused
+  std::unique_ptr<PeerRangeRouter> router_;                         ///< a fleet's (null for one vehicle)
+  std::set<SensorId> calibrated_anchors_;                           ///< ids of the ANCHOR_INITs so far
   /// An inter-vehicle range from vehicle `vehicle`'s data to the vehicle that learns more from it.
   void routeInterVehicleRange(size_t vehicle, const RangeSample& r);
   std::vector<std::optional<Timestamp>> last_pose_to_calibrator_;  ///< per vehicle

@@ -124,8 +124,8 @@ def evaluate(a, dataset, run_dir, calibration, log):
 
 
 def window_errors(errors_csv, t0, t1):
-    """RMSE and largest position error over [t0, t1] from meshnav_eval's errors.csv."""
-    se, worst, n = 0.0, 0.0, 0
+    """RMSE, largest position error and mean position NEES over [t0, t1] from meshnav_eval's errors.csv."""
+    se, worst, n, nees, n_nees = 0.0, 0.0, 0, 0.0, 0
     with open(errors_csv) as f:
         for row in csv.DictReader(f):
             t = float(row["t"])
@@ -134,7 +134,43 @@ def window_errors(errors_csv, t0, t1):
                 se += e * e
                 worst = max(worst, e)
                 n += 1
-    return (math.sqrt(se / n) if n else float("nan")), worst
+                if row.get("nees_p"):
+                    nees += float(row["nees_p"])
+                    n_nees += 1
+    return (math.sqrt(se / n) if n else float("nan")), worst, (nees / n_nees if n_nees else float("nan"))
+
+
+def shared_anchor_nees(shared_csv, truth_yaml, fly_by_ids):
+    """id -> NEES of the fleet's shared (CI) belief of each fly-by anchor against the truth (meshnav_run's
+    shared_anchors.csv: the covariance intersection of every vehicle's final belief)."""
+    if not os.path.isfile(shared_csv):
+        return {}
+    with open(truth_yaml) as f:
+        truth = (yaml.safe_load(f) or {}).get("anchor_positions", {})
+    out = {}
+    with open(shared_csv) as f:
+        for row in csv.DictReader(f):
+            i = int(row["id"])
+            if i not in fly_by_ids or i not in truth:
+                continue
+            e = [float(row[k]) - float(x) for k, x in zip("xyz", truth[i])]
+            P = [[float(row["pxx"]), float(row["pxy"]), float(row["pxz"])],
+                 [float(row["pxy"]), float(row["pyy"]), float(row["pyz"])],
+                 [float(row["pxz"]), float(row["pyz"]), float(row["pzz"])]]
+            out[i] = quad_inv(P, e)
+    return out
+
+
+def quad_inv(P, e):
+    """e^T P^-1 e for a 3x3 symmetric positive definite P (Cramer's rule)."""
+    a, b, c = P[0]
+    _, d, f_ = P[1]
+    g = P[2][2]
+    det = a * (d * g - f_ * f_) - b * (b * g - f_ * c) + c * (b * f_ - d * c)
+    inv = [[d * g - f_ * f_, c * f_ - b * g, b * f_ - c * d],
+           [c * f_ - b * g, a * g - c * c, b * c - a * f_],
+           [b * f_ - c * d, b * c - a * f_, a * d - b * b]]
+    return sum(e[i] * inv[i][j] * e[j] for i in range(3) for j in range(3)) / det
 
 
 def contributors(calibration):
@@ -221,8 +257,12 @@ def run_seed(a, seed):
                 nees_all.append(ok)
                 if len(vs) >= 2:
                     nees_multi.append(ok)
+    shared = shared_anchor_nees(os.path.join(base, "fleet", "shared_anchors.csv"), os.path.join(sim, "v0", "truth.yaml"),
+                                set(fleet_from))
     res["anchors"] = {"n_calibrated": len(fleet_from), "n_multi": sum(1 for vs in fleet_from.values() if len(vs) >= 2),
-                      "multi_fleet": multi, "multi_alone": single, "nees_all": nees_all, "nees_multi": nees_multi}
+                      "multi_fleet": multi, "multi_alone": single, "nees_all": nees_all, "nees_multi": nees_multi,
+                      "shared_nees": [shared[i] for i in sorted(shared)],
+                      "shared_nees_multi": [shared[i] for i in sorted(shared) if len(fleet_from.get(i, ())) >= 2]}
     with open(os.path.join(base, "result.json"), "w") as f:
         json.dump(res, f, indent=1, default=str)
     return res
@@ -232,47 +272,59 @@ def mean(xs):
     return sum(xs) / len(xs) if xs else float("nan")
 
 
+def ok_of(nees):
+    """'k / n': how many of the NEES values are <= NEES_BOUND."""
+    return f"{sum(1 for x in nees if x <= NEES_BOUND)} / {len(nees)}"
+
+
 def tables(results, a):
     t0, t1 = a.window
     lines = ["Position per vehicle (fleet with inter-vehicle ranges / alone), RMSE [m] and ANEES:", "",
-             "| seed | " + " | ".join(f"v{v} RMSE" for v in range(a.vehicles)) + " | worst | ANEES fleet (mean) |",
+             "| seed | " + " | ".join(f"v{v} RMSE" for v in range(a.vehicles)) + " | worst | ANEES fleet per vehicle (mean) |",
              "| ---: |" + " ---: |" * (a.vehicles + 2)]
     for r in results:
         cells = [f"{veh['fleet_rmse']:.3f} / {veh['alone_rmse']:.3f}" for veh in r["vehicles"]]
         worst = max(veh["fleet_rmse"] for veh in r["vehicles"])
+        per_vehicle = " ".join(f"{veh['fleet_anees']:.2f}" for veh in r["vehicles"])
         lines.append(f"| {r['seed']} | " + " | ".join(cells) +
-                     f" | {worst:.3f} | {mean([veh['fleet_anees'] for veh in r['vehicles']]):.2f} |")
+                     f" | {worst:.3f} | {per_vehicle} "
+                     f"({mean([veh['fleet_anees'] for veh in r['vehicles']]):.2f}) |")
     allv = [veh for r in results for veh in r["vehicles"]]
     lines.append(f"| all | {sum(1 for v in allv if v['fleet_rmse'] <= 0.12)} of {len(allv)} vehicles <= 0.12 m; "
                  f"mean {mean([v['fleet_rmse'] for v in allv]):.3f} / {mean([v['alone_rmse'] for v in allv]):.3f} m |" +
                  " |" * (a.vehicles + 1))
     lines += ["", f"Outage: the anchors silent for one vehicle over {t0:g}-{t1:g} s, its position error there "
-              "(RMSE / largest) [m] with and without inter-vehicle ranges:", "",
+              "(RMSE / largest [m], mean position NEES) with and without inter-vehicle ranges:", "",
               "| seed | vehicle | tag-to-tag ranges in the window (per neighbour) | with | without |",
               "| ---: | ---: | ---: | ---: | ---: |"]
     for r in results:
         w, wo = r["outage_with"], r["outage_without"]
         per = ", ".join(f"v{k}: {n}" for k, n in sorted(r["peers"].items(), key=lambda kv: int(kv[0])))
-        lines.append(f"| {r['seed']} | v{r['victim']} | {r['peer_ranges']} ({per}) | {w[0]:.3f} / {w[1]:.3f} "
-                     f"| {wo[0]:.3f} / {wo[1]:.3f} |")
+        nees = lambda x: f", {x[2]:.2f}" if len(x) > 2 else ""  # noqa: E731 (result.json of older versions: 2 figures)
+        lines.append(f"| {r['seed']} | v{r['victim']} | {r['peer_ranges']} ({per}) | {w[0]:.3f} / {w[1]:.3f}{nees(w)} "
+                     f"| {wo[0]:.3f} / {wo[1]:.3f}{nees(wo)} |")
     ok = sum(1 for r in results if r["outage_with"][0] <= 0.30)
     lines.append(f"| all | | | {ok} of {len(results)} <= 0.30 m, mean {mean([r['outage_with'][0] for r in results]):.3f} "
                  f"| mean {mean([r['outage_without'][0] for r in results]):.3f} |")
     lines += ["", "Fly-by anchors: calibrated from >= 2 vehicles' tags in the fleet against the same anchors from one "
               "vehicle alone (error when first calibrated [m]); final NEES <= 13.93 of every vehicle's last estimate:", "",
-              "| seed | calibrated (from >= 2 vehicles) | error fleet / alone (ratio) | final NEES ok, all | final NEES ok, >= 2 vehicles |",
-              "| ---: | ---: | ---: | ---: | ---: |"]
+              "| seed | calibrated (from >= 2 vehicles) | error fleet / alone (ratio) | final NEES ok, all | final NEES ok, >= 2 vehicles "
+              "| shared (CI) belief NEES ok, all / >= 2 vehicles |",
+              "| ---: | ---: | ---: | ---: | ---: | ---: |"]
     for r in results:
         an = r["anchors"]
         mf, ma = mean(an["multi_fleet"]), mean(an["multi_alone"])
         lines.append(f"| {r['seed']} | {an['n_calibrated']} ({an['n_multi']}) | {mf:.3f} / {ma:.3f} ({mf / ma if ma else float('nan'):.2f}) "
-                     f"| {sum(an['nees_all'])} / {len(an['nees_all'])} | {sum(an['nees_multi'])} / {len(an['nees_multi'])} |")
+                     f"| {sum(an['nees_all'])} / {len(an['nees_all'])} | {sum(an['nees_multi'])} / {len(an['nees_multi'])} "
+                     f"| {ok_of(an.get('shared_nees', []))}; {ok_of(an.get('shared_nees_multi', []))} |")
     mf = [x for r in results for x in r["anchors"]["multi_fleet"]]
     ma = [x for r in results for x in r["anchors"]["multi_alone"]]
     na = [x for r in results for x in r["anchors"]["nees_all"]]
     nm = [x for r in results for x in r["anchors"]["nees_multi"]]
+    sa = [x <= NEES_BOUND for r in results for x in r["anchors"].get("shared_nees", [])]
+    sm = [x <= NEES_BOUND for r in results for x in r["anchors"].get("shared_nees_multi", [])]
     lines.append(f"| all | {len(mf)} compared | {mean(mf):.3f} / {mean(ma):.3f} ({mean(mf) / mean(ma) if ma else float('nan'):.2f}) "
-                 f"| {100.0 * mean(na):.1f} % | {100.0 * mean(nm):.1f} % |")
+                 f"| {100.0 * mean(na):.1f} % | {100.0 * mean(nm):.1f} % | {100.0 * mean(sa):.1f} % / {100.0 * mean(sm):.1f} % |")
     return lines
 
 

@@ -70,6 +70,17 @@ CellRanges CellRangeSimulator::simulate(double t_end_s) const {
     anchor_turn[a.id] = 0;
   }
 
+  if (schedule_.hasPeerPhase() && schedule_.peerPhaseSlots() != static_cast<int>(tags.size()) * schedule_.options().peer_slots)
+    throw std::invalid_argument("CellRangeSimulator: the schedule's peer phase is not for the fleet's " +
+                                std::to_string(tags.size()) + " tags");
+  // The peer phase's round robin of each tag: the other vehicles' tags, in id order.
+  std::vector<std::vector<size_t>> fleet_peers(tags.size());
+  for (size_t i = 0; i < tags.size(); ++i)
+    for (size_t j = 0; j < tags.size(); ++j)
+      if (tags[j].vehicle != tags[i].vehicle) fleet_peers[i].push_back(j);
+  std::vector<int64_t> peer_turn(tags.size(), 0);
+  RandomStream rng_peer(RandomStream::deriveSeed(seed_, "cell_peer_ranges"));
+
   CellRanges out;
   out.vehicle.resize(vehicles_.size());
   out.stats.resize(vehicles_.size());
@@ -124,6 +135,29 @@ CellRanges CellRangeSimulator::simulate(double t_end_s) const {
   const int64_t n_slots = schedule_.slotCountUntil(t_end_s);
   for (int64_t s = 0; s < n_slots; ++s) {
     const CellTdmaSlot slot = schedule_.slot(s);
+    if (slot.role == CellSlotRole::PeerSeat) {
+      // Fleet-wide: tag `seat` initiates to the next other vehicle's tag (its own draws, so the cells'
+      // draws do not depend on the peer phase).
+      SlotDraws u;
+      u.u_drop = rng_peer.uniform();
+      u.u_outlier = rng_peer.uniform();
+      u.n = rng_peer.gaussian();
+      u.u_excess = rng_peer.uniform();
+      const size_t i = static_cast<size_t>(slot.seat);
+      const size_t v = tags[i].vehicle;
+      const auto& peers = fleet_peers[i];
+      if (!ranging(v, slot.t_s) || peers.empty()) continue;
+      const size_t j = peers[static_cast<size_t>(peer_turn[i]++ % static_cast<int64_t>(peers.size()))];
+      if (!ranging(tags[j].vehicle, slot.t_s)) continue;
+      CellRangeStats& st = out.stats[v];
+      ++st.peer_slots;
+      if (auto r = exchange(tags[i].id, tags[j].id, UwbType::Tag, UwbType::Tag, slot.t_s, u, st.dropped, st.outliers)) {
+        ++st.ranges;
+        ++st.tag_to_tag;
+        out.vehicle[v].push_back(*r);
+      }
+      continue;
+    }
     const auto& active = colour_cells[static_cast<size_t>(slot.colour)];
     if (slot.phase_slot == 0) {  // seat the tags in the active cells
       for (size_t i = 0; i < tags.size(); ++i)
@@ -139,9 +173,10 @@ CellRanges CellRangeSimulator::simulate(double t_end_s) const {
         seated.push_back(i);
         auto& peers = tag_peers[i];
         peers = near[static_cast<size_t>(tag_cell[i])];
-        for (size_t j = 0; j < tags.size(); ++j)
-          if (tags[j].vehicle != tags[i].vehicle && tag_cell[j] >= 0 && cells.neighbours(tag_cell[i], tag_cell[j]))
-            peers.push_back(tags[j].id);
+        if (!schedule_.hasPeerPhase())  // the other vehicles' tags of the neighbourhood join the round robin
+          for (size_t j = 0; j < tags.size(); ++j)
+            if (tags[j].vehicle != tags[i].vehicle && tag_cell[j] >= 0 && cells.neighbours(tag_cell[i], tag_cell[j]))
+              peers.push_back(tags[j].id);
         std::sort(peers.begin(), peers.end());
       }
     }

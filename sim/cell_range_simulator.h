@@ -10,6 +10,8 @@
 /// p_IinG + R_ItoG p_TinI), stamped t + `time_offset_s`. A tag's cell is taken from its true
 /// position at the phase's first slot (a real tag would use its estimate; the simulator uses the
 /// truth). A vehicle ranges only within [0, its duration].
+/// The schedule's **peer phase** (CellTdmaSchedule): tag `seat` of the fleet (id order) initiates
+/// to the next other vehicle's tag, wherever in the hall it is, with draws of its own stream.
 /// **Outage** (`CellOutage`): from t0 to t1 the anchors do not answer one vehicle's tags (slots
 /// used, nothing written; counted), its tag-to-tag ranges go on.
 
@@ -44,7 +46,8 @@ struct CellOutage {
 
 /// Per vehicle: what its tags initiated and what became of it.
 struct CellRangeStats {
-  int64_t tag_slots = 0;      ///< slots in which one of its tags was seated
+  int64_t tag_slots = 0;      ///< slots in which one of its tags was seated in a cell
+  int64_t peer_slots = 0;     ///< peer-phase slots of its tags with the peer flying
   int64_t ranges = 0;         ///< written (to anchors and to other vehicles' tags)
   int64_t tag_to_tag = 0;     ///< of those, to another vehicle's tag
   int64_t dropped = 0;

@@ -114,7 +114,9 @@ ScaledFleet simulateScaledFleet(const ScaledFleetOptions& options) {
 
   RandomStream rng_tdma(RandomStream::deriveSeed(seed, "cell_tdma_phase"));
   const double t0_s = std::round(rng_tdma.uniform(0.0, options.tdma.slot_s) * 1e6) * 1e-6;
-  const CellTdmaSchedule schedule(layout.cells().colourCount(), options.tdma, t0_s);
+  int n_fleet_tags = 0;
+  for (const CellVehicle& v : ranging) n_fleet_tags += static_cast<int>(v.tags_p_TinI.size());
+  const CellTdmaSchedule schedule(layout.cells().colourCount(), options.tdma, t0_s, n_fleet_tags);
   const UwbHardwareBiases biases(devices, options.base.hardware);
   double t_end = 0.0;
   for (const CellVehicle& v : ranging) t_end = std::max(t_end, v.t_end_s);
@@ -150,6 +152,7 @@ ScaledFleet simulateScaledFleet(const ScaledFleetOptions& options) {
     sc["tdma_t0_s"] = t0_s;
     sc["tdma_frame_s"] = schedule.frameDuration();
     sc["tdma_tag_rate_hz"] = schedule.tagRangeRateHz();
+    sc["tdma_peer_rate_hz"] = schedule.peerRangeRateHz();
     sc["tdma_colours"] = schedule.colourCount();
     sc.erase("scenario_anchor_layout");
     sc["scenario_anchor_grid_x"] = layout.pointsX();

@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "common/skew.h"
+#include "pipeline/anchor_belief_intersection.h"
 #include "pipeline/fleet.h"
 
 namespace meshnav::pipeline {
@@ -31,6 +32,7 @@ Pipeline::Pipeline(const PipelineOptions& options, std::vector<Vehicle> vehicles
     estimators_.push_back(std::make_unique<estimator::EstimatorNode>(options_.estimator, vehicles_[v].setup, es));
   }
   anchor_beliefs_.resize(vehicles_.size());
+  if (vehicles_.size() > 1) router_ = std::make_unique<PeerRangeRouter>(options_.peer_routing, vehicles_.size());
   last_pose_to_calibrator_.resize(vehicles_.size());
   awaiting_smoothed_.resize(vehicles_.size());
   if (options_.calibration_enabled) {
@@ -73,6 +75,11 @@ void Pipeline::onInput(size_t vehicle, const estimator::EstimatorInput& in) {
         drain();  // the receiver's outputs
         return;
       }
+      // A range of this vehicle's tag to an anchor it can use (known or calibrated): its anchor count.
+      const SensorId other = mine.isTag(r->id_initiator) ? r->id_responder : r->id_initiator;
+      if ((mine.isTag(r->id_initiator) || mine.isTag(r->id_responder)) &&
+          (fleet_setup_.isKnownAnchor(other) || calibrated_anchors_.count(other)))
+        router_->noteAnchorRange(vehicle, other, r->t);
     }
   node.onInput(in);
   if (calibrator_) {
@@ -104,15 +111,39 @@ void Pipeline::routeInterVehicleRange(size_t vehicle, const RangeSample& r) {
     diag_.count("inter_vehicle_range_not_between_two_vehicles");
     return;
   }
-  const std::optional<PoseEstimate> pa = estimators_[*va]->pose(), pb = estimators_[*vb]->pose();
-  if (!pa && !pb) {
-    diag_.count("inter_vehicle_range_no_estimate");
+  if (options_.peer_truth) {
+    // The oracle: both vehicles, each with the other's true tag (independent of either estimate).
+    for (const auto& [receiver, sender, peer_tag] :
+         {std::tuple{*va, *vb, r.id_responder}, std::tuple{*vb, *va, r.id_initiator}}) {
+      const std::optional<PoseSample> truth = options_.peer_truth(sender, r.t);
+      if (!truth || !estimators_[receiver]->pose()) continue;
+      PeerRange pr;
+      pr.t = r.t;
+      pr.range = r;
+      pr.peer_tag = peer_tag;
+      pr.p_peer_tag_in_G = truth->p_IinG + truth->q_ItoG * vehicles_[sender].setup.rel_tag_positions.at(peer_tag);
+      pr.cov_peer_tag_m2.setZero();
+      diag_.count("inter_vehicle_range_to:" + vehicles_[receiver].name);
+      estimators_[receiver]->onInput(pr);
+    }
     return;
   }
+  const std::optional<PoseEstimate> pa = estimators_[*va]->pose(), pb = estimators_[*vb]->pose();
   // One of the two learns from the range, with the other's estimate as its anchor (never both:
-  // each would count the other's information as independent of its own, docs/fleet.md): the
-  // vehicle without an estimate yet, else the one with the larger position uncertainty.
-  bool to_a = !pa || (pb && pa->cov_p_m2.trace() > pb->cov_p_m2.trace());
+  // each would count the other's information as independent of its own), and only where that
+  // estimate holds nothing of the receiver's (PeerRangeRouter: from a vehicle with anchors to one
+  // without, docs/decisions/016-fleet-sharing.md).
+  PeerSide sa, sb;
+  sa.has_estimate = pa.has_value();
+  sb.has_estimate = pb.has_value();
+  if (pa) sa.cov_p_trace_m2 = pa->cov_p_m2.trace();
+  if (pb) sb.cov_p_trace_m2 = pb->cov_p_m2.trace();
+  const PeerRangeRouter::Decision decision = router_->decide(*va, sa, *vb, sb, r.t);
+  if (!decision.receiver) {
+    diag_.count("inter_vehicle_range_" + decision.why);
+    return;
+  }
+  const bool to_a = *decision.receiver == *va;
   const size_t receiver = to_a ? *va : *vb, sender = to_a ? *vb : *va;
   const PoseEstimate& ps = to_a ? *pb : *pa;
   const SensorId peer_tag = to_a ? r.id_responder : r.id_initiator;
@@ -129,6 +160,7 @@ void Pipeline::routeInterVehicleRange(size_t vehicle, const RangeSample& r) {
   pr.p_peer_tag_in_G = ps.p_IinG + dt * ps.v_IinG + R * l;
   pr.cov_peer_tag_m2 = ps.cov_p_m2 + dt * dt * ps.cov_v + J * ps.cov_theta_rad2 * J.transpose();
   diag_.count("inter_vehicle_range_to:" + vehicles_[receiver].name);
+  router_->noteReceived(receiver, r.t);
   estimators_[receiver]->onInput(pr);
 }
 
@@ -152,14 +184,14 @@ void Pipeline::forwardAnchors(size_t v, const std::vector<AnchorEstimate>& ancho
   auto& mine = anchor_beliefs_[v];
   mine.clear();
   for (const auto& a : anchors) mine[a.id] = a;
-  std::map<SensorId, AnchorEstimate> best;
-  for (const auto& beliefs : anchor_beliefs_)
-    for (const auto& [id, a] : beliefs) {
-      auto it = best.find(id);
-      if (it == best.end() || a.cov_p_m2.trace() < it->second.cov_p_m2.trace()) best[id] = a;
-    }
-  std::vector<AnchorEstimate> merged;
-  for (const auto& [id, a] : best) merged.push_back(a);
+  // Per anchor, the covariance intersection of the vehicles' latest beliefs (they share the one
+  // ANCHOR_INIT and are correlated by an unknown amount: AnchorBeliefIntersection).
+  std::vector<std::vector<AnchorEstimate>> per_vehicle;
+  for (const auto& beliefs : anchor_beliefs_) {
+    per_vehicle.emplace_back();
+    for (const auto& [id, a] : beliefs) per_vehicle.back().push_back(a);
+  }
+  const std::vector<AnchorEstimate> merged = AnchorBeliefIntersection::fuseVehicles(per_vehicle);
   calibrator_->onAnchors(merged);
 }
 
@@ -206,6 +238,7 @@ void Pipeline::drain() {
             if (sinks_.estimator_status) sinks_.estimator_status(v, m);
           } else if constexpr (std::is_same_v<T, AnchorInit>) {
             anchor_inits_.push_back(m);
+            calibrated_anchors_.insert(m.id);
             for (size_t i = 0; i < estimators_.size(); ++i)
               estimators_[i]->onAnchorInit(vehicles_.size() == 1 ? m : restrictToVehicle(m, vehicles_[i].setup, fleet_setup_));
             if (sinks_.anchor_init) sinks_.anchor_init(m);

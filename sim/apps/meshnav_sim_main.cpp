@@ -90,6 +90,10 @@ void declareOptions(meshnav::Cli& cli, SimCli& c) {
   cli.option("tdma-slot", c.scaled.tdma.slot_s,
              "with --vehicles: the cell TDMA's slot, one SDS-TWR exchange with guard time [s]")
       ->type_name("S")->check(cli_checks::positive())->needs(vehicles)->group("Scaled fleet (--vehicles)");
+  cli.option("tdma-peer-slots", c.scaled.tdma.peer_slots,
+             "with --vehicles: slots per fleet tag in each frame's peer phase, tag to tag across the hall (0: no peer "
+             "phase, tags range to other vehicles' tags only within the cells' round robin; docs/scenarios.md)")
+      ->type_name("K")->check(CLI::Range(0, 16))->needs(vehicles)->group("Scaled fleet (--vehicles)");
   cli.optional("trajectory", c.trajectory,
                "spiral|figure8|lawnmower|helix|hover|walk (default spiral: the paper's flight). hover starts in the "
                "air; walk is a hand-held rig at 0.9-1.5 m with no take-off, no landed state and no barometer "

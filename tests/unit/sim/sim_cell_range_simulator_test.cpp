@@ -55,8 +55,11 @@ struct World {
     }
     biases = std::make_unique<UwbHardwareBiases>(devices);
   }
-  CellRanges simulate(const UwbRangeOptions& uwb, CellOutage outage = {}, CellTdmaOptions tdma = {}) const {
-    const CellTdmaSchedule schedule(layout.cells().colourCount(), tdma, 0.0005);
+  /// `peer_phase`: the schedule has the fleet's peer phase (CellTdmaSchedule's n_fleet_tags).
+  CellRanges simulate(const UwbRangeOptions& uwb, CellOutage outage = {}, CellTdmaOptions tdma = {},
+                      bool peer_phase = false) const {
+    const int n_tags = peer_phase ? static_cast<int>(2 * vehicles.size()) : 0;
+    const CellTdmaSchedule schedule(layout.cells().colourCount(), tdma, 0.0005, n_tags);
     return CellRangeSimulator(layout, vehicles, *biases, uwb, schedule, 7, outage).simulate(20.0);
   }
   bool isTag(SensorId id) const { return id >= 100 && (id % 1000 == 100 || id % 1000 == 105); }
@@ -141,6 +144,56 @@ TEST(SimCellRangeSimulator, AnOutageSilencesTheAnchorsForOneVehicleButNotItsNeig
   EXPECT_NEAR(static_cast<double>(with.stats[0].outage_silent), 5.0 * 2 * 4 / 0.36 * 16 / 18, 6.0);
   EXPECT_EQ(with.vehicle[1].size(), without.vehicle[1].size());  // v1 untouched
   EXPECT_EQ(with.mesh.size(), without.mesh.size());
+}
+
+TEST(SimCellRangeSimulator, WithAPeerPhaseTagsRangeEveryOtherVehicleAcrossTheHallAndNoPeerInTheCells) {
+  // v0 in cell 0, v1 beside it, v2 in the far corner (no cell neighbour of either); v0 without
+  // anchors over 5-10 s.
+  const World w({{-16, -16, 2}, {-10, -16, 3}, {16, 16, 5}});
+  CellOutage outage;
+  outage.vehicle = 0;
+  outage.t0_s = 5.0;
+  outage.t1_s = 10.0;
+  const CellRanges r = w.simulate(exact(), outage, {}, true);
+  const CellRanges legacy = w.simulate(exact(), outage);
+  // Frame: 180 + 6 peer slots = 0.372 s; each tag initiates one peer range per frame, in turn to
+  // the four tags of the two other vehicles.
+  const double frame_s = 186 * 0.002;
+  for (size_t v = 0; v < 3; ++v) {
+    std::map<SensorId, int> to_peer;
+    int to_anchor = 0;
+    for (const SimulatedRange& x : r.vehicle[v]) {
+      if (!w.isTag(x.sample.id_responder)) {
+        ++to_anchor;
+        continue;
+      }
+      EXPECT_NE(x.sample.id_responder / 1000, static_cast<SensorId>(v));
+      ++to_peer[x.sample.id_responder];
+      // Exact: z = beta d + gamma between the two tags' true positions.
+      const meshnav::PairBias& bias = w.biases->truth(x.sample.id_initiator, x.sample.id_responder);
+      EXPECT_NEAR(x.sample.range_m, bias.beta * x.true_distance_m + bias.gamma_m, 1e-9);
+    }
+    EXPECT_EQ(to_peer.size(), 4u) << "v" << v << " ranges every tag of both other vehicles";
+    int n_peer = 0;
+    for (const auto& [id, n] : to_peer) n_peer += n;
+    EXPECT_NEAR(n_peer / 20.0, 2.0 / frame_s, 0.2) << v;  // 2 tags x 1 slot per frame
+    EXPECT_EQ(r.stats[v].tag_to_tag, n_peer);
+    EXPECT_EQ(r.stats[v].peer_slots, n_peer);
+    if (v > 0) EXPECT_NEAR(to_anchor / 20.0, 2 * 4 / frame_s, 1.0) << v;  // the cells: anchors only
+  }
+  // The outage silences v0's anchors, not its peers: 5 s x 2 / 0.372 s ≈ 27 peer ranges in it.
+  int peers_in = 0;
+  for (const SimulatedRange& x : r.vehicle[0])
+    if (x.sample.t.sec() >= 5.0 && x.sample.t.sec() <= 10.0) {
+      EXPECT_TRUE(w.isTag(x.sample.id_responder));
+      ++peers_in;
+    }
+  EXPECT_NEAR(peers_in, 5.0 * 2 / frame_s, 2.0);
+  // Without the peer phase v2, alone in its corner, never ranged a tag.
+  for (const SimulatedRange& x : legacy.vehicle[2]) EXPECT_FALSE(w.isTag(x.sample.id_responder));
+  // A schedule whose peer phase is not for this fleet's tags is refused.
+  const CellTdmaSchedule wrong(w.layout.cells().colourCount(), {}, 0.0, 5);
+  EXPECT_THROW(CellRangeSimulator(w.layout, w.vehicles, *w.biases, exact(), wrong, 7).simulate(1.0), std::invalid_argument);
 }
 
 TEST(SimCellRangeSimulator, ATagBeyondTheCellsSeatsWaits) {

@@ -62,3 +62,43 @@ TEST(SimCellTdmaSchedule, OtherSeatsAndBadOptions) {
   empty.tag_seats = empty.anchor_seats = 0;
   EXPECT_THROW(CellTdmaSchedule(4, empty), std::invalid_argument);
 }
+
+TEST(SimCellTdmaSchedule, APeerPhaseEndsEachFrameWithSlotsForEveryFleetTag) {
+  // Ten fleet tags, one peer slot each: 180 + 10 slots = 0.38 s.
+  const CellTdmaSchedule s(9, CellTdmaOptions{}, 0.0, 10);
+  EXPECT_TRUE(s.hasPeerPhase());
+  EXPECT_EQ(s.peerPhaseSlots(), 10);
+  EXPECT_EQ(s.slotsPerFrame(), 190);
+  EXPECT_NEAR(s.frameDuration(), 0.38, 1e-12);
+  EXPECT_NEAR(s.tagRangeRateHz(), 4.0 / 0.38, 1e-9);
+  EXPECT_NEAR(s.peerRangeRateHz(), 1.0 / 0.38, 1e-9);
+  EXPECT_EQ(s.slot(179).role, CellSlotRole::AnchorSeat);
+  EXPECT_EQ(s.slot(179).colour, 8);
+  for (int k = 0; k < 10; ++k) {
+    const CellTdmaSlot p = s.slot(180 + k);
+    EXPECT_EQ(p.role, CellSlotRole::PeerSeat);
+    EXPECT_EQ(p.colour, -1);
+    EXPECT_EQ(p.seat, k);
+    EXPECT_EQ(p.frame, 0);
+  }
+  const CellTdmaSlot next = s.slot(190);
+  EXPECT_EQ(next.frame, 1);
+  EXPECT_EQ(next.colour, 0);
+  EXPECT_EQ(next.role, CellSlotRole::TagSeat);
+  // Two peer slots per tag: seat = slot / 2; no peer phase with m_p = 0 or no tags.
+  CellTdmaOptions two;
+  two.peer_slots = 2;
+  const CellTdmaSchedule s2(9, two, 0.0, 3);
+  EXPECT_EQ(s2.slotsPerFrame(), 186);
+  EXPECT_EQ(s2.slot(181).seat, 0);
+  EXPECT_EQ(s2.slot(182).seat, 1);
+  EXPECT_EQ(s2.slot(185).seat, 2);
+  CellTdmaOptions none;
+  none.peer_slots = 0;
+  EXPECT_FALSE(CellTdmaSchedule(9, none, 0.0, 10).hasPeerPhase());
+  EXPECT_EQ(CellTdmaSchedule(9, none, 0.0, 10).slotsPerFrame(), 180);
+  EXPECT_EQ(CellTdmaSchedule(9, CellTdmaOptions{}).peerRangeRateHz(), 0.0);
+  EXPECT_THROW(CellTdmaSchedule(9, CellTdmaOptions{}, 0.0, -1), std::invalid_argument);
+  none.peer_slots = -1;
+  EXPECT_THROW(CellTdmaSchedule(9, none, 0.0, 10), std::invalid_argument);
+}

@@ -48,7 +48,8 @@ TEST(SimScaledFleet, VehiclesShareOneWorldAndEachFileHoldsItsOwnTagsAndTheMesh) 
         ++mesh;
       }
     }
-    EXPECT_NEAR(own / 40.0, 2 * 4 / 0.36, 3.0);  // with drops and seat waits
+    // Two tags: 4 cell slots and 1 peer slot each per 0.38 s frame (10 fleet tags), with drops and seat waits.
+    EXPECT_NEAR(own / 40.0, 2 * (4 + 1) / 0.38, 3.0);
     EXPECT_GT(mesh, 1000);
     // Pair biases of pairs that can range only: a tag's with every known anchor, two anchors of
     // neighbouring cells.

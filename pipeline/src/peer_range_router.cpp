@@ -1,0 +1,78 @@
+/// @file peer_range_router.cpp
+/// @brief PeerRangeRouter: the acyclic choice of the vehicle that fuses an inter-vehicle range.
+
+#include "pipeline/peer_range_router.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace meshnav::pipeline {
+
+void PeerRangeRoutingOptions::validate() const {
+  if (min_anchors < 0) throw std::invalid_argument("PeerRangeRoutingOptions: min_anchors must be >= 0");
+  if (!(anchor_window_s > 0.0) || !std::isfinite(anchor_window_s))
+    throw std::invalid_argument("PeerRangeRoutingOptions: anchor_window_s must be > 0 s");
+  if (!(memory_s >= 0.0) || !std::isfinite(memory_s))
+    throw std::invalid_argument("PeerRangeRoutingOptions: memory_s must be >= 0 s");
+}
+
+std::string PeerRangeRoutingOptions::toString() const {
+  std::ostringstream s;
+  s << "peer ranges: received while fewer than " << min_anchors << " anchors in " << anchor_window_s
+    << " s, sent while no peer range received for " << memory_s << " s";
+  return s.str();
+}
+
+PeerRangeRouter::PeerRangeRouter(const PeerRangeRoutingOptions& options, size_t n_vehicles)
+    : options_(options), anchor_seen_(n_vehicles), last_received_(n_vehicles) {
+  options_.validate();
+  if (n_vehicles == 0) throw std::invalid_argument("PeerRangeRouter: no vehicle");
+}
+
+void PeerRangeRouter::noteAnchorRange(size_t v, SensorId anchor, Timestamp t) {
+  Timestamp& last = anchor_seen_.at(v)[anchor];
+  if (last < t) last = t;
+}
+
+void PeerRangeRouter::noteReceived(size_t v, Timestamp t) {
+  auto& last = last_received_.at(v);
+  if (!last || *last < t) last = t;
+}
+
+int PeerRangeRouter::anchorsSeen(size_t v, Timestamp t) const {
+  int n = 0;
+  for (const auto& [id, last] : anchor_seen_.at(v))
+    if ((t - last).sec() < options_.anchor_window_s) ++n;
+  return n;
+}
+
+bool PeerRangeRouter::clean(size_t v, Timestamp t) const {
+  const auto& last = last_received_.at(v);
+  return !last || (t - *last).sec() > options_.memory_s;
+}
+
+PeerRangeRouter::Decision PeerRangeRouter::decide(size_t a, const PeerSide& side_a, size_t b, const PeerSide& side_b,
+                                                  Timestamp t) const {
+  // x can receive from y: x needs it, y's estimate exists and holds nothing of x's.
+  auto can = [&](size_t x, const PeerSide& sx, size_t y, const PeerSide& sy) {
+    return sx.has_estimate && sy.has_estimate && shortOfAnchors(x, t) && clean(y, t);
+  };
+  const bool to_a = can(a, side_a, b, side_b), to_b = can(b, side_b, a, side_a);
+  Decision d;
+  if (to_a && to_b)
+    d.receiver = side_a.cov_p_trace_m2 >= side_b.cov_p_trace_m2 ? a : b;
+  else if (to_a)
+    d.receiver = a;
+  else if (to_b)
+    d.receiver = b;
+  else if (!side_a.has_estimate || !side_b.has_estimate)
+    d.why = "no_estimate";
+  else if (!shortOfAnchors(a, t) && !shortOfAnchors(b, t))
+    d.why = "not_needed";
+  else
+    d.why = "cycle";
+  return d;
+}
+
+}  // namespace meshnav::pipeline
