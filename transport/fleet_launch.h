@@ -8,6 +8,13 @@
 /// size becomes one launch of the existing supervisor (`./meshnav up --fleet FILE`,
 /// `meshnav_fleet_launch`). No calibrator and no mission (docs/fleet.md, "Not done yet").
 ///
+/// Buses (transport/fleet_bus.h): by default each vehicle's processes get `--lcm-url` of the
+/// vehicle's own bus (the base URL's port + 1 + its index in the fleet file), so that a vehicle's
+/// processes receive only its own traffic; `FleetBus::kShared` puts every process on the base URL
+/// (no `--lcm-url` unless `lcm_url` is given: the launch environment's LCM_DEFAULT_URL). A
+/// `calibrator_for` vehicle's calibrator and mission sit on that vehicle's bus, with its CALIB_CMD,
+/// CALIB_STATUS and MISSION_STATUS (docs/decisions/017-bus-per-vehicle.md).
+///
 /// Process names are `<vehicle>_estimator`, `<vehicle>_imu_bridge`, `<vehicle>_uwb_bridge`,
 /// `<vehicle>_logging` (and `<vehicle>_calibrator`, `<vehicle>_mission` for `calibrator_for`); the launch stops when every bridge has played its data
 /// (`shutdown_after`), the loggers last (`stop_last`). Variables of the generated file: BIN
@@ -19,6 +26,7 @@
 #include <vector>
 
 #include "common/fleet_file.h"
+#include "transport/fleet_bus.h"
 
 namespace meshnav::transport {
 
@@ -34,17 +42,24 @@ struct FleetLaunchOptions {
   double shutdown_delay_s = 2.0;
   std::string source;            ///< the fleet file's path, named in the header comment
   /// Non-empty: a calibrator and (with `mission`) a mission serving this one vehicle over LCM
-  /// (`--channel-prefix` it: its RANGE, POSE, ANCHORS in, its ANCHOR_INIT out; CALIB_CMD and
-  /// CALIB_STATUS are the fleet's), so that it gets its fly-by anchors; a calibrator serving the
-  /// whole fleet over LCM does not exist (docs/fleet.md).
+  /// (`--channel-prefix` it: its RANGE, POSE, ANCHORS in, its ANCHOR_INIT out; the unprefixed
+  /// CALIB_CMD, CALIB_STATUS and MISSION_STATUS go on that vehicle's bus), so that it gets its
+  /// fly-by anchors; a calibrator serving the whole fleet over LCM does not exist (docs/fleet.md).
   std::string calibrator_for;
   std::string mission;                                  ///< mission file of that vehicle's mission ("" none)
   std::string calibrator_config = "config/calibrator.yaml";  ///< the calibrator's options
+  /// A bus per vehicle (each process of vehicle k: `--lcm-url` vehicleLcmUrl(bus, lcm_url, k)) or
+  /// one shared bus (`--lcm-url` only when lcm_url is given).
+  FleetBus bus = FleetBus::kPerVehicle;
+  /// The base URL of the buses ("" = resolveLcmUrl(""): LCM_DEFAULT_URL, else LCM's default);
+  /// must be udpm:// for kPerVehicle.
+  std::string lcm_url;
 };
 
 /// The launch file (YAML text) of `vehicles`. Throws std::invalid_argument for a vehicle name that
 /// is no channel prefix (channels::prefixProblem; loadFleetFile already refuses those) and for a
-/// `calibrator_for` that names no vehicle.
+/// `calibrator_for` that names no vehicle, and (vehicleLcmUrl) for kPerVehicle with a base URL that
+/// is not udpm or whose ports run past 65535.
 std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const FleetLaunchOptions& options);
 
 }  // namespace meshnav::transport

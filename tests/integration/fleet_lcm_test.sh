@@ -2,9 +2,12 @@
 # A fleet over LCM (docs/fleet.md, "A fleet over LCM"): two vehicles of a short scaled fleet
 # (meshnav_sim --vehicles 2) run by the launch file of meshnav_fleet_launch under
 # scripts/supervisor.py in a private network namespace (scripts/lcm_netns.sh): per vehicle its
-# bridges, estimator and logger, each with --channel-prefix <vehicle>. Asserts that
-#  - the launch exits 0 and every channel on the network is a vehicle's (v0/..., v1/...; the probe
+# bridges, estimator and logger, each with --channel-prefix <vehicle> and on the vehicle's own LCM
+# bus (meshnav_fleet_launch's default --bus per-vehicle: the base port + 1 + k). Asserts that
+#  - the launch exits 0 and every channel on the buses is a vehicle's (v0/..., v1/...; the probe
 #    hears no unprefixed channel), each vehicle's POSE on its own v<k>/POSE;
+#  - each vehicle's bus carries that vehicle's channels only (the probe listens on both buses, one
+#    LCM instance each): v1's processes never received a datagram of v0's, and the reverse;
 #  - each vehicle's estimate.csv (its logger, from v<k>/POSE) follows its OWN ground truth
 #    (RMSE < 0.5 m) and not the other's (the vehicles fly in different parts of the hall): no
 #    POSE crossed, and no estimator fused the other's IMU or ranges;
@@ -23,6 +26,8 @@ cd "$SRC" || fail "no $SRC"
   > "$WORK/sim.log" 2>&1 || fail "meshnav_sim --vehicles 2 failed"
 "$BIN/meshnav_fleet_launch" --fleet "$WORK/data/fleet.yaml" --out "$WORK/launch.yaml" \
   --estimator-config "$SRC/config/fleet_scale.yaml" > "$WORK/fleet_launch.log" 2>&1 || fail "meshnav_fleet_launch failed"
+grep -q -- "--lcm-url, \"udpm://239.255.76.67:7669?ttl=0\"" "$WORK/launch.yaml" \
+  || fail "v1's processes are not on their own bus (port 7669) in launch.yaml"
 "$BIN/meshnav_lcm_probe" --channel-prefixes v0,v1 --out "$WORK/probe.yaml" > "$WORK/probe.log" 2>&1 &
 probe=$!
 python3 "$SRC/scripts/supervisor.py" "$WORK/launch.yaml" BIN="$BIN" OUT="$WORK/run" RATE=3 > "$WORK/supervisor.log" 2>&1
@@ -43,6 +48,17 @@ print("channels on the network:", ", ".join(channels))
 bad = [c for c in channels if not (c.startswith("v0/") or c.startswith("v1/") or c == "LCM_SELF_TEST")]
 if bad:
     sys.exit("FAIL: channels that belong to no vehicle: %s" % bad)
+buses = probe["buses"]
+if sorted(tuple(b["vehicles"]) for b in buses) != [("v0",), ("v1",)]:
+    sys.exit("FAIL: the probe's buses are %s, expected one for v0 and one for v1" % [b["vehicles"] for b in buses])
+for b in buses:
+    v = b["vehicles"][0]
+    foreign = [c for c in b["channels"] if not (c.startswith(v + "/") or c == "LCM_SELF_TEST")]
+    print(f"bus {b['url']}: {v}'s, {sum(b['channels'].values())} messages on {len(b['channels'])} channels")
+    if foreign:
+        sys.exit(f"FAIL: {v}'s bus {b['url']} carries {foreign}")
+    if b["channels"].get(f"{v}/POSE", 0) == 0:
+        sys.exit(f"FAIL: no {v}/POSE on {v}'s bus")
 for v in ("v0", "v1"):
     for ch in ("IMU", "RANGE", "POSE", "ESTIMATOR_STATUS"):
         if probe["channels"].get(f"{v}/{ch}", {}).get("messages", 0) == 0:

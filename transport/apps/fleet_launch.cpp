@@ -15,9 +15,9 @@ int main(int argc, char** argv) {
   namespace fs = std::filesystem;
   Cli cli("meshnav_fleet_launch",
           "Writes the launch file (scripts/supervisor.py) of a fleet over LCM: per vehicle of --fleet its estimator, "
-          "imu_bridge and uwb_bridge (and a logger unless --no-logging), each with --channel-prefix <vehicle name>; "
-          "run it with ./meshnav up FILE OUT=DIR [RATE=X] (docs/fleet.md, \"A fleet over LCM\").");
-  std::string fleet, out;
+          "imu_bridge and uwb_bridge (and a logger unless --no-logging), each with --channel-prefix <vehicle name> "
+          "and, with --bus per-vehicle (the default), on the vehicle's own LCM bus; run it with ./meshnav up FILE OUT=DIR [RATE=X] (docs/fleet.md, \"A fleet over LCM\").");
+  std::string fleet, out, bus = "per-vehicle";
   bool no_logging = false;
   transport::FleetLaunchOptions o;
   cli.optional("fleet", fleet, "fleet file (docs/fleet.md), e.g. DIR/fleet.yaml of meshnav_sim --vehicles N")
@@ -46,6 +46,15 @@ int main(int argc, char** argv) {
       ->needs("--calibrator-for");
   cli.option("calibrator-config", o.calibrator_config, "with --calibrator-for: the calibrator's options; made absolute when it exists")
       ->type_name("FILE");
+  cli.option("bus", bus,
+             "per-vehicle: vehicle k (its index in --fleet, from 0) on the --lcm-url's port + 1 + k, so that its "
+             "processes receive only its own traffic; shared: every vehicle on --lcm-url (docs/fleet.md)")
+      ->type_name("POLICY")
+      ->check(CLI::IsMember({"per-vehicle", "shared"}));
+  cli.optional("lcm-url", o.lcm_url,
+               "the base LCM URL of the buses (udpm:// for --bus per-vehicle; default: $LCM_DEFAULT_URL, else "
+               "udpm://239.255.76.67:7667?ttl=0)")
+      ->type_name("URL");
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   setupLogging("meshnav_fleet_launch");
@@ -54,6 +63,7 @@ int main(int argc, char** argv) {
     for (FleetEntry& v : vehicles) v.dataset = fs::absolute(v.dataset).lexically_normal().string();
     if (fs::exists(o.estimator_config)) o.estimator_config = fs::absolute(o.estimator_config).lexically_normal().string();
     o.logging = !no_logging;
+    o.bus = transport::parseFleetBus(bus);
     if (fs::exists(o.calibrator_config)) o.calibrator_config = fs::absolute(o.calibrator_config).lexically_normal().string();
     if (!o.mission.empty()) o.mission = fs::absolute(o.mission).lexically_normal().string();
     o.source = fs::absolute(fleet).lexically_normal().string();
@@ -62,7 +72,7 @@ int main(int argc, char** argv) {
     f << text;
     f.close();
     if (!f) throw std::runtime_error("cannot write " + out);
-    spdlog::info("{}: {} vehicles{}", out, vehicles.size(),
+    spdlog::info("{}: {} vehicles, {} bus{}", out, vehicles.size(), bus,
                  o.calibrator_for.empty() ? std::string() : ", a calibrator for " + o.calibrator_for);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());

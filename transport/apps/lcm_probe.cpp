@@ -5,12 +5,19 @@
 /// what each figure is). With --channel-prefixes P1,P2,... (a fleet over LCM, `bench lcm --fleet`)
 /// it does so per vehicle, on each vehicle's channels (channels::prefixed); with --fleet FILE the
 /// prefixes are the fleet's vehicle names and RANGE → POSE is over each vehicle's tag–anchor ranges
-/// (its setup.yaml's tags), the others (anchor mesh, tag to tag) measured apart. It runs until
-/// SIGINT/SIGTERM or --duration, then writes --out (YAML) and prints it.
+/// (its setup.yaml's tags), the others (anchor mesh, tag to tag) measured apart. A fleet's vehicles
+/// each have their own LCM bus by default (--bus per-vehicle, transport/fleet_bus.h, as
+/// meshnav_fleet_launch writes them): the probe then opens one LCM instance per bus and polls them
+/// all from its one thread (the receive times are LCM's, taken in each instance's receive thread).
+/// It runs until SIGINT/SIGTERM or --duration, then writes --out (YAML) and prints it.
+#include <poll.h>
+
+#include <cerrno>
 #include <chrono>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -20,6 +27,7 @@
 #include "common/setup.h"
 #include "transport/channels.h"
 #include "transport/convert.h"
+#include "transport/fleet_bus.h"
 #include "transport/latency_recorder.h"
 #include "transport/lcm_node.h"
 #include "transport/stop_signal.h"
@@ -71,13 +79,15 @@ int main(int argc, char** argv) {
           "Measures IMU -> POSE and RANGE -> POSE latency (median, p99, max, from this process's receive times), lost "
           "messages and messages per second per channel over LCM, for one vehicle or per vehicle of a fleet "
           "(--channel-prefixes), until SIGINT/SIGTERM or --duration; writes --out (YAML).");
-  std::string out, url, prefix_list, fleet_file;
+  std::string out, url, prefix_list, fleet_file, bus_name = "per-vehicle";
   double duration_s = 0.0;
   cli.optional("out", out, "where to write the figures (YAML)")->type_name("FILE")->required();
   cli.option("duration", duration_s, "stop after S seconds of wall time (0: at SIGINT/SIGTERM) [s]")
       ->type_name("S")
       ->check(CLI::NonNegativeNumber);
-  cli.optional("lcm-url", url, "LCM provider (default: LCM_DEFAULT_URL)")->type_name("URL");
+  cli.optional("lcm-url", url,
+               "LCM provider; with a fleet and --bus per-vehicle the base URL of the buses (default: LCM_DEFAULT_URL)")
+      ->type_name("URL");
   cli.optional("channel-prefixes", prefix_list,
                "a fleet: measure each vehicle on its own channels P/IMU, P/RANGE, P/POSE (docs/channels.md); the "
                "figures go under vehicles: P: in --out (default: one vehicle, unprefixed channels)")
@@ -100,6 +110,11 @@ int main(int argc, char** argv) {
                "other_range_to_pose")
       ->type_name("FILE")
       ->excludes("--channel-prefixes");
+  cli.option("bus", bus_name,
+             "a fleet's buses, as meshnav_fleet_launch --bus: per-vehicle (vehicle k, its index in --fleet or "
+             "--channel-prefixes from 0, on the --lcm-url's port + 1 + k) or shared (every vehicle on --lcm-url)")
+      ->type_name("POLICY")
+      ->check(CLI::IsMember({"per-vehicle", "shared"}));
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   StopSignal::install();
@@ -135,9 +150,29 @@ int main(int argc, char** argv) {
   if (!fleet) prefixes.push_back("");
   std::map<std::string, LatencyRecorder> per_vehicle;  // prefix -> its recorder
   LatencyRecorder all;                                 // every channel counted (a fleet's totals)
+  // One LCM instance per bus: bus_of[k] is vehicle k's, buses[i] the vehicles on bus i.
+  std::vector<std::unique_ptr<LcmNode>> nodes;
+  std::vector<std::vector<std::string>> buses;
+  std::vector<LatencyRecorder> per_bus;  // the channels heard on each bus
   try {
-    LcmNode node("lcm_probe", url);
-    for (const std::string& p : prefixes) {
+    const FleetBus bus = fleet ? parseFleetBus(bus_name) : FleetBus::kShared;
+    const std::string base_url = resolveLcmUrl(url);
+    std::map<std::string, size_t> bus_of_url;
+    std::vector<size_t> bus_of;
+    for (size_t k = 0; k < prefixes.size(); ++k) {
+      const std::string u = vehicleLcmUrl(bus, base_url, k);
+      auto [it, added] = bus_of_url.emplace(u, nodes.size());
+      if (added) {
+        nodes.push_back(std::make_unique<LcmNode>("lcm_probe", u));
+        buses.emplace_back();
+      }
+      bus_of.push_back(it->second);
+      buses[it->second].push_back(prefixes[k]);
+    }
+    per_bus.resize(nodes.size());
+    for (size_t k = 0; k < prefixes.size(); ++k) {
+      const std::string& p = prefixes[k];
+      LcmNode& node = *nodes[bus_of[k]];
       LatencyRecorder& rec = per_vehicle[p];
       const std::string imu = channels::prefixed(channels::kImu, p), range = channels::prefixed(channels::kRange, p),
                         pose = channels::prefixed(channels::kPose, p);
@@ -156,21 +191,40 @@ int main(int argc, char** argv) {
         if (auto u = utimeOf(channels::kPose, rb)) rec.onPose(*u, rb.recv_utime);
       });
     }
-    // Every channel once more: the totals, and each vehicle's other channels (by their prefix).
-    node.subscribeRaw(".*", [&](const lcm::ReceiveBuffer& rb, const std::string& ch) {
-      all.onOther(ch, rb.recv_utime);
-      const std::string_view base = channels::unprefixedName(ch);
-      if (base == channels::kImu.name || base == channels::kRange.name || base == channels::kPose.name) return;
-      const std::string prefix = ch.size() > base.size() ? ch.substr(0, ch.size() - base.size() - 1) : "";
-      if (auto it = per_vehicle.find(prefix); it != per_vehicle.end()) it->second.onOther(std::string(base), rb.recv_utime);
-    });
-    std::cout << "lcm_probe: listening on " << node.url()
-              << (fleet ? " for " + std::to_string(prefixes.size()) + " vehicles" : std::string()) << std::endl;
+    // Every channel of every bus once more: the totals, each bus's, and each vehicle's other
+    // channels (by their prefix).
+    for (size_t i = 0; i < nodes.size(); ++i) {
+      nodes[i]->subscribeRaw(".*", [&, i](const lcm::ReceiveBuffer& rb, const std::string& ch) {
+        all.onOther(ch, rb.recv_utime);
+        per_bus[i].onOther(ch, rb.recv_utime);
+        const std::string_view base = channels::unprefixedName(ch);
+        if (base == channels::kImu.name || base == channels::kRange.name || base == channels::kPose.name) return;
+        const std::string prefix = ch.size() > base.size() ? ch.substr(0, ch.size() - base.size() - 1) : "";
+        if (auto it = per_vehicle.find(prefix); it != per_vehicle.end()) it->second.onOther(std::string(base), rb.recv_utime);
+      });
+    }
+    std::cout << "lcm_probe: listening on";
+    for (size_t i = 0; i < nodes.size(); ++i) std::cout << (i ? ", " : " ") << nodes[i]->url();
+    std::cout << (fleet ? " for " + std::to_string(prefixes.size()) + " vehicles" : std::string()) << std::endl;
     const auto start = std::chrono::steady_clock::now();
-    node.spin([&] {
+    auto until = [&] {
       return duration_s > 0.0 &&
              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= duration_s;
-    });
+    };
+    if (nodes.size() == 1) {
+      if (nodes[0]->spin(until) != 0) return 1;
+    } else {
+      // Several buses from one thread: wait on every instance's descriptor, handle the ready ones.
+      std::vector<pollfd> fds;
+      for (auto& n : nodes) fds.push_back({n->lcm().getFileno(), POLLIN, 0});
+      while (!StopSignal::requested() && !until()) {
+        const int ready = ::poll(fds.data(), fds.size(), 100);
+        if (ready < 0 && errno != EINTR) throw std::runtime_error("poll on the LCM buses failed");
+        for (size_t i = 0; ready > 0 && i < fds.size(); ++i)
+          if ((fds[i].revents & POLLIN) && nodes[i]->spinOnce(0) < 0)
+            throw std::runtime_error("LCM handle failed on " + nodes[i]->url());
+      }
+    }
   } catch (const std::exception& ex) {
     std::cerr << "meshnav_lcm_probe: " << ex.what() << "\n";
     return 1;
@@ -182,8 +236,20 @@ int main(int argc, char** argv) {
     y << "vehicles:\n";
     for (const std::string& p : prefixes) y << "  " << p << ":\n" << figures(per_vehicle.at(p), "    ");
     const auto rates = all.ratesHz();
-    y << "channels:  # every channel of the network\n";
+    y << "channels:  # every channel of every bus\n";
     for (const auto& [ch, n] : all.counts()) y << "  " << ch << ": {messages: " << n << ", per_s: " << rates.at(ch) << "}\n";
+    y << "buses:  # each LCM bus listened on (--bus " << bus_name << "): its vehicles and the messages heard on it\n";
+    for (size_t i = 0; i < nodes.size(); ++i) {
+      y << "  - url: \"" << nodes[i]->url() << "\"\n    vehicles: [";
+      for (size_t k = 0; k < buses[i].size(); ++k) y << (k ? ", " : "") << buses[i][k];
+      y << "]\n    channels: {";
+      bool first = true;
+      for (const auto& [ch, n] : per_bus[i].counts()) {
+        y << (first ? "" : ", ") << ch << ": " << n;
+        first = false;
+      }
+      y << "}\n";
+    }
   }
   std::ofstream f(out);
   f << y.str();

@@ -1,6 +1,6 @@
 /// @file test_fleet_launch.cpp
 /// @brief The launch file of a fleet over LCM (transport/fleet_launch.h): exactly which processes
-/// it runs, each on its vehicle's prefixed channels, and what stops the launch.
+/// it runs, each on its vehicle's prefixed channels and its own LCM bus, and what stops the launch.
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
@@ -26,7 +26,11 @@ TEST(FleetLaunch, EveryVehicleRunsItsBridgesAndEstimatorOnItsOwnPrefix) {
   const std::vector<FleetEntry> fleet = {{"v0", "/d/v0"}, {"v1", "/d/v1"}};
   FleetLaunchOptions o;
   o.estimator_config = "/cfg/fleet_scale.yaml";
+  o.lcm_url = "udpm://239.255.76.67:7667?ttl=0";
   const YAML::Node y = YAML::Load(fleetLaunchYaml(fleet, o));
+  // Each vehicle's bus: the base port + 1 + its index, for every one of its processes.
+  const std::map<std::string, std::string> bus = {{"v0", "udpm://239.255.76.67:7668?ttl=0"},
+                                                  {"v1", "udpm://239.255.76.67:7669?ttl=0"}};
   EXPECT_EQ(y["name"].as<std::string>(), "fleet");
   std::vector<std::string> names;
   std::map<std::string, YAML::Node> by_name;
@@ -48,8 +52,10 @@ TEST(FleetLaunch, EveryVehicleRunsItsBridgesAndEstimatorOnItsOwnPrefix) {
     EXPECT_EQ(after(est, "--config"), "${ESTIMATOR_CONFIG:-/cfg/fleet_scale.yaml}");
     EXPECT_EQ(after(est, "--state-dir"), "${OUT}/" + v + "/estimator_state");
     EXPECT_TRUE(by_name.at(v + "_estimator")["required"].as<bool>());
+    EXPECT_EQ(after(est, "--lcm-url"), bus.at(v));
     const auto log = strings(by_name.at(v + "_logging")["args"]);
     EXPECT_EQ(after(log, "--channel-prefix"), v);
+    EXPECT_EQ(after(log, "--lcm-url"), bus.at(v));
     EXPECT_EQ(after(log, "--out"), "${OUT}/" + v);
     EXPECT_EQ(after(log, "--channels"), v + "/.*");
     for (const std::string b : {"_imu_bridge", "_uwb_bridge"}) {
@@ -57,6 +63,7 @@ TEST(FleetLaunch, EveryVehicleRunsItsBridgesAndEstimatorOnItsOwnPrefix) {
       const auto args = strings(p["args"]);
       EXPECT_EQ(p["command"].as<std::string>(), "${BIN:-build/bin}/" + b.substr(1));
       EXPECT_EQ(after(args, "--channel-prefix"), v);
+      EXPECT_EQ(after(args, "--lcm-url"), bus.at(v));
       EXPECT_EQ(after(args, "--dataset"), "/d/" + v);
       EXPECT_EQ(after(args, "--wait-for"), "ESTIMATOR_STATUS");  // the node waits for v/ESTIMATOR_STATUS
       EXPECT_EQ(after(args, "--t0-utime"), "${T0_UTIME}");
@@ -85,6 +92,7 @@ TEST(FleetLaunch, CalibratorAndMissionForOneVehicle) {
   o.calibrator_for = "v1";
   o.mission = "/d/mission.yaml";
   o.calibrator_config = "/cfg/calibrator.yaml";
+  o.lcm_url = "udpm://239.255.76.67:7667?ttl=0";
   const YAML::Node y = YAML::Load(fleetLaunchYaml({{"v0", "/d/v0"}, {"v1", "/d/v1"}}, o));
   std::vector<std::string> names;
   std::map<std::string, std::vector<std::string>> args;
@@ -99,7 +107,34 @@ TEST(FleetLaunch, CalibratorAndMissionForOneVehicle) {
   EXPECT_EQ(after(args["v1_calibrator"], "--config"), "${CALIBRATOR_CONFIG:-/cfg/calibrator.yaml}");
   EXPECT_EQ(after(args["v1_mission"], "--channel-prefix"), "v1");
   EXPECT_EQ(after(args["v1_mission"], "--mission"), "/d/mission.yaml");
+  // On v1's bus (the base URL's port + 2), with v1's estimator: CALIB_CMD, CALIB_STATUS and
+  // MISSION_STATUS go there, not to a fleet-wide bus.
+  for (const char* p : {"v1_estimator", "v1_calibrator", "v1_mission", "v1_imu_bridge"})
+    EXPECT_EQ(after(args[p], "--lcm-url"), "udpm://239.255.76.67:7669?ttl=0") << p;
+  EXPECT_EQ(after(args["v0_estimator"], "--lcm-url"), "udpm://239.255.76.67:7668?ttl=0");
   o.calibrator_for = "v7";
+  EXPECT_THROW(fleetLaunchYaml({{"v0", "/d/v0"}}, o), std::invalid_argument);
+}
+
+// --bus shared: every process on the one URL of the environment (no --lcm-url), or on the one given.
+TEST(FleetLaunch, ASharedBusPutsEveryVehicleOnTheBaseUrl) {
+  FleetLaunchOptions o;
+  o.logging = false;
+  o.bus = FleetBus::kShared;
+  const std::vector<FleetEntry> fleet = {{"v0", "/d/v0"}, {"v1", "/d/v1"}};
+  for (const auto& p : YAML::Load(fleetLaunchYaml(fleet, o))["processes"])
+    EXPECT_EQ(after(strings(p["args"]), "--lcm-url"), "") << p["name"].as<std::string>();
+  o.lcm_url = "udpm://239.1.2.3:9000?ttl=0";
+  for (const auto& p : YAML::Load(fleetLaunchYaml(fleet, o))["processes"])
+    EXPECT_EQ(after(strings(p["args"]), "--lcm-url"), o.lcm_url) << p["name"].as<std::string>();
+}
+
+// A bus per vehicle needs udpm ports: memq:// and ports past 65535 are refused before any text.
+TEST(FleetLaunch, ABusPerVehicleRefusesABaseUrlWithoutPorts) {
+  FleetLaunchOptions o;
+  o.lcm_url = "memq://";
+  EXPECT_THROW(fleetLaunchYaml({{"v0", "/d/v0"}}, o), std::invalid_argument);
+  o.lcm_url = "udpm://239.255.76.67:65535";
   EXPECT_THROW(fleetLaunchYaml({{"v0", "/d/v0"}}, o), std::invalid_argument);
 }
 
