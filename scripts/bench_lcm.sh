@@ -19,14 +19,19 @@
 #   --config FILE          estimator options (default config/fleet_scale.yaml)
 #   --calibrator-for NAME  a calibrator and the fleet's mission.yaml serving vehicle NAME alone over
 #                          LCM, so that it gets its fly-by anchors (none serves the whole fleet yet)
+#   --bus POLICY           per-vehicle (default: each vehicle's processes on their own LCM bus, the
+#                          base port + 1 + its index) or shared (every process on one bus), as
+#                          meshnav_fleet_launch --bus and meshnav_lcm_probe --bus
 # With --fleet, RANGE -> POSE is over each vehicle's tag-anchor ranges; CPU = CPU seconds of a
-# process's life over the wall seconds of the data; lost = published but not received, or not
+# process's life over the wall seconds of the data (cpu_seconds: user and system seconds of each
+# process and of all together, from /proc/PID/stat sampled every 0.5 s by one awk); lost = published but not received, or not
 # answered by a POSE. `chrt -f 20 ./meshnav bench lcm --fleet` runs every process under SCHED_FIFO.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${MESHNAV_BUILD_DIR:-$ROOT/build}/bin"
 seed=1; scale=""; rate=1; out="$ROOT/out/bench-lcm"
 fleet=0; vehicles=5; anchors=100; hall=40,40,10; duration=""; config="$ROOT/config/fleet_scale.yaml"; calib_for=""
+bus=per-vehicle
 args=("$@")
 while [[ $# -gt 0 ]]; do
   case "$1" in
@@ -41,16 +46,18 @@ while [[ $# -gt 0 ]]; do
     --duration) duration="$2"; shift 2 ;;
     --config) config="$2"; shift 2 ;;
     --calibrator-for) calib_for="$2"; shift 2 ;;
+    --bus) bus="$2"; shift 2 ;;
     -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     *) echo "bench_lcm: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
 if (( ! fleet )); then
-  for o in --vehicles --anchors --hall --duration --config --calibrator-for; do
+  for o in --vehicles --anchors --hall --duration --config --calibrator-for --bus; do
     [[ " ${args[*]} " == *" $o "* ]] && { echo "bench_lcm: $o needs --fleet" >&2; exit 2; }
   done
 fi
 [[ "$vehicles" =~ ^[1-9][0-9]*$ ]] || { echo "bench_lcm: --vehicles expects a positive number, got '$vehicles'" >&2; exit 2; }
+[[ "$bus" == per-vehicle || "$bus" == shared ]] || { echo "bench_lcm: --bus expects per-vehicle or shared, got '$bus'" >&2; exit 2; }
 [[ -f "$config" ]] || { echo "bench_lcm: --config $config: no such file" >&2; exit 2; }
 if [[ -z "${MESHNAV_BENCH_LCM_INSIDE:-}" ]]; then
   export MESHNAV_BENCH_LCM_INSIDE=1
@@ -71,10 +78,14 @@ fail() { echo "bench_lcm: $*" >&2; for f in "$out"/*.log; do echo "---- $f" >&2;
 now_us() { date +%s%6N; }
 # cpu_s PID: user + system CPU seconds of a running process.
 cpu_s() { awk -v hz="$(getconf CLK_TCK)" '{ print ($14 + $15) / hz }' "/proc/$1/stat"; }
-# cpu_age PID: its user + system CPU seconds and its age (wall seconds since its start).
-cpu_age() {
-  awk -v hz="$(getconf CLK_TCK)" -v up="$(cut -d' ' -f1 /proc/uptime)" \
-    '{ printf "%.2f %.2f\n", ($14 + $15) / hz, up - $22 / hz }' "/proc/$1/stat" 2>/dev/null
+HZ=$(getconf CLK_TCK)
+# cpu_us_sy PID...: "PID USER_S SYSTEM_S" of each running PID, in one awk (a sample of 16
+# processes every 0.5 s must not fork 50 processes itself on 2 cores); a PID gone is left out.
+cpu_us_sy() {
+  local files=() p
+  for p in "$@"; do [[ -r /proc/$p/stat ]] && files+=("/proc/$p/stat"); done
+  (( ${#files[@]} )) || return 0
+  awk -v hz="$HZ" '{ split(FILENAME, f, "/"); printf "%s %.2f %.2f\n", f[3], $14 / hz, $15 / hz }' "${files[@]}" 2>/dev/null
 }
 
 # ---- a fleet over LCM (--fleet) ---------------------------------------------------------------
@@ -91,28 +102,26 @@ run_fleet() {
                                        --calibrator-config "$ROOT/config/calibrator.yaml")
   # 10 s after the data: an estimator behind (a loaded machine, --rate 10) answers all it was sent.
   "$BIN/meshnav_fleet_launch" --fleet "$data/fleet.yaml" --out "$launch" --no-logging --estimator-config "$config" \
-    --shutdown-delay 10 "${calib_args[@]}" \
+    --shutdown-delay 10 --bus "$bus" "${calib_args[@]}" \
     > "$out/fleet_launch.log" 2>&1 || fail "meshnav_fleet_launch failed"
   local prefixes
   prefixes=$(python3 -c 'import sys, yaml; print(",".join(v["name"] for v in yaml.safe_load(open(sys.argv[1]))["vehicles"]))' \
     "$data/fleet.yaml") || fail "cannot read $data/fleet.yaml"
-  "$BIN/meshnav_lcm_probe" --fleet "$data/fleet.yaml" --out "$out/probe.yaml" > "$out/probe.log" 2>&1 &
+  "$BIN/meshnav_lcm_probe" --fleet "$data/fleet.yaml" --bus "$bus" --out "$out/probe.yaml" > "$out/probe.log" 2>&1 &
   local probe=$!; PIDS+=("$probe")
   local load_start; load_start=$(cut -d' ' -f1-3 /proc/loadavg)
-  echo "[bench lcm] launch $launch at ${rate}x (vehicles $prefixes; load average $load_start)" >&2
+  echo "[bench lcm] launch $launch at ${rate}x (vehicles $prefixes, $bus bus; load average $load_start)" >&2
   python3 "$ROOT/scripts/supervisor.py" "$launch" BIN="$BIN" RATE="$rate" > "$out/supervisor.log" 2>&1 &
   SUP=$!
-  declare -A pid cpu age
+  declare -A name_of usr sys
+  name_of[$probe]=lcm_probe
   : > "$out/load.txt"
-  local n=0
+  local n=0 name p u s l
   while kill -0 "$SUP" 2>/dev/null; do
-    while read -r name p; do pid[$name]=$p; done \
+    while read -r name p; do name_of[$p]=$name; done \
       < <(sed -n 's/^\[supervisor\] started \([^ ]*\) (pid \([0-9]*\)).*/\1 \2/p' "$out/supervisor.log")
-    for name in "${!pid[@]}"; do
-      if read -r c a < <(cpu_age "${pid[$name]}"); then cpu[$name]=$c; age[$name]=$a; fi
-    done
-    if read -r c a < <(cpu_age "$probe"); then cpu[lcm_probe]=$c; age[lcm_probe]=$a; fi
-    (( n++ % 2 == 0 )) && cut -d' ' -f1 /proc/loadavg >> "$out/load.txt"
+    while read -r p u s; do usr[${name_of[$p]}]=$u; sys[${name_of[$p]}]=$s; done < <(cpu_us_sy "${!name_of[@]}")
+    if (( n++ % 2 == 0 )); then read -r l _ < /proc/loadavg; echo "$l" >> "$out/load.txt"; fi
     sleep 0.5
   done
   local rc=0; wait "$SUP" || rc=$?
@@ -130,9 +139,15 @@ run_fleet() {
     span=$(awk -F, -v r="$rate" '$1 ~ /^[0-9.]+$/ { if (f == "") f = $1; l = $1 } END { print (l - f) / (r > 0 ? r : 1) }' \
       "$data/v0/imu.csv")
     echo "cpu_percent_of_a_core:  # user + system CPU seconds of each process's life over the ${span} s of wall time of the data"
-    for name in $(printf '%s\n' "${!cpu[@]}" | sort); do
-      awk -v n="$name" -v c="${cpu[$name]}" -v w="$span" 'BEGIN { printf "  %s: %.2f\n", n, (w > 0 ? 100 * c / w : 0) }'
+    for name in $(printf '%s\n' "${!usr[@]}" | sort); do
+      awk -v n="$name" -v c="${usr[$name]}" -v d="${sys[$name]}" -v w="$span" \
+        'BEGIN { printf "  %s: %.2f\n", n, (w > 0 ? 100 * (c + d) / w : 0) }'
     done
+    echo "cpu_seconds:  # user and system CPU seconds of each process's life (the last sample, 0.5 s before its end at most)"
+    for name in $(printf '%s\n' "${!usr[@]}" | sort); do echo "  $name: {user: ${usr[$name]}, system: ${sys[$name]}}"; done
+    awk -v span="$span" -v u="${usr[*]}" -v s="${sys[*]}" \
+      'BEGIN { nu = split(u, a, " "); ns = split(s, b, " "); for (i = 1; i <= nu; ++i) tu += a[i]; for (i = 1; i <= ns; ++i) ts += b[i]
+             printf "  all: {user: %.1f, system: %.1f, wall_of_the_data: %.1f}\n", tu, ts, span }'
     echo "published:  # what each bridge said it published"
     for v in ${prefixes//,/ }; do
       local ni nr
@@ -142,15 +157,15 @@ run_fleet() {
     done
     echo "load_average: {start: \"$load_start\", end: \"$(cut -d' ' -f1-3 /proc/loadavg)\", 1min_samples: [$(paste -sd, "$out/load.txt")]}"
   } > "$out/fleet_extra.yaml"
-  python3 - "$out" "$seed" "$vehicles" "$anchors" "$hall" "${duration:-default}" "$rate" "$config" "$calib_for" <<'PY'
+  python3 - "$out" "$seed" "$vehicles" "$anchors" "$hall" "${duration:-default}" "$rate" "$config" "$calib_for" "$bus" <<'PY'
 import datetime, os, sys, yaml
-out, seed, nv, na, hall, duration, rate, config, calib_for = sys.argv[1:]
+out, seed, nv, na, hall, duration, rate, config, calib_for, bus = sys.argv[1:]
 probe = yaml.safe_load(open(os.path.join(out, "probe.yaml")))
 extra = yaml.safe_load(open(os.path.join(out, "fleet_extra.yaml")))
 loads = extra["load_average"]["1min_samples"] or [0.0]
 head = (f"# ./meshnav bench lcm --fleet, {datetime.datetime.utcnow():%Y-%m-%dT%H:%M:%SZ}, {nv} vehicles x {na} anchors, "
         f"hall {hall}, seed {seed}, duration {duration}, rate {rate}x, estimator config {config}, "
-        f"{'a calibrator and mission for ' + calib_for + ', ' if calib_for else ''}{os.cpu_count()} cores")
+        f"{'a calibrator and mission for ' + calib_for + ', ' if calib_for else ''}{bus} LCM bus, {os.cpu_count()} cores")
 lost = {}
 rows = []
 for v, f in probe["vehicles"].items():
@@ -185,8 +200,11 @@ with open(os.path.join(out, "table.md"), "w") as t:
             "| unanswered IMU / RANGE | other RANGE (mesh, tag-tag) |\n")
     t.write("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n")
     t.write("\n".join(rows) + "\n")
+    cs = extra["cpu_seconds"]["all"]
     t.write(f"\nprobe CPU {extra['cpu_percent_of_a_core'].get('lcm_probe', 0):.1f} % of a core; "
-            f"all channels {sum(c['per_s'] for c in probe['channels'].values()):.0f} messages/s\n")
+            f"all channels {sum(c['per_s'] for c in probe['channels'].values()):.0f} messages/s; "
+            f"the fleet's processes and the probe: {cs['user']:.1f} s user, {cs['system']:.1f} s system CPU "
+            f"over the {cs['wall_of_the_data']:.0f} s of the data\n")
 PY
   cat "$out/bench_lcm.yaml"; echo; cat "$out/table.md"
   grep -q "imu_to_pose: {n: 0," "$out/bench_lcm.yaml" && fail "a vehicle's POSE answered no IMU sample: its estimator never initialized?"

@@ -2,7 +2,8 @@
 # ./meshnav bench lcm's script at 10x on a 42 s flight: it exits 0, the estimator's POSEs answer
 # (nearly) every IMU sample after its initialization and every RANGE, and bench_lcm.yaml has the
 # latency, rate and CPU sections. Then --fleet at 10x on a 30 s flight of 2 vehicles among 16
-# anchors: per vehicle the same sections, no message lost, every RANGE answered, a table row.
+# anchors: per vehicle the same sections, no message lost, every RANGE answered, a table row, and
+# each vehicle on its own LCM bus (--bus per-vehicle, the default).
 # Figures are not asserted (the machine is shared; docs/fleet.md).
 #   bench_lcm_test.sh SOURCE_DIR BUILD_DIR WORK_DIR
 set -u
@@ -60,6 +61,16 @@ for v, f in y["vehicles"].items():
         sys.exit(f"FAIL: {r['n']} of {pub['RANGE']} RANGE of {v} taken as its tags' to anchors")
     if any(n != 0 for k, n in lost.items() if k != "ranges_after_last_pose"):
         sys.exit(f"FAIL: {v} lost messages: {lost}")
+# The default --bus per-vehicle: the probe listened on one bus per vehicle, each carrying only its
+# vehicle's channels; the CPU seconds of the fleet are reported.
+if sorted(tuple(b["vehicles"]) for b in y["buses"]) != [("v0",), ("v1",)]:
+    sys.exit(f"FAIL: buses {y['buses']}, expected one for v0 and one for v1")
+for b in y["buses"]:
+    v = b["vehicles"][0]
+    if not b["channels"] or any(not (c.startswith(v + "/") or c == "LCM_SELF_TEST") for c in b["channels"]):
+        sys.exit(f"FAIL: {v}'s bus carries {sorted(b['channels'])}")
+if "per-vehicle LCM bus" not in text.splitlines()[0] or y["cpu_seconds"]["all"]["system"] <= 0:
+    sys.exit("FAIL: the header names no per-vehicle bus, or no system CPU seconds")
 rows = [l for l in open(os.path.join(out, "table.md")) if l.startswith("| v0 ") or l.startswith("| v1 ")]
 if len(rows) != 2:
     sys.exit(f"FAIL: table.md has {len(rows)} vehicle rows")
