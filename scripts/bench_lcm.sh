@@ -79,13 +79,19 @@ now_us() { date +%s%6N; }
 # cpu_s PID: user + system CPU seconds of a running process.
 cpu_s() { awk -v hz="$(getconf CLK_TCK)" '{ print ($14 + $15) / hz }' "/proc/$1/stat"; }
 HZ=$(getconf CLK_TCK)
-# cpu_us_sy PID...: "PID USER_S SYSTEM_S" of each running PID, in one awk (a sample of 16
-# processes every 0.5 s must not fork 50 processes itself on 2 cores); a PID gone is left out.
+# cpu_us_sy PID...: "PID USER_S SYSTEM_S RUN_NS WAIT_NS SLICES" of each running PID: its CPU
+# seconds (/proc/PID/stat) and, summed over its threads (/proc/PID/task/*/schedstat), the time it
+# ran, the time it waited on a run queue for a core and how often it was put on one. One grep and
+# one awk for all (a sample of 16 processes every 0.5 s must not fork 50 processes itself on 2
+# cores); a PID or thread gone is left out.
 cpu_us_sy() {
   local files=() p
-  for p in "$@"; do [[ -r /proc/$p/stat ]] && files+=("/proc/$p/stat"); done
+  for p in "$@"; do [[ -r /proc/$p/stat ]] && files+=("/proc/$p/stat" /proc/"$p"/task/*/schedstat); done
   (( ${#files[@]} )) || return 0
-  awk -v hz="$HZ" '{ split(FILENAME, f, "/"); printf "%s %.2f %.2f\n", f[3], $14 / hz, $15 / hz }' "${files[@]}" 2>/dev/null
+  grep -H '' "${files[@]}" 2>/dev/null | awk -v hz="$HZ" '
+    { i = index($0, ":"); split(substr($0, 1, i - 1), f, "/"); n = split(substr($0, i + 1), a, " "); p = f[3]
+      if (f[4] == "stat") { u[p] = a[14] / hz; s[p] = a[15] / hz } else { run[p] += a[1]; w[p] += a[2]; sl[p] += a[3] } }
+    END { for (p in u) printf "%s %.2f %.2f %.0f %.0f %d\n", p, u[p], s[p], run[p], w[p], sl[p] }'
 }
 
 # ---- a fleet over LCM (--fleet) ---------------------------------------------------------------
@@ -113,14 +119,16 @@ run_fleet() {
   echo "[bench lcm] launch $launch at ${rate}x (vehicles $prefixes, $bus bus; load average $load_start)" >&2
   python3 "$ROOT/scripts/supervisor.py" "$launch" BIN="$BIN" RATE="$rate" > "$out/supervisor.log" 2>&1 &
   SUP=$!
-  declare -A name_of usr sys
+  declare -A name_of usr sys run_ns wait_ns slices
   name_of[$probe]=lcm_probe
   : > "$out/load.txt"
   local n=0 name p u s l
   while kill -0 "$SUP" 2>/dev/null; do
     while read -r name p; do name_of[$p]=$name; done \
       < <(sed -n 's/^\[supervisor\] started \([^ ]*\) (pid \([0-9]*\)).*/\1 \2/p' "$out/supervisor.log")
-    while read -r p u s; do usr[${name_of[$p]}]=$u; sys[${name_of[$p]}]=$s; done < <(cpu_us_sy "${!name_of[@]}")
+    while read -r p u s r w c; do
+      usr[${name_of[$p]}]=$u; sys[${name_of[$p]}]=$s; run_ns[${name_of[$p]}]=$r; wait_ns[${name_of[$p]}]=$w; slices[${name_of[$p]}]=$c
+    done < <(cpu_us_sy "${!name_of[@]}")
     if (( n++ % 2 == 0 )); then read -r l _ < /proc/loadavg; echo "$l" >> "$out/load.txt"; fi
     sleep 0.5
   done
@@ -148,6 +156,11 @@ run_fleet() {
     awk -v span="$span" -v u="${usr[*]}" -v s="${sys[*]}" \
       'BEGIN { nu = split(u, a, " "); ns = split(s, b, " "); for (i = 1; i <= nu; ++i) tu += a[i]; for (i = 1; i <= ns; ++i) ts += b[i]
              printf "  all: {user: %.1f, system: %.1f, wall_of_the_data: %.1f}\n", tu, ts, span }'
+    echo "scheduling:  # over each process's threads at its last sample: seconds on a core, seconds waiting on a run queue for one, times put on one, mean wait per time [µs]"
+    for name in $(printf '%s\n' "${!usr[@]}" | sort); do
+      awk -v n="$name" -v r="${run_ns[$name]}" -v w="${wait_ns[$name]}" -v c="${slices[$name]}" \
+        'BEGIN { printf "  %s: {run_s: %.2f, wait_s: %.2f, slices: %d, mean_wait_us: %.1f}\n", n, r / 1e9, w / 1e9, c, (c > 0 ? w / c / 1e3 : 0) }'
+    done
     echo "published:  # what each bridge said it published"
     for v in ${prefixes//,/ }; do
       local ni nr
@@ -205,6 +218,12 @@ with open(os.path.join(out, "table.md"), "w") as t:
             f"all channels {sum(c['per_s'] for c in probe['channels'].values()):.0f} messages/s; "
             f"the fleet's processes and the probe: {cs['user']:.1f} s user, {cs['system']:.1f} s system CPU "
             f"over the {cs['wall_of_the_data']:.0f} s of the data\n")
+    sch = extra.get("scheduling", {})
+    def waits(suffix):
+        w = [f["mean_wait_us"] for n, f in sch.items() if n.endswith(suffix)]
+        return ("–" if not w else f"{min(w):.0f} µs" if len(w) == 1 else f"{min(w):.0f}–{max(w):.0f} µs")
+    t.write(f"\nmean wait on a run queue for a core, per time put on one: estimators {waits('_estimator')}, "
+            f"bridges {waits('_bridge')}, probe {waits('lcm_probe')}\n")
 PY
   cat "$out/bench_lcm.yaml"; echo; cat "$out/table.md"
   grep -q "imu_to_pose: {n: 0," "$out/bench_lcm.yaml" && fail "a vehicle's POSE answered no IMU sample: its estimator never initialized?"

@@ -38,7 +38,7 @@ import os, sys, yaml
 out = sys.argv[1]
 text = open(os.path.join(out, "bench_lcm.yaml")).read()
 y = yaml.safe_load(text)
-for key in ("vehicles", "channels", "cpu_percent_of_a_core", "published", "lost", "load_average"):
+for key in ("vehicles", "channels", "buses", "cpu_percent_of_a_core", "cpu_seconds", "scheduling", "published", "lost", "load_average"):
     if key not in y:
         sys.exit(f"FAIL: bench_lcm.yaml has no '{key}'")
 if sorted(y["vehicles"]) != ["v0", "v1"]:
