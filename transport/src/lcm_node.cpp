@@ -158,9 +158,27 @@ int LcmNode::spin(const std::function<bool()>& until) {
 
 bool LcmNode::waitForMessage(const std::string& channel, Duration timeout) {
   bool seen = false;
-  lcm::Subscription* sub = lcm_->subscribeFunction(
-      channels::prefixedName(channel, prefix_), +[](const lcm::ReceiveBuffer*, const std::string&, bool* flag) { *flag = true; }, &seen);
+  const std::string wire = channels::prefixedName(channel, prefix_);
+  auto flag = +[](const lcm::ReceiveBuffer*, const std::string&, bool* f) { *f = true; };
   const int64_t deadline = timeout.us > 0 ? replay::wallUtimeNow() + timeout.us : 0;
+  // A node that only publishes (a bridge: no subscription, no heartbeat) waits on a second LCM
+  // instance that ends with the wait. udpm starts an instance's receive thread at its first
+  // subscription and then reads every datagram of the bus until the instance ends: on the node's
+  // own instance a bridge would receive its whole vehicle's traffic for the rest of its run
+  // (docs/fleet.md, "A bus per vehicle, measured"). memq:// is one bus per instance, so it keeps
+  // the node's own.
+  if (subs_.empty() && !heartbeat_ && url_.rfind("udpm://", 0) == 0) {
+    lcm::LCM waiter(url_);
+    if (!waiter.good()) throw std::runtime_error(name_ + ": cannot initialise LCM with URL '" + url_ + "' to wait");
+    waiter.subscribeFunction(wire, flag, &seen);
+    while (!seen && !stopRequested()) {
+      if (deadline && replay::wallUtimeNow() >= deadline) break;
+      const int rc = waiter.handleTimeout(100);
+      if (rc < 0 && errno != EINTR && !stopRequested()) break;
+    }
+    return seen;
+  }
+  lcm::Subscription* sub = lcm_->subscribeFunction(wire, flag, &seen);
   while (!seen && !stopRequested()) {
     if (deadline && replay::wallUtimeNow() >= deadline) break;
     if (spinOnce(100) < 0) break;
