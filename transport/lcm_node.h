@@ -164,7 +164,10 @@ class LcmNode {
   int spinOnce(int timeout_ms);
   /// Waits until a message arrives on `channel` (a heartbeat, typically; with a channel prefix,
   /// channels::prefixedName(channel, prefix): this vehicle's), a stop is requested or `timeout`
-  /// passes (≤ 0: no limit). Returns true when the message was seen.
+  /// passes (≤ 0: no limit). Returns true when the message was seen. A node with no subscription
+  /// and no heartbeat on udpm (a bridge) waits on a temporary LCM instance, so that its own never
+  /// starts receiving the bus's traffic; otherwise the node's subscriptions and heartbeat are
+  /// served meanwhile.
   bool waitForMessage(const std::string& channel, Duration timeout);
 
   void requestStop() { stop_ = true; }
