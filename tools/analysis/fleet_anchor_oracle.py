@@ -101,9 +101,10 @@ def write_pose_file(src, dst, dt, append):
             f.write(f"{float(t) + dt!r},{rest}\n")
 
 
-def merged_dataset(d, sim, vehicles, anchor, t_end, poses):
+def merged_dataset(d, sim, vehicles, anchor, t_end, poses, mesh=True):
     """A dataset folder `d` holding `vehicles` (list of (index, pose file)) one after another in time:
-    their tag ranges to `anchor` up to t_end, the mesh ranges of `anchor` once, the union of their setups."""
+    their tag ranges to `anchor` up to t_end, the mesh ranges of `anchor` once (none without `mesh`),
+    the union of their setups."""
     os.makedirs(d, exist_ok=True)
     setup = load_yaml(os.path.join(sim, f"v{vehicles[0][0]}", "setup.yaml"))
     rows = None
@@ -117,7 +118,7 @@ def merged_dataset(d, sim, vehicles, anchor, t_end, poses):
         header, rs = read_ranges(os.path.join(sim, f"v{v}", "ranges.csv"), anchor)
         t1, t2 = header.index("type_ID1"), header.index("type_ID2")
         if rows is None:
-            rows = [header] + [r for r in rs if r[t1] == "A" and r[t2] == "A" and float(r[0]) <= t_end]
+            rows = [header] + [r for r in rs if mesh and r[t1] == "A" and r[t2] == "A" and float(r[0]) <= t_end]
         i1, i2 = header.index("UWB_ID1"), header.index("UWB_ID2")
         own_tag = lambda r: any(typ == "T" and vehicle_of(int(i)) == v  # noqa: E731
                                 for typ, i in ((r[t1], r[i1]), (r[t2], r[i2])))
@@ -159,7 +160,7 @@ def error(p, truth):
     return math.dist(p, truth) if p is not None else None
 
 
-def one_seed(seed_dir, bin_dir, work):
+def one_seed(seed_dir, bin_dir, work, modes=("truth", "estimate"), mesh=True):
     sim = os.path.join(seed_dir, "sim")
     truth = {int(k): v for k, v in load_yaml(os.path.join(sim, "v0", "truth.yaml"))["anchor_positions"].items()}
     fleet = calibrations(os.path.join(seed_dir, "fleet", "calibration.yaml"))
@@ -179,16 +180,20 @@ def one_seed(seed_dir, bin_dir, work):
                                               lambda v: os.path.join(sim, f"v{v}", "groundtruth.csv")),
                                              ("estimate", lambda v: os.path.join(seed_dir, "fleet", f"v{v}", "estimate.csv"),
                                               lambda v: os.path.join(seed_dir, f"alone_v{v}", "estimate.csv"))):
+            if mode not in modes:
+                row[f"{mode}_multi"], row[f"{mode}_multi_sigma"] = None, None
+                row[f"{mode}_single"], row[f"{mode}_single_sigma"] = {}, {}
+                continue
             name = "groundtruth.csv" if mode == "truth" else "estimate.csv"
             d = merged_dataset(os.path.join(work, f"a{anchor}_{mode}_all"), sim,
-                               [(v, fleet_pose(v)) for v in sorted(vs)], anchor, t_fleet, name)
+                               [(v, fleet_pose(v)) for v in sorted(vs)], anchor, t_fleet, name, mesh)
             p, sigma = calibrate(bin_dir, d, anchor, name)
             row[f"{mode}_multi"], row[f"{mode}_multi_sigma"] = error(p, truth[anchor]), sigma
             row["tag_ranges_multi"] = tag_ranges(d)
             errs, sigmas, counts = {}, {}, {}
             for v in singles:
                 d = merged_dataset(os.path.join(work, f"a{anchor}_{mode}_v{v}"), sim, [(v, alone_pose(v))],
-                                   anchor, alone[v][anchor][0], name)
+                                   anchor, alone[v][anchor][0], name, mesh)
                 p, sigmas[v] = calibrate(bin_dir, d, anchor, name)
                 errs[v], counts[v] = error(p, truth[anchor]), tag_ranges(d)
             row[f"{mode}_single"], row[f"{mode}_single_sigma"], row["tag_ranges_single"] = errs, sigmas, counts
@@ -258,6 +263,10 @@ def self_test(bin_dir):
         with open(os.path.join(d, "groundtruth.csv")) as f:
             ts = [float(ln.split(",")[0]) for ln in f.read().splitlines()[1:]]
         assert ts == [0.0, 10.0, 1000.0, 1010.0], ts
+        d2 = merged_dataset(os.path.join(tmp, "n"), sim, [(1, os.path.join(sim, "v1", "groundtruth.csv"))],
+                            101, 5.0, "groundtruth.csv", mesh=False)
+        with open(os.path.join(d2, "ranges.csv")) as f:
+            assert [(float(r["t"]), r["UWB_ID1"]) for r in csv.DictReader(f)] == [(2.0, "1100")]
         setup = load_yaml(os.path.join(d, "setup.yaml"))
         assert set(setup["rel_tag_positions"]) == {100, 1100}, setup
         # The anchor pair both setups list is given once (the setup loader refuses a repeated pair).
@@ -271,6 +280,9 @@ def main(argv):
     p.add_argument("seeds", nargs="*", help="OUT/seedN folders of ./meshnav fleet-scale-table")
     p.add_argument("--bin", default=os.path.join(os.environ.get("MESHNAV_BUILD_DIR", os.path.join(ROOT, "build")), "bin"))
     p.add_argument("--json", default="", help="also write every anchor's figures here")
+    p.add_argument("--truth-only", action="store_true", help="only the true poses (no check against the estimates)")
+    p.add_argument("--no-mesh", action="store_true",
+                   help="leave out the anchor mesh (the ranges every calibration of the anchor shares): tags only")
     p.add_argument("--self-test", action="store_true")
     a = p.parse_args(argv)
     if a.self_test:
@@ -284,7 +296,8 @@ def main(argv):
     for seed_dir in a.seeds:
         work = tempfile.mkdtemp(prefix="fleet_anchor_oracle_")
         try:
-            rows = one_seed(seed_dir, a.bin, work)
+            rows = one_seed(seed_dir, a.bin, work, ("truth",) if a.truth_only else ("truth", "estimate"),
+                            mesh=not a.no_mesh)
         finally:
             shutil.rmtree(work, ignore_errors=True)
         allrows[seed_dir] = rows
