@@ -161,6 +161,9 @@ def error(p, truth):
 
 
 def one_seed(seed_dir, bin_dir, work, modes=("truth", "estimate"), mesh=True):
+    """Per anchor calibrated in the fleet from >= 2 vehicles: its error [m] and the calibrator's σ [m]
+    from all contributing vehicles (`*_multi`) and from each alone (`*_single`, by vehicle; None when
+    meshnav_calibrate refused), for each pose source in `modes`, and the tag ranges each used."""
     sim = os.path.join(seed_dir, "sim")
     truth = {int(k): v for k, v in load_yaml(os.path.join(sim, "v0", "truth.yaml"))["anchor_positions"].items()}
     fleet = calibrations(os.path.join(seed_dir, "fleet", "calibration.yaml"))
