@@ -169,6 +169,9 @@ class LcmNode {
   /// starts receiving the bus's traffic; otherwise the node's subscriptions and heartbeat are
   /// served meanwhile.
   bool waitForMessage(const std::string& channel, Duration timeout);
+  /// The same, for a message that `accept` (its encoded bytes) says yes to; the others are skipped.
+  bool waitForMessage(const std::string& channel, Duration timeout,
+                      const std::function<bool(const void* data, size_t size)>& accept);
 
   void requestStop() { stop_ = true; }
   bool stopRequested() const;

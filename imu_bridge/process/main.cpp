@@ -11,7 +11,8 @@ int main(int argc, char** argv) {
       "imu_bridge",
       "Publishes the inertial inputs of a dataset folder: imu.csv -> IMU, baro.csv -> BARO, flight_state.csv -> "
       "FLIGHT_STATE, height.csv -> HEIGHT (each file optional), time-sorted, message utime = data time. Exits when the data is played "
-      "(0), on SIGINT/SIGTERM (0), on bad input (1) or when --wait-for timed out (3).");
+      "(0; with --drain once the estimator has processed the last IMU sample), on SIGINT/SIGTERM (0), on bad input "
+      "(1) or when --wait-for timed out (3).");
   std::string dataset;
   bool no_imu = false, no_baro = false, no_flight_state = false, no_height = false;
   transport::ReplayCliValues replay_values;
@@ -43,9 +44,13 @@ int main(int argc, char** argv) {
 
     using imu::InertialStreams;
     int64_t n[4] = {0, 0, 0, 0};
-    transport::runReplay(replay_options, events, [&](const replay::ReplayEvent& ev) {
+    Timestamp last_imu_t;  // what --drain waits for the estimator to have processed
+    const auto progress = transport::runReplay(replay_options, events, [&](const replay::ReplayEvent& ev) {
       switch (ev.stream) {
-        case InertialStreams::kImuStream: node.publish(channels::kImu, streams.imu[ev.index]); break;
+        case InertialStreams::kImuStream:
+          node.publish(channels::kImu, streams.imu[ev.index]);
+          last_imu_t = streams.imu[ev.index].t;
+          break;
         case InertialStreams::kBaroStream: node.publish(channels::kBaro, streams.baro[ev.index]); break;
         case InertialStreams::kFlightStateStream: node.publish(channels::kFlightState, streams.flight_states[ev.index]); break;
         case InertialStreams::kHeightStream: node.publish(channels::kHeight, streams.heights[ev.index]); break;
@@ -55,6 +60,7 @@ int main(int argc, char** argv) {
     spdlog::info("published IMU {}, BARO {}, FLIGHT_STATE {}, HEIGHT {}{}", n[InertialStreams::kImuStream],
                  n[InertialStreams::kBaroStream], n[InertialStreams::kFlightStateStream], n[InertialStreams::kHeightStream],
                  node.diagnostics().total() ? ", errors: " + node.diagnostics().summary() : "");
+    if (!progress.stopped && n[InertialStreams::kImuStream] > 0) transport::waitForDrain(node, replay_options, last_imu_t);
     return node.diagnostics().get("lcm:publish_error") > 0 ? 1 : 0;
   });
 }

@@ -157,9 +157,20 @@ int LcmNode::spin(const std::function<bool()>& until) {
 }
 
 bool LcmNode::waitForMessage(const std::string& channel, Duration timeout) {
-  bool seen = false;
+  return waitForMessage(channel, timeout, nullptr);
+}
+
+bool LcmNode::waitForMessage(const std::string& channel, Duration timeout,
+                             const std::function<bool(const void* data, size_t size)>& accept) {
+  struct Wait {
+    const std::function<bool(const void*, size_t)>* accept;
+    bool seen = false;
+  } wait{&accept};
   const std::string wire = channels::prefixedName(channel, prefix_);
-  auto flag = +[](const lcm::ReceiveBuffer*, const std::string&, bool* f) { *f = true; };
+  auto flag = +[](const lcm::ReceiveBuffer* rbuf, const std::string&, Wait* w) {
+    if (!*w->accept || (*w->accept)(rbuf->data, rbuf->data_size)) w->seen = true;
+  };
+  bool& seen = wait.seen;
   const int64_t deadline = timeout.us > 0 ? replay::wallUtimeNow() + timeout.us : 0;
   // A node that only publishes (a bridge: no subscription, no heartbeat) waits on a second LCM
   // instance that ends with the wait. udpm starts an instance's receive thread at its first
@@ -170,7 +181,7 @@ bool LcmNode::waitForMessage(const std::string& channel, Duration timeout) {
   if (subs_.empty() && !heartbeat_ && url_.rfind("udpm://", 0) == 0) {
     lcm::LCM waiter(url_);
     if (!waiter.good()) throw std::runtime_error(name_ + ": cannot initialise LCM with URL '" + url_ + "' to wait");
-    waiter.subscribeFunction(wire, flag, &seen);
+    waiter.subscribeFunction(wire, flag, &wait);
     while (!seen && !stopRequested()) {
       if (deadline && replay::wallUtimeNow() >= deadline) break;
       const int rc = waiter.handleTimeout(100);
@@ -178,7 +189,7 @@ bool LcmNode::waitForMessage(const std::string& channel, Duration timeout) {
     }
     return seen;
   }
-  lcm::Subscription* sub = lcm_->subscribeFunction(wire, flag, &seen);
+  lcm::Subscription* sub = lcm_->subscribeFunction(wire, flag, &wait);
   while (!seen && !stopRequested()) {
     if (deadline && replay::wallUtimeNow() >= deadline) break;
     if (spinOnce(100) < 0) break;

@@ -2,9 +2,12 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <stdexcept>
 #include <thread>
 
+#include "meshnav/estimator_status_t.hpp"
+#include "transport/channels.h"
 #include "transport/stop_signal.h"
 
 namespace meshnav::transport {
@@ -32,6 +35,12 @@ void declareReplayOptions(Cli& cli, ReplayCliValues& v) {
   cli.option("progress", v.progress_s, "seconds between progress lines (0 = none)")
       ->type_name("S")
       ->check(cli::nonNegative());
+  cli.flag("drain", v.drain,
+           "after the last message, wait until ESTIMATOR_STATUS reports a filter time at or after the last IMU "
+           "sample's (the estimator has caught up) before exiting");
+  cli.option("drain-timeout", v.drain_timeout_s, "give up waiting with --drain after S wall seconds (a warning, exit 0)")
+      ->type_name("S")
+      ->check(cli::nonNegative());
 }
 
 ReplayProcessOptions replayOptionsFrom(const Cli& cli, const ReplayCliValues& v) {
@@ -46,6 +55,8 @@ ReplayProcessOptions replayOptionsFrom(const Cli& cli, const ReplayCliValues& v)
   o.wait_timeout = Duration::fromSec(v.wait_timeout_s);
   o.start_delay = Duration::fromSec(v.start_delay_s);
   o.replay.progress_period = Duration::fromSec(v.progress_s);
+  o.drain = v.drain;
+  o.drain_timeout = Duration::fromSec(v.drain_timeout_s);
   return o;
 }
 
@@ -67,6 +78,28 @@ bool waitForStart(LcmNode& node, const ReplayProcessOptions& o) {
     while (!node.stopRequested() && clock.nowUtime() < until) clock.sleepUntil(until, 50000);
   }
   return !node.stopRequested();
+}
+
+bool waitForDrain(LcmNode& node, const ReplayProcessOptions& o, Timestamp last_t) {
+  if (!o.drain) return true;
+  const std::string wire = channels::prefixedName(channels::kEstimatorStatus.name, node.channelPrefix());
+  int64_t newest_us = 0;
+  const bool caught_up = node.waitForMessage(
+      channels::kEstimatorStatus.name, o.drain_timeout, [&](const void* data, size_t size) {
+        estimator_status_t m;
+        if (m.decode(data, 0, static_cast<int>(size)) < 0) return false;  // counted by the estimator's own readers
+        newest_us = std::max(newest_us, m.utime);
+        return m.utime >= last_t.us;
+      });
+  if (caught_up) {
+    spdlog::info("{}: {} reports the filter at t={}: the estimator has caught up", node.name(), wire, formatSeconds(last_t));
+  } else if (!node.stopRequested()) {
+    spdlog::warn("{}: {} did not reach t={} within {:g} s (newest filter time seen: {}): the estimator is behind or "
+                 "dropped data; exiting anyway",
+                 node.name(), wire, formatSeconds(last_t), o.drain_timeout.sec(),
+                 newest_us > 0 ? formatSeconds(Timestamp{newest_us}) : std::string("none"));
+  }
+  return caught_up;
 }
 
 replay::ReplayProgress runReplay(const ReplayProcessOptions& o, const std::vector<replay::ReplayEvent>& events,

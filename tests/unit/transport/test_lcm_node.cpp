@@ -9,6 +9,7 @@
 
 #include "transport/channels.h"
 #include "transport/lcm_node.h"
+#include "transport/replay_runner.h"
 #include "transport/replay/clock.h"
 #include "transport/stop_signal.h"
 
@@ -250,6 +251,33 @@ TEST(LcmNode, WaitForMessage) {
   node.setHeartbeat(Duration::fromMs(5), [&] { node.publish(channels::kEstimatorStatus, st); });
   EXPECT_TRUE(node.waitForMessage(channels::kEstimatorStatus.name, Duration::fromSec(10)));
   EXPECT_FALSE(node.waitForMessage(channels::kCalibStatus.name, Duration::fromMs(20)));
+}
+
+// --drain of the bridges (transport/replay_runner.h): the wait ends at the first ESTIMATOR_STATUS
+// whose filter time reached the last sample's, and gives up (false) when none does in time.
+TEST(LcmNode, WaitForDrainEndsWhenTheFilterTimeReachesTheLastSample) {
+  LcmNode node("test", "memq://");
+  EstimatorStatus st;
+  st.strategy = "dah";
+  int beats = 0;
+  node.setHeartbeat(Duration::fromMs(2), [&] {
+    st.t = Timestamp::fromSec(0.5 * ++beats);  // the estimator working through its queue
+    node.publish(channels::kEstimatorStatus, st);
+  });
+  ReplayProcessOptions o;
+  o.drain = true;
+  o.drain_timeout = Duration::fromSec(10.0);
+  EXPECT_TRUE(waitForDrain(node, o, Timestamp::fromSec(2.0)));
+  EXPECT_EQ(beats, 4);  // t = 0.5, 1.0, 1.5 are skipped, 2.0 ends the wait
+  o.drain_timeout = Duration::fromMs(30);
+  EXPECT_FALSE(waitForDrain(node, o, Timestamp::fromSec(1e6)));  // never reached: a warning, false
+  o.drain = false;
+  EXPECT_TRUE(waitForDrain(node, o, Timestamp::fromSec(1e6)));  // not asked for: at once
+  // The predicate form skips what it does not accept.
+  int skipped = 0;
+  EXPECT_TRUE(node.waitForMessage(channels::kEstimatorStatus.name, Duration::fromSec(10.0),
+                                  [&](const void*, size_t) { return ++skipped > 2; }));
+  EXPECT_EQ(skipped, 3);
 }
 
 TEST(LcmNode, StopSignalEndsSpin) {
