@@ -45,6 +45,7 @@ const Field kFields[] = {
     {"init.sigma_bias_gyro_rad_s", field<&EstimatorOptions::init, &InitOptions::sigma_bias_gyro_rad_s>, "[rad/s]"},
     {"init.sigma_bias_acc_m_s2", field<&EstimatorOptions::init, &InitOptions::sigma_bias_acc_m_s2>, "[m/s^2]"},
     {"init.motion_window_s", field<&EstimatorOptions::init, &InitOptions::motion_window_s>, "in-motion alignment window [s]"},
+    {"init.settle_max_s", field<&EstimatorOptions::init, &InitOptions::settle_max_s>, "before the initialization, inputs wait until every stream has passed them, at most this long [s]"},
     {"init.resume_max_age_s", field<&EstimatorOptions::init, &InitOptions::resume_max_age_s>, "a restart resumes from a checkpoint at most this old [s]"},
     {"init.resume_max_outage_s", field<&EstimatorOptions::init, &InitOptions::resume_max_outage_s>, "longer restart outages re-initialize the pose (anchors kept) [s]"},
     {"baro.enabled", field<&EstimatorOptions::baro, &BaroOptions::enabled>, ""},
@@ -270,6 +271,7 @@ void EstimatorOptions::validate() const {
        "init.motion_* (window >= min span > 0, min_ranges >= 8, sigmas > 0)");
   need(init.motion_relinearize_rad >= 0 && init.motion_relinearize_rad < M_PI, "init.motion_relinearize_rad in [0, pi)");
   need(init.gravity_early_check_nis_ratio >= 0, "init.gravity_early_check_nis_ratio >= 0");
+  need(init.settle_max_s >= 0, "init.settle_max_s >= 0");
   need(health.window_s > 0 && health.min_ranges >= 1 && health.min_anchors >= 1 &&
            health.degraded_gated_fraction > 0 && health.degraded_gated_fraction <= health.lost_gated_fraction &&
            health.lost_gated_fraction <= 1 && health.degraded_mean_nis > 0 && health.degraded_no_aiding_s > 0 &&

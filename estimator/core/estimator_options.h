@@ -72,6 +72,10 @@ struct InitOptions {
   /// the best makes the pose ambiguous (refused) [-]
   double ambiguity_chi2 = 16.0;
   double motion_window_s = 12.0;            ///< in-motion alignment: data window [s]
+  /// Before the initialization, an input goes to the initializers once every stream has passed
+  /// its stamp (InputSettler), or at the latest when it is this much older than the newest input:
+  /// a stream stopped for longer no longer holds the others back [s]
+  double settle_max_s = 2.0;
   /// Before the scheduled gravity check (a `motion_window_s` after the first initialization): a
   /// batch median range NIS (process_noise: every `batch` ranges, so only with it enabled) at
   /// least this many times its expected value runs the check at once (once; it acts only on a

@@ -70,6 +70,7 @@ EstimatorNode::EstimatorNode(const EstimatorOptions& options, const SystemSetup&
       gate_(options_, diag_),
       imu_units_(ImuUnitsCheck::Options{.gravity_m_s2 = options_.gravity_m_s2}),
       init_(options_, setup_, diag_, timings_),
+      settler_(options_.init.settle_max_s, !setup_.rel_tag_positions.empty()),
       gravity_(options_.init.motion_window_s, options_.init.gravity_early_check_nis_ratio, diag_),
       volume_(options_.flight_volume, setup_, diag_),
       outputs_(options_.pose_output_rate_hz, options_.anchors_output_rate_hz, options_.status_rate_hz),
@@ -103,6 +104,7 @@ void EstimatorNode::resetAll() {
   flushSmoothed();  // the smoothed poses still waiting go out (a Reset, a clock gone back): one per POSE
   smoother_.reset();
   init_.reset();
+  settler_.clear();
   volume_.reset();
   gravity_.reset();
   recovery_.reset();
@@ -166,6 +168,30 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     }
   }
   if (!imu_units_.fault().empty()) return;
+  if (!initialized()) {
+    settle(in);
+    return;
+  }
+  route(in);
+}
+
+void EstimatorNode::settle(const EstimatorInput& in) {
+  if (!settler_.add(in)) {
+    // An event (ANCHOR_INIT, a command) applies at once anyway; a measurement is reported.
+    if (InputSettler::isStreamInput(in))
+      diag_.report("late_for_initialization",
+                 where("input", inputTime(in)) + " (" + inputKindName(in) +
+                     ") came after later inputs had gone to the initialization: processed out of order");
+    route(in);
+  }
+  // Settled inputs in the canonical order; once one of them initializes the filter, the rest
+  // (settled or not) go on the usual path, which handles later arrivals by rewinding.
+  for (const EstimatorInput& s : settler_.takeSettled()) route(s);
+  if (initialized())
+    for (const EstimatorInput& s : settler_.takeAll()) route(s);
+}
+
+void EstimatorNode::route(const EstimatorInput& in) {
   // A measurement between two IMU samples waits for the second (heldForNextImu); an IMU sample
   // releases the ones before it, with itself as their next sample.
   if (holdForNextImu(in)) return;
@@ -209,7 +235,10 @@ void EstimatorNode::releaseHeld(const std::optional<ImuSample>& next, bool at_it
   }
 }
 
-void EstimatorNode::flushHeld() { releaseHeld(std::nullopt, true); }
+void EstimatorNode::flushHeld() {
+  for (const EstimatorInput& s : settler_.takeAll()) route(s);  // the stream's end: nothing more will settle them
+  releaseHeld(std::nullopt, true);
+}
 
 std::optional<ImuSample> EstimatorNode::orReleasingSample(const EstimatorInput& in,
                                                           std::optional<ImuSample> next) const {

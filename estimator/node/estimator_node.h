@@ -84,6 +84,7 @@
 #include "estimator/init/initialization.h"
 #include "estimator/node/filter_context.h"
 #include "estimator/node/input_gate.h"
+#include "estimator/node/input_settler.h"
 #include "estimator/node/input_timeline.h"
 #include "estimator/node/output_schedule.h"
 #include "estimator/zupt/rest_rate_mean.h"
@@ -188,6 +189,11 @@ class EstimatorNode : private RerunReplayer {
   void runGravityDirection(Timestamp t);
   /// The clock jumped back past everything the node holds: it starts over, streams forgotten.
   void startOverAfterClockBack();
+  /// Before initialization: `in` waits in the settler until nothing earlier can still arrive
+  /// (InputSettler), then the settled inputs are routed in the canonical order.
+  void settle(const EstimatorInput& in);
+  /// An admitted input on its way: held for the next IMU sample (holdForNextImu) or accepted.
+  void route(const EstimatorInput& in);
   /// Before initialization: the input to the initializers (anchors held for later).
   void feedInitializer(const EstimatorInput& in);
   void initialize(const InitialBelief& b);
@@ -303,6 +309,8 @@ class EstimatorNode : private RerunReplayer {
   /// (waitingFor), counter `imu_units_implausible`; only a Reset command starts it again.
   ImuUnitsCheck imu_units_;
   Initialization init_;
+  /// Inputs before the initialization, until settled (init.settle_max_s).
+  InputSettler settler_;
   GravityDirection gravity_;
   FlightVolumeGuard volume_;
   OutputSchedule outputs_;
