@@ -168,7 +168,9 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
     }
   }
   if (!imu_units_.fault().empty()) return;
-  if (!initialized()) {
+  // A restart's checkpoint (offered until the first IMU sample decides) resumes the pose at once:
+  // nothing waits for it.
+  if (!initialized() && !resume_.offered()) {
     settle(in);
     return;
   }

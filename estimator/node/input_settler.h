@@ -18,6 +18,8 @@
 /// later than both bounds arrives out of order ("late_for_initialization" in the node).
 /// Events (flight state, ANCHOR_INIT, commands) and a fleet's peer ranges do not move W; they are
 /// held and released in order.
+/// While a restart's checkpoint is offered (until the first IMU sample decides whether it resumes
+/// the pose, EstimatorNode::resumeFrom) the node does not hold inputs: a resumed pose comes at once.
 
 #include <map>
 #include <optional>
