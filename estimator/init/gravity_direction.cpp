@@ -28,7 +28,16 @@ void GravityDirection::reset() {
   last_reinit_try_.reset();
 }
 
-void GravityDirection::onInitialized(Timestamp t) {
+void GravityDirection::onInitialized(Timestamp t, int decided_sign) {
+  if (decided_sign != 0 && checks_ == 0) {
+    check_at_.reset();
+    checks_ = kMaxChecks;  // decided: nothing more to compare
+    if (decided_sign > 0) {
+      diag_.count("anchor_frame_z_down");
+      sign_ = 1.0;
+    }
+    return;
+  }
   if (checks_ == 0 && !check_at_) check_at_ = t + Duration::fromSec(window_s_);
 }
 

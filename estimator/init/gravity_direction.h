@@ -15,7 +15,10 @@
 ///  - earlier, once, when the range innovations say the model is far off before that: a median
 ///    range NIS of `init.gravity_early_check_nis_ratio` times its expected value (a wrong sign
 ///    shows there first: ISAS-Walk1 started mid-walk reaches 12× within 2 s).
-/// Baro and heights measure along −z of G: with them the frame is taken as it is (a warning only).
+/// The first in-motion alignment compares both signs on its own window and starts along the one
+/// that fits decisively better (Initialization, InitialBelief::gravity_z_sign): then nothing above
+/// is scheduled. Baro and heights measure along −z of G: with them the frame is taken as it is (a
+/// warning only).
 /// Once +z wins, s = +1 from then on and the pose is re-initialized by the aligner with it
 /// (anchors and biases kept), retried every `kFlipRetry_s` while the aligner refuses.
 ///
@@ -71,7 +74,10 @@ class GravityDirection {
   Eigen::Vector3d gravityG(double g_m_s2) const { return {0.0, 0.0, sign_ * g_m_s2}; }
 
   /// The filter was initialized at `t`: the first comparison is scheduled a window later (once).
-  void onInitialized(Timestamp t);
+  /// `decided_sign` (InitialBelief::gravity_z_sign): the first in-motion alignment compared both
+  /// signs on its window and one fitted decisively better (+1: along +z, taken from now on; −1:
+  /// along −z); nothing is scheduled then. 0: not compared there, or undecided.
+  void onInitialized(Timestamp t, int decided_sign = 0);
   /// A batch's median range NIS over its expected value (the process-noise adapter's): at or above
   /// the early ratio before the first comparison, the comparison runs at the next IMU sample.
   void noteRangeNisRatio(double ratio);

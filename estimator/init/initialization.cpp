@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include <spdlog/spdlog.h>
+
 #include "common/atmosphere.h"
 
 namespace meshnav::estimator {
@@ -84,6 +86,7 @@ void Initialization::reset() {
   landed_ = std::make_unique<StaticInitializer>(options_, setup_);
   aligner_.clear();
   aligner_.setGravityAlongPlusZ(false);
+  decided_sign_ = 0;
   last_align_try_.reset();
   last_align_height_.reset();
 }
@@ -187,6 +190,7 @@ std::optional<InitialBelief> Initialization::tryInitialize(const EstimatorInput&
   if (last_align_try_ && (t - *last_align_try_).sec() < kAlignRetry_s) return std::nullopt;
   last_align_try_ = t;
   const int relinearized_before = aligner_.relinearizations();
+  compareGravitySigns(t);
   const auto r = align(Eigen::Vector3d::Zero());
   if (aligner_.relinearizations() > relinearized_before) diag_.count("init_motion_relinearized");
   if (!r) {
@@ -196,7 +200,32 @@ std::optional<InitialBelief> Initialization::tryInitialize(const EstimatorInput&
                                             " refused: " + aligner_.reason());
     return std::nullopt;
   }
-  return beliefFrom(*r, landedAt(r->t, landed));
+  InitialBelief b = beliefFrom(*r, landedAt(r->t, landed));
+  b.gravity_z_sign = decided_sign_;
+  return b;
+}
+
+void Initialization::compareGravitySigns(Timestamp t) {
+  // Baro and heights measure along −z of G: with them the frame is taken as it is. After a reset
+  // the node compares again (its sign went back to −z with the aligner's).
+  if (decided_sign_ != 0 || sawVerticalSensor()) return;
+  const auto check = aligner_.checkGravityDirection(Eigen::Vector3d::Zero());
+  if (!check || (!check->zDown() && !check->zUp())) {
+    diag_.count("gravity_compare_undecided");  // the next try compares again
+    return;
+  }
+  decided_sign_ = check->zDown() ? 1 : -1;
+  const std::string costs = fmt::format("cost {:.1f} with gravity along -z, {:.1f} along +z, margin {:.1f}, {} ranges",
+                                        check->cost_z_up, check->cost_z_down, check->margin, check->n_ranges);
+  if (decided_sign_ < 0) {
+    spdlog::info("estimator: gravity along -z of G as assumed, by the alignment window at t={} ({})", formatSeconds(t),
+                 costs);
+    return;
+  }
+  aligner_.setGravityAlongPlusZ(true);
+  spdlog::warn("estimator: at t={} the alignment window fits the IMU with the anchors' frame G upside down ({}): its "
+               "z axis points down; gravity is taken along +z of G (docs/real_data.md)",
+               formatSeconds(t), costs);
 }
 
 std::optional<AlignmentResult> Initialization::align(const Eigen::Vector3d& bias_gyro_rad_s,

@@ -101,6 +101,11 @@ class Initialization {
   void feedBaro(const BaroSample& b);
   void feedRange(const RangeSample& r, const UwbNetwork& network, const FusionStrategy* filter);
   std::optional<InitialBelief> tryMotion(Timestamp t);
+  /// Before an in-motion alignment at IMU time `t`, until one decides: both gravity signs
+  /// compared on the window (MotionAligner::checkGravityDirection); a decisive +z turns the
+  /// aligner, so the pose is fitted with it (InitialBelief::gravity_z_sign). Not with baro or
+  /// heights (they measure along −z of G).
+  void compareGravitySigns(Timestamp t);
 
   const EstimatorOptions& options_;
   const SystemSetup& setup_;
@@ -115,6 +120,7 @@ class Initialization {
   std::optional<double> last_pressure_pa_;
   std::optional<Timestamp> last_align_height_;  ///< thinning of heights fed to the aligner
   std::optional<Timestamp> last_align_try_;
+  int decided_sign_ = 0;  ///< gravity's sign along z of G decided on an alignment window (0: not yet)
 };
 
 /// The setup's carried height is used (setup `carried_height` and `carried_height.enabled`).

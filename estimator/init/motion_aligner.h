@@ -240,7 +240,13 @@ class MotionAligner {
   static Eigen::Vector3d bodyTerm(const Increments& inc, const Unknowns& x, const Eigen::Vector3d& p_TinI,
                                   const Eigen::Matrix3d& C);
   ImuState endState(const Unknowns& x, const Increments& end, const Eigen::Vector3d& bias_gyro) const;
-  std::vector<Unknowns> starts(const std::vector<Obs>& obs) const;
+  /// The multi-start: positions (and their mirror across nearly coplanar anchors) × a yaw grid ×
+  /// the roll and pitch levelled from the mean specific force and, when it differs by more than
+  /// kLevelBasin_rad, from the window's integrated specific force `end.V` (motion_aligner_fit.cpp).
+  std::vector<Unknowns> starts(const std::vector<Obs>& obs, const Increments& end) const;
+  /// Two levellings of the starts closer than this fall in one basin of the fit: one set of
+  /// starts is enough [rad] (2°).
+  static constexpr double kLevelBasin_rad = 2.0 * M_PI / 180.0;
   /// Covariance, end state and the acceptance checks of the best fit. With `heading`, the end
   /// state is first combined with the prior heading (a Kalman update of the yaw, H = [0 0 nᵀ 0 0],
   /// n = R_ItoGᵀ e_z, so that the fit's heading and the prior's weigh by their variances) unless

@@ -137,7 +137,7 @@ ImuState MotionAligner::endState(const Unknowns& x, const Increments& end, const
   return s;
 }
 
-std::vector<MotionAligner::Unknowns> MotionAligner::starts(const std::vector<Obs>& obs) const {
+std::vector<MotionAligner::Unknowns> MotionAligner::starts(const std::vector<Obs>& obs, const Increments& end) const {
   std::map<SensorId, Eigen::Vector3d> anchors;
   for (const Obs& o : obs) anchors[o.r.anchor] = o.r.p_AinG;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -183,27 +183,44 @@ std::vector<MotionAligner::Unknowns> MotionAligner::starts(const std::vector<Obs
     const Eigen::Vector3d n = svd.matrixU().col(2);
     positions.push_back(best - 2.0 * n.dot(best - centroid) * n);
   }
-  // Roll and pitch from the mean specific force (gravity dominates over a few seconds).
+  // Roll and pitch of R₀, two ways. (a) The mean raw specific force: gravity dominates it over a
+  // few seconds, but each reading is in its own body frame, so a rig tilted one way and then
+  // another (a hand-held walk) averages to a level it never had. (b) The specific force integrated
+  // in the first sample's body frame, V(T) = ∫ C f ds: R₀ V(T)/T = Δv/T − g exactly, so V(T)
+  // levels R₀ to within |Δv|/(gT) whatever the rig did (ISAS-Walk1's first window: the +z fits
+  // from (a) ended 200 m off or in local minima, from (b) they decide +z by a margin of 16).
+  // Both sets of starts when the two levels differ by more than kLevelBasin_rad, on windows of
+  // the full nominal length `window_s` only: on MILUV's longer sparse windows extra starts found
+  // lower-cost wrong poses (ifo001 2.46 → 4.28 m), and on shorter ones (the first tries after
+  // the start) they found rivals that made one tag's 6 s windows ambiguous
+  // (MotionAligner.AHeadingPriorTheFitContradictsIsNotTaken).
+  auto levelling = [](const Eigen::Vector3d& f) -> Eigen::Matrix3d {
+    const double roll = std::atan2(f.y(), f.z()), pitch = std::atan2(-f.x(), std::hypot(f.y(), f.z()));
+    return (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+        .toRotationMatrix();
+  };
   Eigen::Vector3d f = Eigen::Vector3d::Zero();
   const Timestamp t0 = windowStart();
   for (const ImuSample& s : imu_)
     if (s.t >= t0) f += s.acc_m_s2;
-  const double roll = std::atan2(f.y(), f.z()), pitch = std::atan2(-f.x(), std::hypot(f.y(), f.z()));
-  const Eigen::Matrix3d R_rp =
-      (Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-          .toRotationMatrix();
+  std::vector<Eigen::Matrix3d> levels{levelling(f)};
+  const bool nominal_window = std::abs(spanSeconds() - options_.window_s) <= 0.1;
+  if (nominal_window && end.V.norm() > 0.0 && f.norm() > 0.0 &&
+      std::acos(std::clamp(end.V.normalized().dot(f.normalized()), -1.0, 1.0)) > kLevelBasin_rad)
+    levels.push_back(levelling(end.V));
   // Gravity along +z of G: the specific force at rest points along −z, half a turn about x.
   const Eigen::Matrix3d R_up = gravity_z_sign_ > 0.0
                                    ? Eigen::Matrix3d(Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal())
                                    : Eigen::Matrix3d::Identity();
   std::vector<Unknowns> out;
-  for (const Eigen::Vector3d& p : positions)
-    for (int k = 0; k < options_.yaw_starts; ++k) {
-      Unknowns x;
-      x.p0 = p;
-      x.R0 = rotZ(2.0 * M_PI * k / options_.yaw_starts) * R_up * R_rp;
-      out.push_back(x);
-    }
+  for (const Eigen::Matrix3d& R_rp : levels)
+    for (const Eigen::Vector3d& p : positions)
+      for (int k = 0; k < options_.yaw_starts; ++k) {
+        Unknowns x;
+        x.p0 = p;
+        x.R0 = rotZ(2.0 * M_PI * k / options_.yaw_starts) * R_up * R_rp;
+        out.push_back(x);
+      }
   return out;
 }
 
@@ -234,7 +251,7 @@ bool MotionAligner::fitStarts(const Eigen::Vector3d& bias_gyro_rad_s, Window* w)
       return false;
     }
     w->cands.clear();
-    for (Unknowns x : starts(w->obs)) {  // δb_ω = 0: at b_lin
+    for (Unknowns x : starts(w->obs, w->end)) {  // δb_ω = 0: at b_lin
       const double c = fit(w->obs, w->heights, w->dbg_prior_mean, x, nullptr);
       if (std::isfinite(c)) w->cands.push_back({x, c, endState(x, w->end, w->b_lin)});
     }
@@ -369,7 +386,7 @@ std::optional<MotionAligner::GravityCheck> MotionAligner::checkGravityDirection(
   for (const double sign : {-1.0, 1.0}) {
     gravity_z_sign_ = sign;
     double best = std::numeric_limits<double>::infinity();
-    for (Unknowns x : starts(obs)) {
+    for (Unknowns x : starts(obs, end)) {
       const double c = fit(obs, heights, Eigen::Vector3d::Zero(), x, nullptr);
       if (std::isfinite(c) && c < best) {
         best = c;

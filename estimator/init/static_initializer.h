@@ -47,6 +47,10 @@ struct InitialBelief {
   /// with heights): mean [m] and variance [m²]. None: the node's prior (0, height.init_bias_sigma_m²).
   std::optional<std::pair<double, double>> height_bias;
   int n_heights_used = 0;
+  /// The sign s of gravity g_G = (0, 0, s|g|) that the first in-motion alignment's window decided
+  /// by comparing both (MotionAligner::checkGravityDirection, the pose fitted with it); 0: not
+  /// compared (landed, vertical sensors, a later alignment) or undecided.
+  int gravity_z_sign = 0;
 };
 
 class StaticInitializer {

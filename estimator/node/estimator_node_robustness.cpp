@@ -53,7 +53,9 @@ void EstimatorNode::logInitialization(const InitialBelief& b) const {
 }
 
 void EstimatorNode::initialize(const InitialBelief& b) {
-  gravity_.onInitialized(b.t);
+  const double sign_before = gravity_.zSign();
+  gravity_.onInitialized(b.t, b.gravity_z_sign);
+  if (gravity_.zSign() != sign_before) sensors_.zupt = ZuptModel(gravityG());  // the aligner has turned already
   auto filter = makeStrategy(options_, gravity_.zSign());
   filter->reset(setup_.imu_id, b.imu, b.cov, b.t);
   if (options_.baro.enabled && b.baro_reference_pa) {

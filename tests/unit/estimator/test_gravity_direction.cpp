@@ -247,3 +247,25 @@ TEST(GravityDirection, AReplayTakesTheLiveSign) {
   replay.takeSignOf(live);
   EXPECT_EQ(replay.gravityG(9.81), Eigen::Vector3d(0.0, 0.0, -9.81));
 }
+
+TEST_F(GravityTest, ASignDecidedAtTheFirstAlignmentIsTakenAndNothingIsScheduled) {
+  g.onInitialized(at(5.0), +1);  // the first alignment's window fitted +z decisively
+  EXPECT_EQ(g.zSign(), 1.0);
+  EXPECT_EQ(diag.get("anchor_frame_z_down"), 1);
+  g.noteRangeNisRatio(100.0);  // no early check either
+  for (double t = 5.0; t < 60.0; t += 0.5) g.onImu(at(t), c);
+  EXPECT_EQ(c.compared, 0);
+  EXPECT_TRUE(c.reinit_at.empty());  // the pose was fitted with +z already
+  EXPECT_EQ(c.turned, 0);            // the node turned its models at the initialization
+
+  GravityDirection minus{kWindow_s, kEarlyRatio, diag};
+  minus.onInitialized(at(5.0), -1);
+  for (double t = 5.0; t < 60.0; t += 0.5) minus.onImu(at(t), c);
+  EXPECT_EQ(minus.zSign(), -1.0);
+  EXPECT_EQ(c.compared, 0);
+
+  GravityDirection undecided_at_init{kWindow_s, kEarlyRatio, diag};
+  undecided_at_init.onInitialized(at(5.0), 0);  // undecided: the comparison a window later, as always
+  undecided_at_init.onImu(at(17.0), c);
+  EXPECT_EQ(c.compared, 1);
+}
