@@ -15,7 +15,13 @@
 ///      p_T = p_k + v_k τ + ½ g τ² + R_k (Δp + …) + R_k ΔR Exp(J_R^ω δb_ω) p_TinI,
 ///      r = (z − γ − β ‖p_A − p_T‖) / σ under a robust loss ρ (Huber or Cauchy, scale k σ):
 ///    the heavy tail of UWB errors (NLOS excess) gets a bounded (Huber) or vanishing (Cauchy)
-///    influence instead of a gate;
+///    influence instead of a gate; with `nlos_fraction` ε > 0 each range's error is also the
+///    estimator's line-of-sight / NLOS mixture (estimator/core/nlos_mixture.h), fitted by EM over
+///    the passes: after a pass, at its solution, the range's posterior probability of line of sight
+///    w = (1 − ε) N(r; 0, s) / ((1 − ε) N(r; 0, s) + ε p_N(r)) from its residual r (measured minus
+///    predicted) and s = its own σ² (the correlation's inflation left out, as the filter judges a
+///    range by its own R); the next pass takes the range with σ²/w (w ≥ 0.01), the loss's scale
+///    still k own σ, so that its cost is w ρ(r²/σ²): the loss on top of the weight;
 ///  * a downward rangefinder's reading (SmootherHeight) like a range, under the same loss, with one
 ///    bias b_H ~ N(0, σ_bH²) per problem;
 ///  * landed knots: v = 0, and no turn between two of them (the ZUPT model);
@@ -37,6 +43,12 @@ struct BatchSmootherOptions {
   Loss range_loss = Loss::Cauchy;  ///< robust loss of the ranges
   double loss_scale_sigmas = 2.0;  ///< the loss's scale in range σ [-]
   int passes = 3;                  ///< solves, each after re-integrating at the solved biases [-]
+  /// Prior probability ε that a range carries an NLOS excess b₀ + Exp(μ) (the mixture of the file
+  /// comment, one E step per pass after the first); 0: off. smoothRun sets these three from the
+  /// estimator's uwb.nlos_fraction, uwb.nlos_min_excess_m and uwb.nlos_mean_excess_m [-]
+  double nlos_fraction = 0.0;
+  double nlos_offset_m = 0.2;      ///< b₀, the smallest NLOS excess [m]
+  double nlos_scale_m = 0.3;       ///< μ, the mean NLOS excess beyond b₀ [m]
   int max_iterations = 50;         ///< Levenberg–Marquardt iterations per solve [-]
   bool covariance = true;          ///< compute each knot's marginal covariance of p and θ
   int threads = 1;
@@ -65,6 +77,7 @@ struct SmootherResult {
   int n_heights = 0;
   int n_ranges = 0;
   int n_range_outliers = 0;            ///< ranges beyond 3 loss scales at the solution
+  int n_range_nlos = 0;                ///< ranges the last solve took with LOS weight w < 0.5 (ε > 0)
   double range_rms_inliers_m = 0.0;    ///< RMS of the range residuals within 3 loss scales [m]
   bool converged = false;
   bool covariance_ok = false;

@@ -12,6 +12,7 @@
 
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,6 +59,11 @@ struct RunSmootherOptions {
   /// rate departs from the straight line between the samples around a gap by a few 0.1 rad/s over
   /// a second of hand or flight motion. The accelerometer's is the estimator's imu.gap_sigma_acc_m_s2.
   double gap_sigma_gyro_rad_s = 0.1;
+  /// The range errors' line-of-sight / NLOS mixture (BatchSmootherOptions::nlos_*) is the
+  /// estimator's, so that smoother and filter share one model: ε, b₀ and μ from uwb.nlos_fraction,
+  /// uwb.nlos_min_excess_m and uwb.nlos_mean_excess_m of `estimator_config` (or the estimator's
+  /// defaults), whatever `solver` holds. Set: this ε instead (tests, comparisons) [-]
+  std::optional<double> nlos_fraction;
   BatchSmootherOptions solver;
 };
 

@@ -103,6 +103,7 @@ int run(SmoothCli& c) {
       << "filter_reinitializations" << YAML::Value << ch.reinit_jumps << YAML::Key << "imu_gaps" << YAML::Value
       << ch.imu_gaps << YAML::Key << "ranges" << YAML::Value
       << r.n_ranges << YAML::Key << "range_outliers" << YAML::Value << r.n_range_outliers << YAML::Key
+      << "range_nlos" << YAML::Value << r.n_range_nlos << YAML::Key
       << "range_rms_inliers_m" << YAML::Value << r.range_rms_inliers_m << YAML::Key << "message" << YAML::Value
       << r.message << YAML::EndMap;
     if (ch.imu_gaps > 0)

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "estimator/core/nlos_mixture.h"
 #include "estimator/core/so3.h"
 
 namespace meshnav::smoother {
@@ -277,6 +278,9 @@ void checkProblem(const SmoothingProblem& pr) {
 SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
                                     const std::function<void(int, int, const std::string&)>& progress) const {
   checkProblem(pr);
+  if (!(options_.nlos_fraction >= 0.0 && options_.nlos_fraction < 1.0 && options_.nlos_offset_m >= 0.0 &&
+        options_.nlos_scale_m > 0.0))
+    throw std::invalid_argument("smoother: nlos_fraction must be in [0, 1), nlos_offset_m >= 0, nlos_scale_m > 0");
   const size_t n = pr.knots.size();
   std::vector<KnotBlocks> blocks;
   blocks.reserve(n);
@@ -295,6 +299,10 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
     if (options_.range_loss == BatchSmootherOptions::Loss::Cauchy) return new ceres::CauchyLoss(k);
     return new ceres::HuberLoss(k);
   };
+  // The NLOS mixture's E step (batch_smoother.h): per range of the problem the factor 1/w on its
+  // variance, from the previous pass's residual; 1 in the first pass and with ε = 0.
+  const bool mixture = options_.nlos_fraction > 0.0;
+  std::vector<double> nlos_variance_factor(pr.ranges.size(), 1.0);
 
   for (int pass = 0; pass < std::max(1, options_.passes); ++pass) {
     ceres::AutoDiffManifold<LocalQuaternionPlus, 4, 3> quat_manifold;  // outlives the problem
@@ -422,18 +430,24 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
     };
     // Ranges.
     std::vector<ceres::ResidualBlockId> range_ids;
-    std::vector<double> range_sigma, range_inflation;
-    for (const auto& r : pr.ranges) {
+    std::vector<double> range_sigma, range_inflation;  // σ_eff and σ_eff / own σ of each block
+    std::vector<size_t> range_index;                   // its range in pr.ranges
+    for (size_t i = 0; i < pr.ranges.size(); ++i) {
+      const SmootherRange& r = pr.ranges[i];
       if (r.t < pr.knots.front().t || r.t > pr.knots.back().t) continue;
+      // σ²/w for the mixture's weight w; the loss keeps its scale at k of the range's own σ.
+      const double sqrt_nlos = std::sqrt(nlos_variance_factor[i]);
+      const double sigma_eff = r.sigma_m * sqrt_nlos, inflation = r.noise_inflation * sqrt_nlos;
+      range_index.push_back(i);
       double* gu = r.gamma_unknown >= 0 ? &biases[static_cast<size_t>(r.gamma_unknown)] : &zero_gamma;
       if (r.tag == 0) {  // anchor–anchor
-        auto* cost = new AnchorRangeCost{r.z_m, r.beta, r.gamma_fixed_m, 1.0 / r.sigma_m};
+        auto* cost = new AnchorRangeCost{r.z_m, r.beta, r.gamma_fixed_m, 1.0 / sigma_eff};
         range_ids.push_back(problem.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<AnchorRangeCost, 1, 3, 3, 1>(cost), robustLoss(r.noise_inflation),
+            new ceres::AutoDiffCostFunction<AnchorRangeCost, 1, 3, 3, 1>(cost), robustLoss(inflation),
             anchorBlock(r.anchor, r.p_AinG, r.anchor_unknown), anchorBlock(r.anchor_b, r.p_BinG, r.anchor_b_unknown),
             gu));
-        range_sigma.push_back(r.sigma_m);
-        range_inflation.push_back(r.noise_inflation);
+        range_sigma.push_back(sigma_eff);
+        range_inflation.push_back(inflation);
         continue;
       }
       size_t k = 0;
@@ -444,15 +458,15 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
       cost->z = r.z_m;
       cost->beta = r.beta;
       cost->gamma_fixed = r.gamma_fixed_m;
-      cost->inv_sigma = 1.0 / r.sigma_m;
-      ceres::LossFunction* loss = robustLoss(r.noise_inflation);
+      cost->inv_sigma = 1.0 / sigma_eff;
+      ceres::LossFunction* loss = robustLoss(inflation);
       double* cu = r.common_unknown >= 0 ? &biases[static_cast<size_t>(r.common_unknown)] : &zero_common;
       KnotBlocks& b = blocks[k];
       range_ids.push_back(problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<RangeCost, 1, 3, 4, 3, 3, 3, 1, 1, 3>(cost), loss, b.p.data(), b.q.data(),
           b.v.data(), b.bg.data(), b.ba.data(), gu, cu, anchorBlock(r.anchor, r.p_AinG, r.anchor_unknown)));
-      range_sigma.push_back(r.sigma_m);
-      range_inflation.push_back(r.noise_inflation);
+      range_sigma.push_back(sigma_eff);
+      range_inflation.push_back(inflation);
     }
 
     ceres::Solver::Options sopt;
@@ -475,11 +489,25 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
     const double mean_chi2 = imu_ids.empty() ? 1.0 : chi2_imu / (9.0 * static_cast<double>(imu_ids.size()));
     result.n_ranges = static_cast<int>(range_ids.size());
     result.n_range_outliers = 0;
+    result.n_range_nlos = 0;
+    const bool last = pass + 1 >= std::max(1, options_.passes);
     double sq = 0.0;
     int n_in = 0;
     for (size_t i = 0; i < range_ids.size(); ++i) {
       double res = 0.0;
       problem.EvaluateResidualBlock(range_ids[i], false, nullptr, &res, nullptr);
+      if (mixture) {
+        // E step at this solution: r = z − ẑ [m], s = the range's own σ² (correlation and the
+        // previous weight left out), for the next pass.
+        double& factor = nlos_variance_factor[range_index[i]];
+        if (factor > 2.0) ++result.n_range_nlos;  // this solve took it with w < 0.5
+        if (!last) {
+          const double own_sigma = range_sigma[i] / range_inflation[i];
+          factor = estimator::nlos::innovationInflation(res * range_sigma[i], own_sigma * own_sigma,
+                                                        options_.nlos_fraction, options_.nlos_offset_m,
+                                                        options_.nlos_scale_m);
+        }
+      }
       if (std::abs(res) * range_inflation[i] > 3.0 * k_loss) {  // beyond 3 loss scales of its own σ
         ++result.n_range_outliers;
       } else {
@@ -490,12 +518,12 @@ SmootherResult BatchSmoother::solve(const SmoothingProblem& pr,
     result.range_rms_inliers_m = n_in > 0 ? std::sqrt(sq / n_in) : 0.0;
     result.imu_chi2_per_dof = mean_chi2;
 
-    const bool last = pass + 1 >= std::max(1, options_.passes);
     if (progress) {
       std::ostringstream s;
       s << "pass " << pass + 1 << ": " << summary.iterations.size() << " iterations, cost " << summary.final_cost
         << ", IMU residual chi2/dof " << mean_chi2 << ", " << result.n_range_outliers
         << " of " << result.n_ranges << " ranges beyond " << 3.0 * k_loss << " sigma";
+      if (mixture) s << ", " << result.n_range_nlos << " taken as NLOS (w < 0.5)";
       progress(pass + 1, std::max(1, options_.passes), s.str());
     }
 

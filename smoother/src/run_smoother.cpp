@@ -350,7 +350,11 @@ SmoothedRun smoothRun(const Dataset& ds, const FilterRun& run, const RunSmoother
     }
     out.n_ranges_used += static_cast<int>(pr.ranges.size());
 
-    BatchSmoother smoother(o.solver);
+    BatchSmootherOptions solver = o.solver;  // the estimator's NLOS mixture (run_smoother.h)
+    solver.nlos_fraction = o.nlos_fraction.value_or(est.uwb.nlos_fraction);
+    solver.nlos_offset_m = est.uwb.nlos_min_excess_m;
+    solver.nlos_scale_m = est.uwb.nlos_mean_excess_m;
+    BatchSmoother smoother(solver);
     auto res = smoother.solve(pr, [&](int pass, int passes, const std::string& line) {
       if (progress) {
         std::ostringstream m;

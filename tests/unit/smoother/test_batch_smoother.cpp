@@ -1,13 +1,16 @@
 /// @file test_batch_smoother.cpp
 /// @brief The whole-recording smoother on the analytic scenario (estimator/testing): exact answers
-/// from noise-free data and a poor start, outliers under the robust loss, an anchor frame with z
-/// down, a filter that re-initialized, and the consistency of its covariance on noisy data.
+/// from noise-free data and a poor start, outliers under the robust loss, a small NLOS excess under
+/// the NLOS mixture, an anchor frame with z down, a filter that re-initialized, and the
+/// consistency of its covariance on noisy data.
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <random>
 
+#include "estimator/core/estimator_options.h"
 #include "estimator/core/so3.h"
 #include "estimator/testing/synthetic_scenario.h"
 #include "smoother/run_smoother.h"
@@ -121,14 +124,58 @@ TEST(BatchSmoother, HeavyTailedRangesDoNotPullTheTrajectory) {
     }
   ASSERT_GT(n_out, 100);
   const FilterRun run = perturbedRun(ds, 0.1, 2.0);
+  // The loss alone: without the NLOS mixture (whatever the estimator's default ε), which would
+  // down-weight the long ranges under squared loss too.
   RunSmootherOptions robust;
+  robust.nlos_fraction = 0.0;
   const Errors e_robust = errorsAgainstTruth(ds, smoothRun(ds, run, robust));
-  RunSmootherOptions squared;  // a Huber loss whose corner no residual reaches: least squares
+  RunSmootherOptions squared = robust;  // a Huber loss whose corner no residual reaches: least squares
   squared.solver.range_loss = BatchSmootherOptions::Loss::Huber;
   squared.solver.loss_scale_sigmas = 1e6;
   const Errors e_squared = errorsAgainstTruth(ds, smoothRun(ds, run, squared));
   EXPECT_LT(e_robust.pos_rms_m, 0.04);
   EXPECT_GT(e_squared.pos_rms_m, 2.0 * e_robust.pos_rms_m);
+}
+
+TEST(BatchSmoother, TheNlosMixtureTakesOutASmallPositiveExcessTheLossKeeps) {
+  // 10 % of the ranges carry an NLOS excess of 0.2–0.6 m (2–6 σ): within the Cauchy loss's reach,
+  // so it biases the fit; the mixture's EM over the passes takes those ranges with little weight.
+  const Dataset clean = syn::makeSyntheticDataset(scenario(true));
+  Dataset ds = clean;
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  int n_nlos = 0;
+  for (auto& r : ds.ranges)
+    if (u01(rng) < 0.1) {
+      r.range_m += 0.2 + 0.4 * u01(rng);
+      ++n_nlos;
+    }
+  ASSERT_GT(n_nlos, 100);
+  const FilterRun run = perturbedRun(ds, 0.1, 2.0);
+  RunSmootherOptions off, on;
+  off.nlos_fraction = 0.0;
+  on.nlos_fraction = 0.1;
+  const SmoothedRun sm_off = smoothRun(ds, run, off), sm_on = smoothRun(ds, run, on);
+  const Errors e_off = errorsAgainstTruth(ds, sm_off), e_on = errorsAgainstTruth(ds, sm_on);
+  const Errors e_clean = errorsAgainstTruth(clean, smoothRun(clean, run, off));
+  std::cout << "NLOS excess on " << n_nlos << " ranges: position RMSE " << e_off.pos_rms_m << " m (mixture off), "
+            << e_on.pos_rms_m << " m (on, " << sm_on.chunks[0].result.n_range_nlos
+            << " ranges with w < 0.5); without the excess " << e_clean.pos_rms_m << " m\n";
+  EXPECT_EQ(sm_off.chunks[0].result.n_range_nlos, 0);
+  EXPECT_GT(sm_on.chunks[0].result.n_range_nlos, n_nlos / 2);  // measured 206 of 232
+  // Measured (2026-12-06): 0.0329 m off, 0.0240 m on, 0.0232 m without the excess: the mixture
+  // takes back 92 % of what the excess costs. Other draws of the excess (seeds 21, 34, 55): off
+  // 0.040 / 0.037 / 0.036 m, on 0.031 / 0.025 / 0.028 m.
+  EXPECT_LT(e_on.pos_rms_m, 0.85 * e_off.pos_rms_m);
+  EXPECT_LT(e_on.pos_rms_m - e_clean.pos_rms_m, 0.3 * (e_off.pos_rms_m - e_clean.pos_rms_m));
+  // Unset, ε is the estimator's (uwb.nlos_fraction of its options): the same fit as when given.
+  RunSmootherOptions estimator_eps;
+  estimator_eps.nlos_fraction = estimator::EstimatorOptions{}.uwb.nlos_fraction;
+  const SmoothedRun sm_default = smoothRun(ds, run, RunSmootherOptions{});
+  const SmoothedRun sm_given = smoothRun(ds, run, estimator_eps);
+  ASSERT_EQ(sm_default.poses.size(), sm_given.poses.size());
+  for (size_t i = 0; i < sm_default.poses.size(); ++i)
+    ASSERT_EQ(sm_default.poses[i].p_IinG, sm_given.poses[i].p_IinG) << "pose " << i;
 }
 
 TEST(BatchSmoother, TheCovarianceIsConsistentOnNoisyData) {
