@@ -123,6 +123,7 @@ void EstimatorNode::resetAll() {
   gate_.forgetKeys();
   sensors_.baro.setReference(std::nullopt);
   instance_stats_.clear();
+  range_fates_.clear();
   outputs_.resetPose();
   held_for_imu_.clear();
   next_imu_.reset();
@@ -316,6 +317,8 @@ void EstimatorNode::accept(const EstimatorInput& in) {
   if (rerun_.pending() && !rerun_.running() && !std::holds_alternative<AnchorInit>(in) && !pending_next_imu_)
     startRerun();
   timeline_.retire(*newest - Duration::fromSec(options_.window_s));
+  const int64_t oldest_us = (*newest - Duration::fromSec(options_.window_s)).us;
+  while (!range_fates_.empty() && range_fates_.begin()->first.t_us < oldest_us) range_fates_.erase(range_fates_.begin());
   init_.pruneStillness(timeline_.oldestReplayUs(newest->us));
   updateHealth(*newest);
   publishPeriodic();

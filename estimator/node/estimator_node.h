@@ -207,6 +207,9 @@ class EstimatorNode : private RerunReplayer {
   /// A fleet's inter-vehicle range (docs/fleet.md "Inter-vehicle ranges"): the peer's tag as an
   /// exactly known point for this update, its covariance added along the line of sight to R.
   void processPeerRange(const PeerRange& p, bool first);
+  /// A range re-processed (not first) with another gate decision than it was counted with: its two
+  /// instances' counts move to the new decision (range_fates_).
+  void recountRange(const RangeSample& s, SensorId a, SensorId b, bool accepted);
   void processHeight(const HeightSample& s, bool first);
   void processZupt(const ImuSample& s, bool first);
   /// Instance statistics, health and the "gated_<type>" counter of a scalar update (baro, height).
@@ -341,6 +344,9 @@ class EstimatorNode : private RerunReplayer {
   InputTimeline timeline_;
   AnchorRerun rerun_;
   std::map<SensorId, InstanceStatus> instance_stats_;
+  /// Each counted range in the out-of-sequence window: fused (true) or gated at its last processing,
+  /// so that a rewind that changes the decision moves its count (recountRange); pruned with the window.
+  std::map<InputOrder, bool> range_fates_;
   FixedLagSmoother smoother_;  ///< enabled by fixed_lag.enabled and a pose_smoothed sink
 };
 

@@ -98,7 +98,11 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
   }
   // Every batch's median NIS, whether λ changed or not (it holds at its bound, or while H P Hᵀ ≫ R).
   if (first && cur_.noise_adapter.decisions() != decisions) gravity_.noteRangeNisRatio(cur_.noise_adapter.lastRatio());
-  if (!count) return;
+  if (!count) {
+    if (!first) recountRange(s, z.a, z.b, r.accepted);
+    return;
+  }
+  range_fates_[inputOrder(s)] = r.accepted;
   if (!r.accepted) diag_.count("gated_range");
   if (tag_range && r.accepted) reentry_.noteAccepted(s.t);
   // Tag ranges tell whether the pose is right; ranges between anchors do not.
@@ -111,6 +115,19 @@ void EstimatorNode::processRange(const RangeSample& s, bool first) {
   for (SensorId id : {z.a, z.b}) {
     InstanceStatus& is = instance_stats_[id];
     ++(r.accepted ? is.n_updates : is.n_rejected);
+  }
+}
+
+void EstimatorNode::recountRange(const RangeSample& s, SensorId a, SensorId b, bool accepted) {
+  auto it = range_fates_.find(inputOrder(s));
+  if (it == range_fates_.end() || it->second == accepted) return;
+  // A rewind re-processed this range with the other decision (a late input before it changed the
+  // state): the instances' counts follow its last decision, as in-order processing would count it.
+  it->second = accepted;
+  for (SensorId id : {a, b}) {
+    InstanceStatus& is = instance_stats_[id];
+    --(accepted ? is.n_rejected : is.n_updates);
+    ++(accepted ? is.n_updates : is.n_rejected);
   }
 }
 
