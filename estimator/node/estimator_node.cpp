@@ -179,8 +179,14 @@ void EstimatorNode::onInput(const EstimatorInput& in_raw) {
 }
 
 void EstimatorNode::settle(const EstimatorInput& in) {
+  // ANCHOR_INIT and commands are not data of a window: they apply at once, as after the
+  // initialization (held, a command stamped an hour ahead would move the clock past every input).
+  if (std::holds_alternative<AnchorInit>(in) || std::holds_alternative<EstimatorCommand>(in)) {
+    route(in);
+    return;
+  }
   if (!settler_.add(in)) {
-    // An event (ANCHOR_INIT, a command) applies at once anyway; a measurement is reported.
+    // A flight state or a peer range is taken as it comes; a stream's input is reported.
     if (InputSettler::isStreamInput(in))
       diag_.report("late_for_initialization",
                  where("input", inputTime(in)) + " (" + inputKindName(in) +

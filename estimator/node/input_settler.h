@@ -16,8 +16,9 @@
 /// settled anyway. In one process the inputs come in the canonical order already, so the
 /// released sequence is the arrival sequence and nothing changes (tested); over LCM only an input
 /// later than both bounds arrives out of order ("late_for_initialization" in the node).
-/// Events (flight state, ANCHOR_INIT, commands) and a fleet's peer ranges do not move W; they are
-/// held and released in order.
+/// Flight states and a fleet's peer ranges do not move W; they are held and released in order.
+/// ANCHOR_INIT and commands are not given to the settler: the node applies them at once (a
+/// command stamped far ahead must not move the clock, EstimatorTimeGuard).
 /// While a restart's checkpoint is offered (until the first IMU sample decides whether it resumes
 /// the pose, EstimatorNode::resumeFrom) the node does not hold inputs: a resumed pose comes at once.
 
