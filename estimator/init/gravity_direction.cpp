@@ -3,6 +3,8 @@
 
 #include "estimator/init/gravity_direction.h"
 
+#include <algorithm>
+
 #include <spdlog/spdlog.h>
 
 namespace meshnav::estimator {
@@ -16,13 +18,21 @@ std::string costsText(const MotionAligner::GravityCheck& c) {
 
 }  // namespace
 
-GravityDirection::GravityDirection(double window_s, double early_nis_ratio, Diagnostics& diag)
-    : window_s_(window_s), early_nis_ratio_(early_nis_ratio), diag_(diag) {}
+GravityDirection::GravityDirection(double first_s, double window_s, double early_nis_ratio, Diagnostics& diag)
+    : first_s_(first_s), window_s_(window_s), early_nis_ratio_(early_nis_ratio), diag_(diag) {}
+
+void GravityDirection::scheduleNext(Timestamp t) {
+  // The data since the initialization doubles: first_s, then steps of 2 first_s, 4 first_s, …
+  // capped at the window (the aligner fits no more than a window).
+  step_s_ = std::min(2.0 * (step_s_ > 0.0 ? step_s_ : 0.5 * first_s_), window_s_);
+  check_at_ = t + Duration::fromSec(step_s_);
+}
 
 void GravityDirection::reset() {
   sign_ = -1.0;
   check_at_.reset();
   checks_ = 0;
+  step_s_ = 0.0;
   early_due_ = early_checked_ = false;
   reinit_pending_ = false;
   last_reinit_try_.reset();
@@ -38,7 +48,10 @@ void GravityDirection::onInitialized(Timestamp t, int decided_sign) {
     }
     return;
   }
-  if (checks_ == 0 && !check_at_) check_at_ = t + Duration::fromSec(window_s_);
+  if (checks_ == 0 && !check_at_) {
+    step_s_ = 0.0;
+    scheduleNext(t);  // first_s after it
+  }
 }
 
 void GravityDirection::noteRangeNisRatio(double ratio) {
@@ -58,7 +71,7 @@ void GravityDirection::scheduledCheck(Timestamp t, Context& c) {
   const auto check = c.compareGravitySigns();
   if (!check) {
     spdlog::info("estimator: gravity direction not checked at t={}: {}", formatSeconds(t), c.whyNot());
-    if (checks_ < kMaxChecks) check_at_ = t + Duration::fromSec(window_s_);
+    if (checks_ < kMaxChecks) scheduleNext(t);
     return;
   }
   if (check->zDown()) {
@@ -67,8 +80,8 @@ void GravityDirection::scheduledCheck(Timestamp t, Context& c) {
   }
   spdlog::info("estimator: gravity direction at t={}: {} ({})", formatSeconds(t),
                check->zUp() ? "along -z of G as assumed" : "undecided", costsText(*check));
-  // Undecided (little motion in the window): again a window later, at most kMaxChecks times.
-  if (!check->zUp() && checks_ < kMaxChecks) check_at_ = t + Duration::fromSec(window_s_);
+  // Undecided (little motion in the window): again when the data has doubled, at most kMaxChecks times.
+  if (!check->zUp() && checks_ < kMaxChecks) scheduleNext(t);
 }
 
 void GravityDirection::earlyCheck(Timestamp t, Context& c) {

@@ -1,6 +1,6 @@
 /// GravityDirection (estimator/init/gravity_direction.h) against a scripted Context: when the
-/// comparison of both signs runs (a window after the initialization, again while undecided, at
-/// most kMaxChecks times, once early on a large range NIS), what +z does (sign, the models turned,
+/// comparison of both signs runs (first_s after the initialization, again while undecided each time
+/// the data has doubled, at most kMaxChecks times, once early on a large range NIS), what +z does (sign, the models turned,
 /// a re-initialization retried every kFlipRetry_s) and what a vertical sensor prevents.
 #include <gtest/gtest.h>
 
@@ -16,6 +16,7 @@ namespace {
 
 Timestamp at(double s) { return Timestamp::fromSec(s); }
 
+constexpr double kFirst_s = 3.0;  // init.motion_min_span_s
 constexpr double kWindow_s = 12.0;
 constexpr double kEarlyRatio = 6.0;
 
@@ -57,7 +58,7 @@ class FakeContext : public GravityDirection::Context {
 
 struct GravityTest : ::testing::Test {
   Diagnostics diag;
-  GravityDirection g{kWindow_s, kEarlyRatio, diag};
+  GravityDirection g{kFirst_s, kWindow_s, kEarlyRatio, diag};
   FakeContext c;
 };
 
@@ -71,52 +72,56 @@ TEST_F(GravityTest, NothingRunsBeforeTheFirstInitialization) {
   EXPECT_EQ(diag.get("gravity_early_check"), 0);
 }
 
-TEST_F(GravityTest, TheScheduledComparisonRunsOnceAWindowAfterTheFirstInitialization) {
+TEST_F(GravityTest, TheFirstComparisonRunsTheShortestWindowAfterTheFirstInitialization) {
   c.checks = {zUp()};
   g.onInitialized(at(5.0));
-  g.onInitialized(at(8.0));  // a later initialization does not move it
-  g.onImu(at(16.99), c);
+  g.onInitialized(at(7.0));  // a later initialization does not move it
+  g.onImu(at(7.99), c);
   EXPECT_EQ(c.compared, 0);
-  g.onImu(at(17.0), c);
+  g.onImu(at(8.0), c);
   EXPECT_EQ(c.compared, 1);
   // Decided for −z: never again, not even after another initialization.
   g.onInitialized(at(30.0));
-  for (double t = 17.5; t < 80.0; t += 0.5) g.onImu(at(t), c);
+  for (double t = 8.5; t < 80.0; t += 0.5) g.onImu(at(t), c);
   EXPECT_EQ(c.compared, 1);
   EXPECT_EQ(g.zSign(), -1.0);
   EXPECT_EQ(c.turned, 0);
   EXPECT_TRUE(c.reinit_at.empty());
 }
 
-TEST_F(GravityTest, UndecidedOrRefusedIsComparedAgainAWindowLaterAtMostMaxChecksTimes) {
-  ASSERT_EQ(GravityDirection::kMaxChecks, 3);
-  c.checks = {std::nullopt, undecided(), undecided(), zDown()};  // the fourth is never asked
+TEST_F(GravityTest, UndecidedOrRefusedIsComparedAgainWhenTheDataHasDoubledAtMostMaxChecksTimes) {
+  ASSERT_EQ(GravityDirection::kMaxChecks, 4);
+  c.checks = {std::nullopt, undecided(), undecided(), undecided(), zDown()};  // the fifth is never asked
   g.onInitialized(at(0.0));
-  g.onImu(at(12.0), c);
+  g.onImu(at(3.0), c);
   EXPECT_EQ(c.compared, 1);
-  g.onImu(at(23.9), c);
-  EXPECT_EQ(c.compared, 1);  // rescheduled from the check's time: 24
-  g.onImu(at(24.0), c);
+  g.onImu(at(8.9), c);
+  EXPECT_EQ(c.compared, 1);  // rescheduled from the check's time by twice the first step: 9
+  g.onImu(at(9.0), c);
   EXPECT_EQ(c.compared, 2);
-  g.onImu(at(36.0), c);
+  g.onImu(at(20.9), c);
+  EXPECT_EQ(c.compared, 2);  // then 12 s (the window caps the doubling): 21, 33
+  g.onImu(at(21.0), c);
   EXPECT_EQ(c.compared, 3);
-  for (double t = 36.5; t < 100.0; t += 0.5) g.onImu(at(t), c);
-  EXPECT_EQ(c.compared, 3);
+  g.onImu(at(33.0), c);
+  EXPECT_EQ(c.compared, 4);
+  for (double t = 33.5; t < 100.0; t += 0.5) g.onImu(at(t), c);
+  EXPECT_EQ(c.compared, 4);
   EXPECT_EQ(g.zSign(), -1.0);
 }
 
 TEST_F(GravityTest, PlusZWithoutAVerticalSensorTurnsGravityAndReinitializes) {
   c.checks = {zDown()};
   g.onInitialized(at(2.0));
-  g.onImu(at(14.0), c);
+  g.onImu(at(5.0), c);
   EXPECT_EQ(g.zSign(), 1.0);
   EXPECT_EQ(g.gravityG(9.81), Eigen::Vector3d(0.0, 0.0, 9.81));
   EXPECT_EQ(c.turned, 1);
   ASSERT_EQ(c.reinit_at.size(), 1u);
-  EXPECT_EQ(c.reinit_at[0], at(14.0));
+  EXPECT_EQ(c.reinit_at[0], at(5.0));
   EXPECT_EQ(diag.get("anchor_frame_z_down"), 1);
   EXPECT_EQ(diag.get("gravity_flip"), 1);
-  for (double t = 14.5; t < 60.0; t += 0.5) g.onImu(at(t), c);
+  for (double t = 5.5; t < 60.0; t += 0.5) g.onImu(at(t), c);
   EXPECT_EQ(c.compared, 1);
   EXPECT_EQ(c.turned, 1);
   EXPECT_EQ(c.reinit_at.size(), 1u);
@@ -127,19 +132,19 @@ TEST_F(GravityTest, ARefusedReinitializationIsRetriedAfterFlipRetry) {
   c.checks = {zDown()};
   c.reinit_answers = {false, false, true};
   g.onInitialized(at(0.0));
-  g.onImu(at(12.0), c);
+  g.onImu(at(3.0), c);
   EXPECT_EQ(c.reinit_at.size(), 1u);
-  g.onImu(at(12.3), c);
-  g.onImu(at(12.499), c);
+  g.onImu(at(3.3), c);
+  g.onImu(at(3.499), c);
   EXPECT_EQ(c.reinit_at.size(), 1u);
-  g.onImu(at(12.5), c);
+  g.onImu(at(3.5), c);
   EXPECT_EQ(c.reinit_at.size(), 2u);
-  g.onImu(at(12.9), c);
+  g.onImu(at(3.9), c);
   EXPECT_EQ(c.reinit_at.size(), 2u);
-  g.onImu(at(13.0), c);
+  g.onImu(at(4.0), c);
   ASSERT_EQ(c.reinit_at.size(), 3u);
-  EXPECT_EQ(c.reinit_at[2], at(13.0));
-  g.onImu(at(13.5), c);
+  EXPECT_EQ(c.reinit_at[2], at(4.0));
+  g.onImu(at(4.5), c);
   g.onImu(at(20.0), c);
   EXPECT_EQ(c.reinit_at.size(), 3u);  // accepted: no more tries
   EXPECT_EQ(diag.get("gravity_flip_refused"), 2);
@@ -195,7 +200,7 @@ TEST_F(GravityTest, ADecisiveEarlyCheckTakesPlusZAndCancelsTheScheduledOne) {
 
 TEST_F(GravityTest, NoEarlyCheckAfterTheFirstScheduledOneOrWhenOff) {
   g.onInitialized(at(0.0));
-  g.onImu(at(12.0), c);  // undecided: rescheduled to 24
+  g.onImu(at(12.0), c);  // the first comparison (due at 3), undecided: rescheduled to 18
   ASSERT_EQ(c.compared, 1);
   g.noteRangeNisRatio(50.0);
   g.onImu(at(13.0), c);
@@ -203,7 +208,7 @@ TEST_F(GravityTest, NoEarlyCheckAfterTheFirstScheduledOneOrWhenOff) {
   EXPECT_EQ(diag.get("gravity_early_check"), 0);
 
   Diagnostics d2;
-  GravityDirection off(kWindow_s, 0.0, d2);  // ratio 0: off
+  GravityDirection off(kFirst_s, kWindow_s, 0.0, d2);  // ratio 0: off
   FakeContext c2;
   off.onInitialized(at(0.0));
   off.noteRangeNisRatio(1000.0);
@@ -225,15 +230,15 @@ TEST_F(GravityTest, ResetReturnsToTheConventionAndForgetsTheSchedule) {
   EXPECT_EQ(c.compared, 1);
   // A new initialization schedules a new first comparison.
   g.onInitialized(at(40.0));
-  g.onImu(at(51.9), c);
+  g.onImu(at(42.9), c);
   EXPECT_EQ(c.compared, 1);
-  g.onImu(at(52.0), c);
+  g.onImu(at(43.0), c);
   EXPECT_EQ(c.compared, 2);
 }
 
 TEST(GravityDirection, AReplayTakesTheLiveSign) {
   Diagnostics diag;
-  GravityDirection live(kWindow_s, kEarlyRatio, diag), replay(kWindow_s, kEarlyRatio, diag);
+  GravityDirection live(kFirst_s, kWindow_s, kEarlyRatio, diag), replay(kFirst_s, kWindow_s, kEarlyRatio, diag);
   FakeContext c;
   c.checks = {zDown()};
   live.onInitialized(at(0.0));
@@ -258,14 +263,14 @@ TEST_F(GravityTest, ASignDecidedAtTheFirstAlignmentIsTakenAndNothingIsScheduled)
   EXPECT_TRUE(c.reinit_at.empty());  // the pose was fitted with +z already
   EXPECT_EQ(c.turned, 0);            // the node turned its models at the initialization
 
-  GravityDirection minus{kWindow_s, kEarlyRatio, diag};
+  GravityDirection minus{kFirst_s, kWindow_s, kEarlyRatio, diag};
   minus.onInitialized(at(5.0), -1);
   for (double t = 5.0; t < 60.0; t += 0.5) minus.onImu(at(t), c);
   EXPECT_EQ(minus.zSign(), -1.0);
   EXPECT_EQ(c.compared, 0);
 
-  GravityDirection undecided_at_init{kWindow_s, kEarlyRatio, diag};
-  undecided_at_init.onInitialized(at(5.0), 0);  // undecided: the comparison a window later, as always
-  undecided_at_init.onImu(at(17.0), c);
+  GravityDirection undecided_at_init{kFirst_s, kWindow_s, kEarlyRatio, diag};
+  undecided_at_init.onInitialized(at(5.0), 0);  // undecided: the comparison first_s later, as always
+  undecided_at_init.onImu(at(8.0), c);
   EXPECT_EQ(c.compared, 1);
 }
