@@ -1,7 +1,7 @@
 """The whole-recording smoother on real recordings (issue 35): `meshnav_run` with its defaults,
 then `meshnav_smooth`, then `meshnav_eval`, which scores estimate_smoothed.csv beside the filter.
 Asserted on each: the issue's target for the smoothed estimate, the figure measured when it was
-built (MEASURED, 2026-12-06; a deterministic run: the margin absorbs compiler/libm differences),
+built (MEASURED, 2026-12-06, NLOS mixture on in filter and smoother; a deterministic run: the margin absorbs compiler/libm differences),
 that the smoother beats the filter of the same run, and that its output names what it found
 (gravity's direction, the filter's re-initializations). When a change moves these figures,
 update MEASURED and docs/results.md."""
@@ -16,7 +16,7 @@ import realdata_support as rs
 
 STARLOC_DIR = os.path.join(rs.SHARED, "data", "real-starloc-loop2d-s1")
 # smoothed position RMSE [m] (the filter's in brackets), 2026-12-06
-MEASURED = {"starloc": 0.123, "isas": 0.052, "ifo002": 0.250}  # (0.141, 0.250, 1.006)
+MEASURED = {"starloc": 0.118, "isas": 0.050, "ifo002": 0.214}  # (0.121, 0.167, 1.007)
 TARGET = {"starloc": 0.20, "isas": 0.16}  # issue 35; MILUV: half the filter's figure
 MARGIN_M = 0.02
 
@@ -62,10 +62,11 @@ class SmoothRealData(unittest.TestCase):
             f, s, anees, summary = smooth_and_evaluate(self, ds, tmp.name, "se3")
         self.assertLess(s, min(TARGET["isas"], MEASURED["isas"] + MARGIN_M))
         self.assertLess(s, 0.5 * f)
-        # The anchors' frame has z down (docs/real_data.md): found from the data, and the filter's
-        # flip to it is a re-initialization the smoother starts its attitudes behind.
+        # The anchors' frame has z down (docs/real_data.md): found from the data before the filter's
+        # first pose (the alignment window compares both signs), so the filter starts along it and
+        # is never re-initialized for it.
         self.assertEqual(summary["chunks"][0]["gravity_z_sign"], 1)
-        self.assertGreaterEqual(summary["chunks"][0]["filter_reinitializations"], 1)
+        self.assertEqual(summary["chunks"][0]["filter_reinitializations"], 0)
         self.assertLess(anees, 4.0)
 
     def test_miluv_ifo002(self):
