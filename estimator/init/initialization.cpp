@@ -210,7 +210,8 @@ void Initialization::compareGravitySigns(Timestamp t) {
   // the node compares again (its sign went back to −z with the aligner's).
   if (decided_sign_ != 0 || sawVerticalSensor()) return;
   const auto check = aligner_.checkGravityDirection(Eigen::Vector3d::Zero());
-  if (!check || (!check->zDown() && !check->zUp())) {
+  if (!check) return;  // too little data to compare yet (the aligner says why when it refuses)
+  if (!check->zDown() && !check->zUp()) {
     diag_.count("gravity_compare_undecided");  // the next try compares again
     return;
   }
