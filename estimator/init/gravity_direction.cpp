@@ -24,7 +24,7 @@ GravityDirection::GravityDirection(double first_s, double window_s, double early
 void GravityDirection::scheduleNext(Timestamp t) {
   // The data since the initialization doubles: first_s, then steps of 2 first_s, 4 first_s, …
   // capped at the window (the aligner fits no more than a window).
-  step_s_ = std::min(2.0 * (step_s_ > 0.0 ? step_s_ : 0.5 * first_s_), window_s_);
+  step_s_ = std::min(step_s_ > 0.0 ? 2.0 * step_s_ : first_s_, window_s_);
   check_at_ = t + Duration::fromSec(step_s_);
 }
 

@@ -100,7 +100,6 @@ class Initialization {
   void feedHeight(const HeightSample& h);
   void feedBaro(const BaroSample& b);
   void feedRange(const RangeSample& r, const UwbNetwork& network, const FusionStrategy* filter);
-  std::optional<InitialBelief> tryMotion(Timestamp t);
   /// Before an in-motion alignment at IMU time `t`, until one decides: both gravity signs
   /// compared on the window (MotionAligner::checkGravityDirection); a decisive +z turns the
   /// aligner, so the pose is fitted with it (InitialBelief::gravity_z_sign). Not with baro or

@@ -7,21 +7,17 @@
 
 namespace meshnav::estimator {
 
-namespace {
 /// The streams whose order the watermark relies on (a fleet's peer ranges are routed inside one
 /// process and come only while a peer is ranged: not a stream that must pass).
-bool isStream(const EstimatorInput& in) {
+bool InputSettler::isStreamInput(const EstimatorInput& in) {
   return std::holds_alternative<ImuSample>(in) || std::holds_alternative<RangeSample>(in) ||
          std::holds_alternative<BaroSample>(in) || std::holds_alternative<HeightSample>(in);
 }
-}  // namespace
-
-bool InputSettler::isStreamInput(const EstimatorInput& in) { return isStream(in); }
 
 bool InputSettler::add(const EstimatorInput& in) {
   const InputOrder key = inputOrder(in);
   const Timestamp t = inputTime(in);
-  if (isStream(in)) {
+  if (isStreamInput(in)) {
     auto [it, fresh] = newest_by_kind_.emplace(inputKindRank(in), t);
     if (!fresh) it->second = std::max(it->second, t);
     newest_ = newest_ ? std::max(*newest_, t) : t;
