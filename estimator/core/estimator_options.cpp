@@ -72,7 +72,7 @@ const Field kFields[] = {
     {"uwb.fuse_calibrated_anchor_pairs", field<&EstimatorOptions::uwb, &UwbOptions::fuse_calibrated_anchor_pairs>, "fuse ranges between two calibrated anchors (their correlated calibration errors are not known)"},
     {"uwb.dah_fuse_estimated_anchor_pairs", field<&EstimatorOptions::uwb, &UwbOptions::dah_fuse_estimated_anchor_pairs>, "dah only: fuse ranges between two estimated anchors (overconfident, see docs)"},
     {"uwb.dah_joint_anchors", field<&EstimatorOptions::uwb, &UwbOptions::dah_joint_anchors>, "dah only: anchors updated jointly: none | batch (added together, e.g. by a re-run) | all"},
-    {"uwb.nlos_fraction", field<&EstimatorOptions::uwb, &UwbOptions::nlos_fraction>, "prior probability that a range carries an NLOS excess (posterior line-of-sight weight after the gate), 0 = Gaussian only [-]"},
+    {"uwb.nlos_fraction", field<&EstimatorOptions::uwb, &UwbOptions::nlos_fraction>, "prior probability that a range carries an NLOS excess (the update after the gate is the mixture's collapsed posterior), 0 = Gaussian only [-]"},
     {"uwb.range_error_correlation_s", field<&EstimatorOptions::uwb, &UwbOptions::range_error_correlation_s>, "correlation time of a pair's range error: the update weighs R x (1 + rho)/(1 - rho), rho = exp(-dt/tau), dt since the pair's previous range (the gate judges R); 0 = white [s]"},
     {"uwb.reentry_gap_s", field<&EstimatorOptions::uwb, &UwbOptions::reentry_gap_s>, "no tag range accepted for this long: hold and cross-check the next ones, 0 = off [s]"},
     {"zupt.enabled", field<&EstimatorOptions::zupt, &ZuptOptions::enabled>, ""},

@@ -187,8 +187,9 @@ struct UwbOptions {
   double clock_offset_rw_s_per_sqrt_s = 1e-4;
   /// A range's error is a line-of-sight / NLOS mixture (estimator/core/nlos_mixture.h): with prior
   /// probability `nlos_fraction` a positive excess nlos_min_excess_m + Exp(nlos_mean_excess_m); a
-  /// range that passed the gate is weighted by its posterior probability of line of sight (only
-  /// while the measurement dominates its innovation, as the Huber weight: huber_max_prior_ratio).
+  /// range that passed the gate updates the state by the mixture's posterior collapsed to one
+  /// Gaussian (only while the measurement dominates its innovation, as the Huber weight:
+  /// huber_max_prior_ratio).
   /// b₀ and μ are model parameters, from STAR-loc's errors against its truth (γ removed): beyond
   /// +0.2 m 10.1 % of them, below −0.2 m 4.2 % (about 6 % excess on the positive side), mean
   /// excess beyond 0.2 m 0.35 m. ε is an option, 0.1 by default: STAR-loc's ranges more than

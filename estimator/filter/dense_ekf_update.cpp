@@ -27,38 +27,42 @@ DenseUpdateOutput denseEkfUpdate(Eigen::MatrixXd& P, const StateLayout& layout, 
   Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
   DenseUpdateOutput out;
   out.nis = lin.residual.dot(ldlt.solve(lin.residual));
-  if (!std::isfinite(out.nis) || (nis_gate > 0.0 && out.nis > nis_gate)) return out;
-  // Correlated errors and robust weights, after the gate: R_eff = R·f + S'(inflate − 1); the Joseph
-  // form below uses S = H P Hᵀ + R_eff.
-  if (const double robust = lin.robustInflation(out.nis, S(0, 0)); lin.step_noise_factor > 1.0 || robust > 1.0) {
-    S = lin.stepCovariance(S, robust);
-    ldlt.compute(S);
-  }
-  out.K = ldlt.solve(U.transpose()).transpose();  // n × m
-  out.dx = out.K * lin.residual;
+  if (!lin.passesGate(out.nis, nis_gate)) return out;
   if (m == 1) {
-    // One row of H (a range, the baro): K Uᵀ and K S Kᵀ are outer products. The form and the
-    // symmetrization below in one pass over the pairs (i ≥ j), in place, with the arithmetic of the
-    // matrix expressions per coefficient (the same values, without their three n × n temporaries).
-    const double s = S(0, 0);
+    // One row of H (a range, the baro): the step of Linearization::scalarStep, K = u / s_step,
+    // δx = K r', P ← P − K uᵀ − u Kᵀ + K (s_step + c) Kᵀ (Joseph) or P − K uᵀ + K c Kᵀ: both
+    // P − u uᵀ (s_step − c)/s_step². Outer products, with the symmetrization in one pass over the
+    // pairs (i ≥ j), in place (without the matrix expressions' three n × n temporaries).
+    const Linearization::ScalarStep st = lin.scalarStep(S(0, 0), out.nis);
+    const double s = st.s_step, c = st.spread_m2;
+    out.K = U / s;
+    out.dx = out.K * st.residual;
     const double* k = out.K.data();
     const double* u = U.data();
     for (Eigen::Index j = 0; j < n; ++j)
       for (Eigen::Index i = j; i < n; ++i) {
         double a, b;  // the new P(i, j) and P(j, i) before the symmetrization
         if (joseph_form) {
-          a = P(i, j) + ((-(k[i] * u[j]) - k[j] * u[i]) + (k[i] * s) * k[j]);
-          b = P(j, i) + ((-(k[j] * u[i]) - k[i] * u[j]) + (k[j] * s) * k[i]);
+          a = P(i, j) + ((-(k[i] * u[j]) - k[j] * u[i]) + (k[i] * (s + c)) * k[j]);
+          b = P(j, i) + ((-(k[j] * u[i]) - k[i] * u[j]) + (k[j] * (s + c)) * k[i]);
         } else {
-          a = P(i, j) - k[i] * u[j];
-          b = P(j, i) - k[j] * u[i];
+          a = P(i, j) - k[i] * u[j] + (k[i] * c) * k[j];
+          b = P(j, i) - k[j] * u[i] + (k[j] * c) * k[i];
         }
         P(i, j) = P(j, i) = 0.5 * (a + b);
       }
-    out.S = std::move(S);
+    out.S = Eigen::MatrixXd::Constant(1, 1, s);
     out.accepted = true;
     return out;
   }
+  // Correlated errors (step_noise_factor), after the gate: R_eff = R·f; the Joseph form below uses
+  // S = H P Hᵀ + R_eff. No robust weight for m > 1.
+  if (lin.step_noise_factor > 1.0) {
+    S = lin.stepCovariance(S, 1.0);
+    ldlt.compute(S);
+  }
+  out.K = ldlt.solve(U.transpose()).transpose();  // n × m
+  out.dx = out.K * lin.residual;
   if (joseph_form) {
     const Eigen::MatrixXd KU = out.K * U.transpose();
     P += -KU - KU.transpose() + out.K * S * out.K.transpose();

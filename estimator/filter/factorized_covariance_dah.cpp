@@ -255,22 +255,27 @@ class DahUpdate {
     invertible_ = std::abs(s_) > std::numeric_limits<double>::min();  // LDLT's pseudo-inverse
     const double r = lin_.residual(0);
     res->nis = r * (invertible_ ? r / s_ : 0.0);
-    if (!std::isfinite(res->nis) || (nis_gate > 0.0 && res->nis > nis_gate)) return false;
-    // Correlated errors, Huber and NLOS weights (Linearization::stepCovariance), after the gate.
-    s_ = lin_.stepCovariance(S, lin_.robustInflation(res->nis, s_))(0, 0);
+    if (!lin_.passesGate(res->nis, nis_gate)) return false;
+    // Correlated errors, the Huber weight and the NLOS mixture's collapse (Linearization::scalarStep),
+    // after the gate: δx = K r', P ← P − u uᵀ (s_step − c)/s_step².
+    const Linearization::ScalarStep st = lin_.scalarStep(s_, res->nis);
+    s_ = st.s_step;
+    spread_ = st.spread_m2;
     Kv_.resize(n_);
     for (int i = 0; i < n_; ++i) Kv_(i) = invertible_ ? U_(i) / s_ : 0.0;
     // Element (i, j) and (j, i) in one pass over the upper triangle, then symmetrized.
     auto updated = [&](int i, int j) {
-      return joseph ? P_(i, j) + ((-(Kv_(i) * U_(j)) - Kv_(j) * U_(i)) + (Kv_(i) * s_) * Kv_(j))
-                    : P_(i, j) - Kv_(i) * U_(j);
+      return joseph ? P_(i, j) + ((-(Kv_(i) * U_(j)) - Kv_(j) * U_(i)) + (Kv_(i) * (s_ + spread_)) * Kv_(j))
+                    : P_(i, j) - Kv_(i) * U_(j) + (Kv_(i) * spread_) * Kv_(j);
     };
     for (int j = 0; j < n_; ++j) {
       for (int i = 0; i < j; ++i) P_(i, j) = P_(j, i) = 0.5 * (updated(i, j) + updated(j, i));
       P_(j, j) = updated(j, j);
     }
     res->dx.resize(n_);
-    for (int i = 0; i < n_; ++i) res->dx(i) = Kv_(i) * r;
+    for (int i = 0; i < n_; ++i) res->dx(i) = Kv_(i) * st.residual;
+    // From here Kv_ is the gain of the covariance, K (s − c)/s (the write-back's factors).
+    if (spread_ > 0.0) Kv_ *= covGainScale();
     accept(res);
     return true;
   }
@@ -371,7 +376,9 @@ class DahUpdate {
           const MatrixXd M = b.Sigma.ldlt().solve(MatrixXd(Sigma_new)).transpose();
           b.L = b.L.size() ? MatrixXd(M * b.L) : M;
         } else if (invertible_) {  // else K = 0: nothing changed
-          foldScalarCorrection(b, U_.segment(p.off, p.dim), s_);
+          // Σ_ii' = Σ_ii − u uᵀ (s − c)/s²: the fold's s is s²/(s − c) (infinite: Σ_ii unchanged).
+          const double g = covGainScale();
+          foldScalarCorrection(b, U_.segment(p.off, p.dim), g != 0.0 ? s_ / g : std::numeric_limits<double>::infinity());
         }
         ++b.lazy_steps;
       }
@@ -436,6 +443,10 @@ class DahUpdate {
   Mat P_;       ///< Σ_PP, updated in place
   Vec U_, Kv_;  ///< scalar update: Σ_PP hᵀ and the gain
   double s_ = 0.0;
+  /// The NLOS collapse's spread c of a scalar update (0 without it): Σ' = Σ − u uᵀ (s − c)/s², so
+  /// the factors' gain is K (s − c)/s (covGainScale).
+  double spread_ = 0.0;
+  double covGainScale() const { return spread_ > 0.0 ? (s_ - spread_) / s_ : 1.0; }
   bool invertible_ = false;
   MatrixXd K_;  ///< vector update: gain
   PerPart<Factor> Linv_{};

@@ -65,10 +65,14 @@ TEST(RobustNode, StillnessZuptsLetASmoothHoverDrift) {
   // The flight-state σ of the incident: v 0.02 m/s, ω 0.01 rad/s. Since the ω row fuses the mean
   // reading, zupt.sigma_gyro_rad_s is a rest allowance (default 0.001 rad/s); with it this hover's
   // tight ZUPTs happen to be χ²-gated nearly all (330) and the run ends 0.26 m off, with 0.003 rad/s
-  // 4.4 m off: the flight-state velocity σ on a drifting body stays wrong either way.
-  EXPECT_GT(runWith(defaults.zupt.sigma_vel_m_s, 0.01).max_error_after_m, 0.5);
-  EXPECT_LT(runWith(defaults.zupt.stillness_sigma_vel_m_s, defaults.zupt.stillness_sigma_gyro_rad_s).max_error_after_m,
-            0.3);
+  // 4.4 m off: the flight-state velocity σ on a drifting body stays wrong either way. Since the
+  // NLOS mixture's update is its collapsed posterior (2026-12-06) the tight σ ends 0.476 m off
+  // (above 0.5 m before) against 0.220 m with the stillness σ: still twice as far.
+  const double tight = runWith(defaults.zupt.sigma_vel_m_s, 0.01).max_error_after_m;
+  const double stated =
+      runWith(defaults.zupt.stillness_sigma_vel_m_s, defaults.zupt.stillness_sigma_gyro_rad_s).max_error_after_m;
+  EXPECT_GT(tight, 2.0 * stated);
+  EXPECT_LT(stated, 0.3);
 }
 
 TEST(RobustNode, TheImuGradesBiasSpreadKeepsAOneTagTakeOffUnderClusteredCeilingAnchors) {
