@@ -16,7 +16,7 @@ import realdata_support as rs
 
 STARLOC_DIR = os.path.join(rs.SHARED, "data", "real-starloc-loop2d-s1")
 # smoothed position RMSE [m] (the filter's in brackets), 2026-12-06
-MEASURED = {"starloc": 0.118, "isas": 0.050, "ifo002": 0.214}  # (0.121, 0.167, 1.007)
+MEASURED = {"starloc": 0.119, "isas": 0.050, "ifo002": 0.214}  # (0.122, 0.164, 1.007)
 TARGET = {"starloc": 0.20, "isas": 0.16}  # issue 35; MILUV: half the filter's figure
 MARGIN_M = 0.02
 
