@@ -35,8 +35,8 @@ struct Linearization {
   /// update must correct in full (a filter that has drifted would otherwise never catch up).
   double huber_max_prior_ratio = 1.0;
   /// > 0: a scalar range whose error is a line-of-sight / NLOS mixture (nlos_mixture.h) with this
-  /// prior NLOS probability ε and excess nlos_min_m + Exp(nlos_mean_m): its gate is the mixture's
-  /// step the mixture's posterior collapsed to one Gaussian (scalarStep); 0: Gaussian only.
+  /// prior NLOS probability ε and excess nlos_min_m + Exp(nlos_mean_m): its step is the mixture's
+  /// posterior collapsed to one Gaussian (scalarStep), its gate Gaussian (passesGate); 0: Gaussian only.
   double nlos_fraction = 0.0;
   double nlos_min_m = 0.2;
   double nlos_mean_m = 0.3;

@@ -13,9 +13,9 @@
 /// and the posterior probability of line of sight is w = (1 − ε) N(r; 0, s) / ((1 − ε) N(r; 0, s) + ε p_N(r)).
 /// The filter's update is the mixture's posterior collapsed to one Gaussian (`collapse`, assumed-density
 /// filtering: the line-of-sight update and the NLOS one given the excess's posterior, moment-matched).
-/// A negative or small
-/// innovation keeps w ≈ 1 and the plain update; a positive one of a few tenths of a metre, where the
-/// NLOS density dominates, moves the state by little and shrinks its covariance by little.
+/// A negative or small innovation keeps w ≈ 1 and the plain update; a positive one of a few tenths
+/// of a metre, where the NLOS density dominates, moves the state by little and shrinks its
+/// covariance by little.
 /// The whole-recording smoother weighs each range by w in its EM passes (`innovationInflation`, 1/w
 /// floored at kMinWeight).
 

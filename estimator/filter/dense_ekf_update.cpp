@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -35,7 +36,8 @@ DenseUpdateOutput denseEkfUpdate(Eigen::MatrixXd& P, const StateLayout& layout, 
     // pairs (i ≥ j), in place (without the matrix expressions' three n × n temporaries).
     const Linearization::ScalarStep st = lin.scalarStep(S(0, 0), out.nis);
     const double s = st.s_step, c = st.spread_m2;
-    out.K = U / s;
+    // s = 0 (an exact measurement of an exact state): K = 0, as LDLT's pseudo-inverse gave.
+    out.K = std::abs(s) > std::numeric_limits<double>::min() ? Eigen::MatrixXd(U / s) : Eigen::MatrixXd::Zero(n, 1);
     out.dx = out.K * st.residual;
     const double* k = out.K.data();
     const double* u = U.data();
