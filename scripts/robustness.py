@@ -43,7 +43,7 @@ BAD_ANCHOR_M = 0.5      # final error of a calibrated anchor that counts as a ba
 ANCHOR_NEES_BOUND = 13.93  # chi^2(3) at 99.7 %: a final anchor NEES above it is overconfident
 SCENARIO_KEYS = {"name", "seed", "trajectory", "hall", "anchor_layout", "tags", "known", "unknown",
                  "sigma_range", "outliers", "drop", "imu_grade", "duration", "bias_max", "nlos", "range_correlation",
-                 "range_time_offset", "imu_scale_sigma", "imu_misalignment"}
+                 "range_time_offset", "imu_scale_sigma", "imu_misalignment", "vibration"}
 
 
 # Largest sigma of the IMU axes' scale error [-] and misalignment [deg] the widened sweep draws per
@@ -131,7 +131,8 @@ def sim_args(sc):
              ("known", "known"), ("unknown", "unknown"), ("sigma_range", "sigma-range"), ("outliers", "outliers"),
              ("drop", "drop"), ("imu_grade", "imu-grade"), ("duration", "duration"), ("bias_max", "bias-max"),
              ("nlos", "nlos"), ("range_correlation", "range-correlation"), ("range_time_offset", "range-time-offset"),
-             ("imu_scale_sigma", "imu-scale-sigma"), ("imu_misalignment", "imu-misalignment")]
+             ("imu_scale_sigma", "imu-scale-sigma"), ("imu_misalignment", "imu-misalignment"),
+             ("vibration", "vibration")]
     args = []
     for key, flag in flags:
         if key in sc and sc[key] is not None:

@@ -236,7 +236,11 @@ std::optional<AlignmentResult> Initialization::align(const Eigen::Vector3d& bias
 }
 
 bool Initialization::landedAt(Timestamp t, bool current) const {
-  if (have_flight_state_ || !options_.zupt.detect_stillness) return current;
+  if (have_flight_state_) return current;
+  // Neither a flight state nor the IMU's stillness: no evidence of rest, so not landed (else the
+  // node's flag, which starts landed, would stay so the whole flight and ZUPT it), unless the user
+  // says a vehicle without a flight state rests (init.assume_landed_without_flight_state).
+  if (!options_.zupt.detect_stillness) return options_.init.assume_landed_without_flight_state;
   auto it = still_at_.find(t.us);
   return it != still_at_.end() && it->second;
 }

@@ -71,7 +71,8 @@ class Initialization {
   /// An alignment as an initial belief: the pose, the height bias it estimated, the baro's
   /// reference and bias. `landed`: the rest state at r.t.
   InitialBelief beliefFrom(const AlignmentResult& r, bool landed) const;
-  /// Rest at IMU time `t` by stillness (`current` when a flight state decides or stillness is off).
+  /// Rest at IMU time `t`: `current` once a flight state decides; else the stillness detector's
+  /// verdict; with stillness detection off, init.assume_landed_without_flight_state.
   bool landedAt(Timestamp t, bool current) const;
   /// Drops stillness verdicts before `oldest_us` [µs].
   void pruneStillness(int64_t oldest_us);

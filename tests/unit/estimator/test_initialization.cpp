@@ -76,13 +76,25 @@ TEST(Initialization, StillnessDecidesRestUntilAFlightStateComes) {
   EXPECT_FALSE(s.init->landedAt(at(0.95), true));
 }
 
-TEST(Initialization, WithoutStillnessDetectionCurrentDecides) {
+TEST(Initialization, WithoutStillnessDetectionNorFlightStateNothingSaysLanded) {
+  // Resting IMU data, but stillness detection off and no flight state: no evidence of rest, whatever
+  // the node's current flag (which starts landed and nothing else would ever clear: a whole flight
+  // of ZUPTs, found on a hover of the widened sweep).
   EstimatorOptions o;
   o.zupt.detect_stillness = false;
   Init s(o);
   for (int k = 0; k <= 200; ++k) s.feed(restingImu(0.005 * k));
   EXPECT_FALSE(s.init->landedAt(at(0.9), false));
-  EXPECT_TRUE(s.init->landedAt(at(0.9), true));
+  EXPECT_FALSE(s.init->landedAt(at(0.9), true));
+  // Unless the user says such a vehicle rests.
+  o.init.assume_landed_without_flight_state = true;
+  Init assumed(o);
+  for (int k = 0; k <= 200; ++k) assumed.feed(restingImu(0.005 * k));
+  EXPECT_TRUE(assumed.init->landedAt(at(0.9), false));
+  // With detection on, the detector decides (rest here), not the flag.
+  Init detecting;
+  for (int k = 0; k <= 200; ++k) detecting.feed(restingImu(0.005 * k));
+  EXPECT_TRUE(detecting.init->landedAt(at(0.9), false));
 }
 
 TEST(Initialization, WaitingForSaysWhatIsMissingBeforeData) {
