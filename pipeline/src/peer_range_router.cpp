@@ -20,12 +20,12 @@ void PeerRangeRoutingOptions::validate() const {
 std::string PeerRangeRoutingOptions::toString() const {
   std::ostringstream s;
   s << "peer ranges: received while fewer than " << min_anchors << " anchors in " << anchor_window_s
-    << " s, sent while no peer range received for " << memory_s << " s";
+    << " s, sent to a vehicle whose information the sender did not absorb within " << memory_s << " s";
   return s.str();
 }
 
 PeerRangeRouter::PeerRangeRouter(const PeerRangeRoutingOptions& options, size_t n_vehicles)
-    : options_(options), anchor_seen_(n_vehicles), last_received_(n_vehicles) {
+    : options_(options), anchor_seen_(n_vehicles), holds_(n_vehicles) {
   options_.validate();
   if (n_vehicles == 0) throw std::invalid_argument("PeerRangeRouter: no vehicle");
 }
@@ -35,9 +35,18 @@ void PeerRangeRouter::noteAnchorRange(size_t v, SensorId anchor, Timestamp t) {
   if (last < t) last = t;
 }
 
-void PeerRangeRouter::noteReceived(size_t v, Timestamp t) {
-  auto& last = last_received_.at(v);
-  if (!last || *last < t) last = t;
+void PeerRangeRouter::noteReceived(size_t v, size_t sender, Timestamp t) {
+  auto& h = holds_.at(v);
+  auto enter = [&](size_t u) {
+    if (u == v) return;
+    auto [it, inserted] = h.emplace(u, t);
+    if (!inserted && it->second < t) it->second = t;
+  };
+  enter(sender);
+  // What the sender holds now enters v with it (a bound: it counts from t, not from when it
+  // entered the sender).
+  for (const auto& [u, since] : holds_.at(sender))
+    if ((t - since).sec() <= options_.memory_s) enter(u);
 }
 
 int PeerRangeRouter::anchorsSeen(size_t v, Timestamp t) const {
@@ -47,16 +56,17 @@ int PeerRangeRouter::anchorsSeen(size_t v, Timestamp t) const {
   return n;
 }
 
-bool PeerRangeRouter::clean(size_t v, Timestamp t) const {
-  const auto& last = last_received_.at(v);
-  return !last || (t - *last).sec() > options_.memory_s;
+bool PeerRangeRouter::holds(size_t y, size_t x, Timestamp t) const {
+  const auto& h = holds_.at(y);
+  const auto it = h.find(x);
+  return it != h.end() && (t - it->second).sec() <= options_.memory_s;
 }
 
 PeerRangeRouter::Decision PeerRangeRouter::decide(size_t a, const PeerSide& side_a, size_t b, const PeerSide& side_b,
                                                   Timestamp t) const {
   // x can receive from y: x needs it, y's estimate exists and holds nothing of x's.
   auto can = [&](size_t x, const PeerSide& sx, size_t y, const PeerSide& sy) {
-    return sx.has_estimate && sy.has_estimate && shortOfAnchors(x, t) && clean(y, t);
+    return sx.has_estimate && sy.has_estimate && shortOfAnchors(x, t) && !holds(y, x, t);
   };
   const bool to_a = can(a, side_a, b, side_b), to_b = can(b, side_b, a, side_a);
   Decision d;

@@ -160,7 +160,7 @@ void Pipeline::routeInterVehicleRange(size_t vehicle, const RangeSample& r) {
   pr.p_peer_tag_in_G = ps.p_IinG + dt * ps.v_IinG + R * l;
   pr.cov_peer_tag_m2 = ps.cov_p_m2 + dt * dt * ps.cov_v + J * ps.cov_theta_rad2 * J.transpose();
   diag_.count("inter_vehicle_range_to:" + vehicles_[receiver].name);
-  router_->noteReceived(receiver, r.t);
+  router_->noteReceived(receiver, sender, r.t);
   estimators_[receiver]->onInput(pr);
 }
 

@@ -47,15 +47,29 @@ TEST(PeerRangeRouter, InformationFlowsFromAVehicleWithAnchorsToOneWithoutAndNeve
   ASSERT_TRUE(d.receiver);
   EXPECT_EQ(*d.receiver, 1u);
   EXPECT_EQ(*r.decide(1, side(0.1), 0, side(5.0), at(20.5)).receiver, 1u);  // the order of the ends does not matter
-  r.noteReceived(1, at(20.5));
-  // v1 is not clean for 10 s: v2, also without anchors, cannot receive from it (a cycle if v2
-  // ever sends to v1), but v1 may still receive from v2 (clean).
+  r.noteReceived(1, 0, at(20.5));
+  EXPECT_TRUE(r.holds(1, 0, at(20.5)));
+  EXPECT_FALSE(r.holds(0, 1, at(20.5)));
+  // v1 holds v0's information, nothing of v2's: v2 (also without anchors) may receive from v1, and
+  // v1 from v2; the larger covariance receives.
   d = r.decide(1, side(1.0), 2, side(2.0), at(25.0));
   ASSERT_TRUE(d.receiver);
-  EXPECT_EQ(*d.receiver, 1u);
-  r.noteReceived(1, at(25.0));
-  r.noteReceived(2, at(25.0));
-  d = r.decide(1, side(1.0), 2, side(2.0), at(26.0));
+  EXPECT_EQ(*d.receiver, 2u);
+  r.noteReceived(2, 1, at(25.0));
+  // v2 now holds v1's and, through v1, v0's: it may not send to either, v1 not to v2.
+  EXPECT_TRUE(r.holds(2, 1, at(25.0)));
+  EXPECT_TRUE(r.holds(2, 0, at(25.0)));
+  d = r.decide(1, side(3.0), 2, side(2.0), at(26.0));
+  ASSERT_TRUE(d.receiver) << "v1 holds nothing of v2's: v2 may receive from it again";
+  EXPECT_EQ(*d.receiver, 2u);
+  // v0, short of anchors now too, may not receive from v2 (v2 holds v0's information through v1);
+  // v2 may receive from v0 (v0 holds nothing of v2's).
+  d = r.decide(0, side(9.0), 2, side(1.0), at(26.0));
+  ASSERT_TRUE(d.receiver);
+  EXPECT_EQ(*d.receiver, 2u);
+  // Both holding each other's: a cycle either way.
+  r.noteReceived(1, 2, at(26.0));
+  d = r.decide(1, side(1.0), 2, side(2.0), at(27.0));
   EXPECT_FALSE(d.receiver);
   EXPECT_EQ(d.why, "cycle");
   // Both with anchors: not needed.
@@ -68,9 +82,25 @@ TEST(PeerRangeRouter, InformationFlowsFromAVehicleWithAnchorsToOneWithoutAndNeve
   d = r.decide(0, side(1.0), 2, PeerSide{}, at(30.5));
   EXPECT_FALSE(d.receiver);
   EXPECT_EQ(d.why, "no_estimate");
-  // 10 s after its last peer range v1 is clean again (35.0 + ... > 25.0 + 10).
-  EXPECT_FALSE(r.clean(1, at(35.0)));
-  EXPECT_TRUE(r.clean(1, at(35.1)));
+  // What a vehicle absorbed counts for memory_s (10 s): v2 received from v1 at 25 s and holds v1's
+  // until 35 s; v1 received from v2 at 26 s and holds v2's until 36 s.
+  EXPECT_TRUE(r.holds(2, 1, at(35.0)));
+  EXPECT_FALSE(r.holds(2, 1, at(35.1)));
+  EXPECT_TRUE(r.holds(1, 2, at(36.0)));
+  EXPECT_FALSE(r.holds(1, 2, at(36.1)));
+}
+
+TEST(PeerRangeRouter, AVehicleThatReceivedStillSendsToOneWhoseInformationItDoesNotHold) {
+  // Seed 9's outage (docs/fleet.md): v3, short of anchors now and then, received from v0; v4 lost
+  // its anchors. v3 holds nothing of v4's, so v4 receives v3's ranges (the rule before refused them
+  // for 10 s after v3's last peer range, and v4 drifted 1.16 m).
+  PeerRangeRouter r(PeerRangeRoutingOptions{}, 5);
+  seeAnchors(r, 0, 5, 60.0);
+  r.noteReceived(3, 0, at(60.2));
+  seeAnchors(r, 3, 5, 60.5);
+  const auto d = r.decide(3, side(0.02), 4, side(0.3), at(61.0));
+  ASSERT_TRUE(d.receiver);
+  EXPECT_EQ(*d.receiver, 4u);
 }
 
 TEST(PeerRangeRouter, BothShortAndCleanTheLargerCovarianceReceives) {
