@@ -103,7 +103,7 @@ TEST(PeerRangeRouter, AVehicleThatReceivedStillSendsToOneWhoseInformationItDoesN
   EXPECT_EQ(*d.receiver, 4u);
 }
 
-TEST(PeerRangeRouter, BothShortAndCleanTheLargerCovarianceReceives) {
+TEST(PeerRangeRouter, BothShortAndHoldingNothingOfEachOtherTheLargerCovarianceReceives) {
   PeerRangeRouter r(PeerRangeRoutingOptions{}, 2);
   EXPECT_EQ(*r.decide(0, side(1.0), 1, side(2.0), at(1.0)).receiver, 1u);
   EXPECT_EQ(*r.decide(0, side(3.0), 1, side(2.0), at(1.0)).receiver, 0u);
