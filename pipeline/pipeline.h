@@ -44,6 +44,8 @@
 
 namespace meshnav::pipeline {
 
+class FleetCalibratorFeed;
+
 struct PipelineOptions {
   estimator::EstimatorOptions estimator;
   calib::CalibratorOptions calibrator;
@@ -139,24 +141,19 @@ class Pipeline {
     Message msg;
   };
   void drain();
-  /// False for an anchor–anchor range another vehicle's dataset already gave the calibrator (within
-  /// 10 s; counted "mesh_range_from_another_vehicle").
-  bool firstInFleet(const RangeSample& r);
-  /// ANCHORS of vehicle v towards the calibrator: per anchor the CI of the vehicles' latest.
-  void forwardAnchors(size_t v, const std::vector<AnchorEstimate>& anchors);
 
   PipelineOptions options_;
   PipelineSinks sinks_;
   std::vector<Vehicle> vehicles_;
   SystemSetup fleet_setup_;  ///< what the calibrator knows
   std::vector<std::unique_ptr<estimator::EstimatorNode>> estimators_;
-  std::vector<std::map<SensorId, AnchorEstimate>> anchor_beliefs_;  ///< per vehicle, its latest ANCHORS
   std::unique_ptr<calib::CalibratorNode> calibrator_;
   std::unique_ptr<mission::MissionNode> mission_;
   std::deque<Event> queue_;
   std::vector<AnchorInit> anchor_inits_;
   Diagnostics diag_;
-  std::set<std::tuple<int64_t, SensorId, SensorId>> mesh_ranges_;  ///< (µs, ids) given to the calibrator
+  /// What the calibrator hears from the vehicles and says to each (the mesh once, the anchor beliefs' CI).
+  std::unique_ptr<FleetCalibratorFeed> feed_;
   std::set<std::tuple<int64_t, SensorId, SensorId>> peer_ranges_;  ///< (µs, ids) of inter-vehicle ranges fused
   std::unique_ptr<PeerRangeRouter> router_;                         ///< a fleet's (null for one vehicle)
   std::set<SensorId> calibrated_anchors_;                           ///< ids of the ANCHOR_INITs so far

@@ -18,7 +18,9 @@
 #   --vehicles N  --anchors M  --hall X,Y,Z  --duration S (seconds of flight, meshnav_sim's)
 #   --config FILE          estimator options (default config/fleet_scale.yaml)
 #   --calibrator-for NAME  a calibrator and the fleet's mission.yaml serving vehicle NAME alone over
-#                          LCM, so that it gets its fly-by anchors (none serves the whole fleet yet)
+#                          LCM, so that it gets its fly-by anchors
+#   --fleet-calibrator     one calibrator serving every vehicle (calibrator --fleet) and the fleet's
+#                          mission.yaml on the first vehicle: every vehicle gets the fly-by anchors
 #   --bus POLICY           per-vehicle (default: each vehicle's processes on their own LCM bus, the
 #                          base port + 1 + its index) or shared (every process on one bus), as
 #                          meshnav_fleet_launch --bus and meshnav_lcm_probe --bus
@@ -31,7 +33,7 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="${MESHNAV_BUILD_DIR:-$ROOT/build}/bin"
 seed=1; scale=""; rate=1; out="$ROOT/out/bench-lcm"
 fleet=0; vehicles=5; anchors=100; hall=40,40,10; duration=""; config="$ROOT/config/fleet_scale.yaml"; calib_for=""
-bus=per-vehicle
+calib_fleet=0; bus=per-vehicle
 args=("$@")
 while [[ $# -gt 0 ]]; do
   case "$1" in
@@ -46,16 +48,18 @@ while [[ $# -gt 0 ]]; do
     --duration) duration="$2"; shift 2 ;;
     --config) config="$2"; shift 2 ;;
     --calibrator-for) calib_for="$2"; shift 2 ;;
+    --fleet-calibrator) calib_fleet=1; shift ;;
     --bus) bus="$2"; shift 2 ;;
     -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     *) echo "bench_lcm: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
 done
 if (( ! fleet )); then
-  for o in --vehicles --anchors --hall --duration --config --calibrator-for --bus; do
+  for o in --vehicles --anchors --hall --duration --config --calibrator-for --fleet-calibrator --bus; do
     [[ " ${args[*]} " == *" $o "* ]] && { echo "bench_lcm: $o needs --fleet" >&2; exit 2; }
   done
 fi
+[[ -n "$calib_for" && "$calib_fleet" == 1 ]] && { echo "bench_lcm: --calibrator-for and --fleet-calibrator exclude each other" >&2; exit 2; }
 [[ "$vehicles" =~ ^[1-9][0-9]*$ ]] || { echo "bench_lcm: --vehicles expects a positive number, got '$vehicles'" >&2; exit 2; }
 [[ "$bus" == per-vehicle || "$bus" == shared ]] || { echo "bench_lcm: --bus expects per-vehicle or shared, got '$bus'" >&2; exit 2; }
 [[ -f "$config" ]] || { echo "bench_lcm: --config $config: no such file" >&2; exit 2; }
@@ -106,6 +110,8 @@ run_fleet() {
   local calib_args=()
   [[ -n "$calib_for" ]] && calib_args=(--calibrator-for "$calib_for" --mission "$data/mission.yaml"
                                        --calibrator-config "$ROOT/config/calibrator.yaml")
+  (( calib_fleet )) && calib_args=(--fleet-calibrator --mission "$data/mission.yaml"
+                                   --calibrator-config "$ROOT/config/calibrator.yaml")
   # 10 s after the data: an estimator behind (a loaded machine, --rate 10) answers all it was sent.
   "$BIN/meshnav_fleet_launch" --fleet "$data/fleet.yaml" --out "$launch" --no-logging --estimator-config "$config" \
     --shutdown-delay 10 --bus "$bus" "${calib_args[@]}" \
@@ -170,7 +176,8 @@ run_fleet() {
     done
     echo "load_average: {start: \"$load_start\", end: \"$(cut -d' ' -f1-3 /proc/loadavg)\", 1min_samples: [$(paste -sd, "$out/load.txt")]}"
   } > "$out/fleet_extra.yaml"
-  python3 - "$out" "$seed" "$vehicles" "$anchors" "$hall" "${duration:-default}" "$rate" "$config" "$calib_for" "$bus" <<'PY'
+  local served="$calib_for"; (( calib_fleet )) && served="the fleet"
+  python3 - "$out" "$seed" "$vehicles" "$anchors" "$hall" "${duration:-default}" "$rate" "$config" "$served" "$bus" <<'PY'
 import datetime, os, sys, yaml
 out, seed, nv, na, hall, duration, rate, config, calib_for, bus = sys.argv[1:]
 probe = yaml.safe_load(open(os.path.join(out, "probe.yaml")))

@@ -6,7 +6,8 @@
 /// `--channel-prefix NAME` (the vehicle's name: `v0/IMU`, `v0/POSE`; transport/channels.h), and
 /// optionally a logger per vehicle. Generated, not written by hand, so that a fleet file of any
 /// size becomes one launch of the existing supervisor (`./meshnav up --fleet FILE`,
-/// `meshnav_fleet_launch`). No calibrator and no mission (docs/fleet.md, "Not done yet").
+/// `meshnav_fleet_launch`). Optionally a calibrator (and a mission) for one vehicle or for the
+/// whole fleet.
 ///
 /// Buses (transport/fleet_bus.h): by default each vehicle's processes get `--lcm-url` of the
 /// vehicle's own bus (the base URL's port + 1 + its index in the fleet file), so that a vehicle's
@@ -44,9 +45,15 @@ struct FleetLaunchOptions {
   /// Non-empty: a calibrator and (with `mission`) a mission serving this one vehicle over LCM
   /// (`--channel-prefix` it: its RANGE, POSE, ANCHORS in, its ANCHOR_INIT out; the unprefixed
   /// CALIB_CMD, CALIB_STATUS and MISSION_STATUS go on that vehicle's bus), so that it gets its
-  /// fly-by anchors; a calibrator serving the whole fleet over LCM does not exist (docs/fleet.md).
+  /// fly-by anchors only (for the whole fleet: `fleet_calibrator`).
   std::string calibrator_for;
-  std::string mission;                                  ///< mission file of that vehicle's mission ("" none)
+  /// One calibrator serving every vehicle (`calibrator --fleet source --bus ...`, process
+  /// `fleet_calibrator`): each vehicle's RANGE, POSE, ANCHORS in and its own ANCHOR_INIT out on its
+  /// bus; CALIB_CMD and CALIB_STATUS on the first vehicle's bus, where the fleet's mission
+  /// (`fleet_mission`, with `mission`) runs on that vehicle's prefix. Excludes calibrator_for;
+  /// needs `source`.
+  bool fleet_calibrator = false;
+  std::string mission;  ///< mission file of calibrator_for's or the fleet calibrator's mission ("" none)
   std::string calibrator_config = "config/calibrator.yaml";  ///< the calibrator's options
   /// A bus per vehicle (each process of vehicle k: `--lcm-url` vehicleLcmUrl(bus, lcm_url, k)) or
   /// one shared bus (`--lcm-url` only when lcm_url is given).
@@ -58,7 +65,8 @@ struct FleetLaunchOptions {
 
 /// The launch file (YAML text) of `vehicles`. Throws std::invalid_argument for a vehicle name that
 /// is no channel prefix (channels::prefixProblem; loadFleetFile already refuses those) and for a
-/// `calibrator_for` that names no vehicle, and (vehicleLcmUrl) for kPerVehicle with a base URL that
+/// `calibrator_for` that names no vehicle or comes with `fleet_calibrator`, for `fleet_calibrator`
+/// without `source`, and (vehicleLcmUrl) for kPerVehicle with a base URL that
 /// is not udpm or whose ports run past 65535.
 std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const FleetLaunchOptions& options);
 

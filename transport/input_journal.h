@@ -36,10 +36,16 @@ class InputJournal {
   /// Appends `value` (of the channel's type) as its LCM message on `channel`, stamped `utime`.
   template <class T>
   void write(channels::Channel<T> channel, const std::type_identity_t<T>& value, int64_t utime) {
+    writeAs<T>("", channel, value, utime);
+  }
+  /// The same on vehicle `prefix`'s channel (channels::prefixed(channel, prefix); "" none).
+  template <class T>
+  void writeAs(const std::string& prefix, channels::Channel<T> channel, const std::type_identity_t<T>& value,
+               int64_t utime) {
     const auto msg = toWire(value);
     std::vector<uint8_t> buf(static_cast<size_t>(msg.getEncodedSize()));
     msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
-    writeRaw(channel.name, buf, utime);
+    writeRaw(channels::prefixed(channel, prefix), buf, utime);
   }
   void writeRaw(const std::string& channel, const std::vector<uint8_t>& bytes, int64_t utime);
   const std::string& path() const { return path_; }

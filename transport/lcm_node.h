@@ -120,8 +120,16 @@ class LcmNode {
   /// subscription with another type does not compile.
   template <class T>
   void subscribe(channels::Channel<T> channel, std::type_identity_t<std::function<void(const T&)>> fn) {
-    watch<T>(channel);
-    subscribeRaw(wireName(channel), [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
+    subscribeAs<T>(prefix_, channel, std::move(fn));
+  }
+  /// As subscribe, on vehicle `prefix`'s channel (channels::prefixed(channel, prefix)) whatever this
+  /// node's own prefix: one node that serves several vehicles on one bus (the fleet's calibrator).
+  template <class T>
+  void subscribeAs(const std::string& prefix, channels::Channel<T> channel,
+                   std::type_identity_t<std::function<void(const T&)>> fn) {
+    const std::string wire = channels::prefixed(channel, prefix);
+    watch<T>(channel, wire);
+    subscribeRaw(wire, [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
       WireType<T> msg;
       if (!decode(rbuf, ch, msg)) return;
       guarded(ch, [&] { fn(fromWire<T>(msg)); });
@@ -133,7 +141,7 @@ class LcmNode {
   template <class T>
   void subscribeStamped(channels::Channel<T> channel,
                         std::type_identity_t<std::function<void(const T&, int64_t recv_utime)>> fn) {
-    watch<T>(channel);
+    watch<T>(channel, wireName(channel));
     subscribeRaw(wireName(channel), [this, fn](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
       WireType<T> msg;
       if (!decode(rbuf, ch, msg)) return;
@@ -145,9 +153,14 @@ class LcmNode {
   /// struct. False when it is not sent (too large: "<CHANNEL>:oversized_publish"; LCM error).
   template <class T>
   bool publish(channels::Channel<T> channel, const std::type_identity_t<T>& value) {
+    return publishAs<T>(prefix_, channel, value);
+  }
+  /// As publish, on vehicle `prefix`'s channel whatever this node's own prefix.
+  template <class T>
+  bool publishAs(const std::string& prefix, channels::Channel<T> channel, const std::type_identity_t<T>& value) {
     if (!second_instance_.empty()) return false;  // it yields the channel: nothing more from it
-    const std::string wire = wireName(channel);
-    if (serving_ && !watch_.published(wire)) watchOwn<T>(channel);
+    const std::string wire = channels::prefixed(channel, prefix);
+    if (serving_ && !watch_.published(wire)) watchOwn<T>(channel, wire);
     auto msg = toWire(value);
     msg.sender_id = instance_id_;
     return publishWire(wire, msg);
@@ -159,6 +172,11 @@ class LcmNode {
   /// Handles messages until StopSignal or requestStop(), or until `until()` returns true (checked
   /// after every handled message and at least every 100 ms). Returns 0, or 1 after an LCM error.
   int spin(const std::function<bool()>& until = {});
+  /// spin() over several nodes (one per LCM bus) from one thread: waits on every node's descriptor
+  /// and handles the ready ones, runs each node's due heartbeat; stops on StopSignal, when any
+  /// node's stop was requested (a second instance included) or when `until()` returns true
+  /// (checked at least every 100 ms). Returns 0, or 1 after an LCM error.
+  static int spinAll(const std::vector<LcmNode*>& nodes, const std::function<bool()>& until = {});
   /// Handles at most one batch of messages, waiting up to `timeout_ms`; runs a due heartbeat.
   /// Returns > 0 when something was handled, 0 on timeout, < 0 on an LCM error.
   int spinOnce(int timeout_ms);
@@ -227,8 +245,7 @@ class LcmNode {
   /// or implausible one is left to the typed subscription to count) and hands its sender to the
   /// PublisherWatch.
   template <class T>
-  void watch(channels::Channel<T> typed) {
-    const std::string channel = wireName(typed);
+  void watch(channels::Channel<T> typed, const std::string& channel) {
     if (!channels::hasOnePublisher(typed.name) || !watched_.insert(channel).second) return;
     subscribeRaw(channel, [this](const lcm::ReceiveBuffer& rbuf, const std::string& ch) {
       if (rbuf.data_size > kMaxMessageBytes) return;
@@ -246,10 +263,10 @@ class LcmNode {
   /// that only publishes never handles its own messages, so it does not watch them): every other
   /// sender on it is a second publisher. The first one starts the kSecondInstanceWindow_s.
   template <class T>
-  void watchOwn(channels::Channel<T> channel) {
-    watch_.markPublished(wireName(channel));
+  void watchOwn(channels::Channel<T> channel, const std::string& wire) {
+    watch_.markPublished(wire);
     if (announced_wall_us_ == 0) announced_wall_us_ = replay::wallUtimeNow();
-    watch<T>(channel);
+    watch<T>(channel, wire);
   }
   /// A second publisher's message on `channel`: on a channel of this node, from an instance that
   /// started before it, within kSecondInstanceWindow_s of its start, this node is the second

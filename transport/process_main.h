@@ -65,6 +65,12 @@ class ProcessMain {
   /// The LCM instance on --lcm-url with --channel-prefix (created on first use; throws when LCM
   /// cannot start).
   LcmNode& lcm();
+  /// --lcm-url as given ("" when not: resolveLcmUrl then takes the environment's).
+  const std::string& lcmUrlOption() const { return lcm_url_; }
+  /// Makes lcm() the instance on `url` with channel prefix `prefix` instead of --lcm-url and
+  /// --channel-prefix: a process that serves several buses (the fleet's calibrator) names its
+  /// first. Throws std::logic_error once lcm() was created.
+  void useLcm(std::string url, std::string prefix);
 
   /// `status` as published: stamped with the wall time, and with the process's own counters
   /// (added to `counters`, or appended to `text` for a status without counters).

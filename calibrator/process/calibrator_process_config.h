@@ -19,7 +19,12 @@ namespace meshnav::calib {
 
 /// Options of the `calibrator` process.
 struct CalibratorProcessConfig {
-  std::string setup_path;           ///< --setup (required to run)
+  std::string setup_path;           ///< --setup (required to run, unless --fleet)
+  /// --fleet: serve every vehicle of this fleet file (pipeline/fleet.h) over LCM, each on its own
+  /// prefix and bus (docs/fleet.md, "The fleet's calibrator over LCM"); excludes --setup and
+  /// --channel-prefix
+  std::string fleet_path;
+  std::string bus = "per-vehicle";  ///< --bus with --fleet: per-vehicle | shared (transport/fleet_bus.h)
   std::string config_path;          ///< --config ("" = built-in defaults)
   std::string out_yaml;             ///< --out-yaml ("" = none)
   std::string state_dir;            ///< --state-dir: input journal of a restart ("" = none)

@@ -4,6 +4,7 @@
 
 #include "common/skew.h"
 #include "pipeline/anchor_belief_intersection.h"
+#include "pipeline/fleet_calibrator_feed.h"
 #include "pipeline/fleet.h"
 
 namespace meshnav::pipeline {
@@ -15,14 +16,8 @@ Pipeline::Pipeline(const PipelineOptions& options, std::vector<Vehicle> vehicles
                    PipelineSinks sinks)
     : options_(options), sinks_(std::move(sinks)), vehicles_(std::move(vehicles)), fleet_setup_(fleet_setup) {
   if (vehicles_.empty()) throw std::invalid_argument("pipeline: no vehicle");
-  std::map<SensorId, size_t> vehicle_of_tag;
+  feed_ = std::make_unique<FleetCalibratorFeed>(vehicles_, fleet_setup, diag_);
   for (size_t v = 0; v < vehicles_.size(); ++v) {
-    for (const auto& [tag, lever] : vehicles_[v].setup.rel_tag_positions) {
-      if (!fleet_setup.isTag(tag))
-        throw std::invalid_argument("pipeline: tag " + std::to_string(tag) + " of vehicle " + vehicles_[v].name +
-                                    " is not in the fleet's setup");
-      vehicle_of_tag[tag] = v;
-    }
     estimator::EstimatorSinks es;
     es.pose = [this, v](const PoseEstimate& p) { queue_.push_back({v, p}); };
     if (sinks_.pose_smoothed || (options_.calibration_enabled && options_.calibrator_on_smoothed))
@@ -31,7 +26,6 @@ Pipeline::Pipeline(const PipelineOptions& options, std::vector<Vehicle> vehicles
     es.status = [this, v](const EstimatorStatus& s) { queue_.push_back({v, s}); };
     estimators_.push_back(std::make_unique<estimator::EstimatorNode>(options_.estimator, vehicles_[v].setup, es));
   }
-  anchor_beliefs_.resize(vehicles_.size());
   if (vehicles_.size() > 1) router_ = std::make_unique<PeerRangeRouter>(options_.peer_routing, vehicles_.size());
   last_pose_to_calibrator_.resize(vehicles_.size());
   awaiting_smoothed_.resize(vehicles_.size());
@@ -42,7 +36,7 @@ Pipeline::Pipeline(const PipelineOptions& options, std::vector<Vehicle> vehicles
     cs.anchor_init = [this](const AnchorInit& a) { queue_.push_back({0, a}); };
     cs.status = [this](const CalibStatus& s) { queue_.push_back({0, s}); };
     calibrator_ = std::make_unique<calib::CalibratorNode>(options_.calibrator, fleet_setup, cs, node_opts,
-                                                          std::move(vehicle_of_tag));
+                                                          feed_->vehicleOfTag());
   }
   if (options_.mission) {
     mission::MissionSinks ms;
@@ -83,7 +77,7 @@ void Pipeline::onInput(size_t vehicle, const estimator::EstimatorInput& in) {
     }
   node.onInput(in);
   if (calibrator_) {
-    if (const auto* r = std::get_if<RangeSample>(&in); r && firstInFleet(*r)) calibrator_->onRange(*r);
+    if (const auto* r = std::get_if<RangeSample>(&in); r && feed_->forCalibrator(*r)) calibrator_->onRange(*r);
     calibrator_->tick(t);
   }
   if (mission_) mission_->onTime(t);
@@ -164,37 +158,6 @@ void Pipeline::routeInterVehicleRange(size_t vehicle, const RangeSample& r) {
   estimators_[receiver]->onInput(pr);
 }
 
-bool Pipeline::firstInFleet(const RangeSample& r) {
-  if (vehicles_.size() == 1 || fleet_setup_.isTag(r.id_initiator) || fleet_setup_.isTag(r.id_responder)) return true;
-  // The anchors' mesh is heard by every vehicle: the same sample in several datasets is one range.
-  constexpr int64_t kKeepUs = 10'000'000;
-  while (!mesh_ranges_.empty() && std::get<0>(*mesh_ranges_.begin()) < r.t.us - kKeepUs)
-    mesh_ranges_.erase(mesh_ranges_.begin());
-  const auto key = pairKey(r.id_initiator, r.id_responder);
-  if (mesh_ranges_.emplace(r.t.us, key.first, key.second).second) return true;
-  diag_.count("mesh_range_from_another_vehicle");
-  return false;
-}
-
-void Pipeline::forwardAnchors(size_t v, const std::vector<AnchorEstimate>& anchors) {
-  if (vehicles_.size() == 1) {
-    calibrator_->onAnchors(anchors);
-    return;
-  }
-  auto& mine = anchor_beliefs_[v];
-  mine.clear();
-  for (const auto& a : anchors) mine[a.id] = a;
-  // Per anchor, the covariance intersection of the vehicles' latest beliefs (they share the one
-  // ANCHOR_INIT and are correlated by an unknown amount: AnchorBeliefIntersection).
-  std::vector<std::vector<AnchorEstimate>> per_vehicle;
-  for (const auto& beliefs : anchor_beliefs_) {
-    per_vehicle.emplace_back();
-    for (const auto& [id, a] : beliefs) per_vehicle.back().push_back(a);
-  }
-  const std::vector<AnchorEstimate> merged = AnchorBeliefIntersection::fuseVehicles(per_vehicle);
-  calibrator_->onAnchors(merged);
-}
-
 void Pipeline::finish() {
   for (auto& e : estimators_) {
     e->flushHeld();
@@ -231,7 +194,7 @@ void Pipeline::drain() {
             }
             if (sinks_.pose_smoothed) sinks_.pose_smoothed(v, m.pose);
           } else if constexpr (std::is_same_v<T, std::vector<AnchorEstimate>>) {
-            if (calibrator_) forwardAnchors(v, m);
+            if (calibrator_) calibrator_->onAnchors(feed_->anchorsFrom(v, m));
             if (sinks_.anchors) sinks_.anchors(v, m);
           } else if constexpr (std::is_same_v<T, EstimatorStatus>) {
             if (mission_ && v == 0) mission_->onEstimatorStatus(m);
@@ -240,7 +203,7 @@ void Pipeline::drain() {
             anchor_inits_.push_back(m);
             calibrated_anchors_.insert(m.id);
             for (size_t i = 0; i < estimators_.size(); ++i)
-              estimators_[i]->onAnchorInit(vehicles_.size() == 1 ? m : restrictToVehicle(m, vehicles_[i].setup, fleet_setup_));
+              estimators_[i]->onAnchorInit(feed_->forVehicle(i, m));
             if (sinks_.anchor_init) sinks_.anchor_init(m);
           } else if constexpr (std::is_same_v<T, CalibStatus>) {
             if (mission_) mission_->onCalibStatus(m);

@@ -123,6 +123,25 @@ TEST(CalibratorProcessConfig, BadValuesNameTheOption) {
   }
 }
 
+// --fleet serves every vehicle of a fleet file: it takes the setups from the fleet's datasets, so
+// --setup beside it is a contradiction, and --bus names one of the two policies.
+TEST(CalibratorProcessConfig, AFleetInsteadOfOneSetup) {
+  auto p = parseCalibrator({"--fleet", "f.yaml"});
+  ASSERT_TRUE(p->ok);
+  EXPECT_EQ(p->config.fleet_path, "f.yaml");
+  EXPECT_EQ(p->config.bus, "per-vehicle");
+  EXPECT_NE(loaded(*p).toString().find("fleet: f.yaml"), std::string::npos);
+  auto both = parseCalibrator({"--fleet", "f.yaml", "--setup", "s.yaml"});
+  EXPECT_FALSE(both->ok);
+  EXPECT_EQ(both->code, 2);
+  auto bad_bus = parseCalibrator({"--fleet", "f.yaml", "--bus", "mixed"});
+  EXPECT_FALSE(bad_bus->ok);
+  EXPECT_EQ(bad_bus->code, 2);
+  auto shared = parseCalibrator({"--fleet", "f.yaml", "--bus", "shared"});
+  ASSERT_TRUE(shared->ok);
+  EXPECT_EQ(shared->config.bus, "shared");
+}
+
 TEST(CalibratorProcessConfig, UnknownOptionIsRejected) {
   auto p = parseCalibrator({"--autom"});
   EXPECT_FALSE(p->ok);

@@ -37,14 +37,21 @@ int main(int argc, char** argv) {
              "it still has queued meanwhile)")
       ->type_name("S")
       ->check(cli::nonNegative());
-  cli.optional("calibrator-for", o.calibrator_for,
-               "a calibrator serving this vehicle alone over LCM (its fly-by anchors; a calibrator serving the fleet "
-               "does not exist yet)")
-      ->type_name("NAME");
-  cli.optional("mission", o.mission, "with --calibrator-for: that vehicle's mission file (e.g. the fleet's mission.yaml)")
-      ->type_name("FILE")
-      ->needs("--calibrator-for");
-  cli.option("calibrator-config", o.calibrator_config, "with --calibrator-for: the calibrator's options; made absolute when it exists")
+  CLI::Option* for_one = cli.optional("calibrator-for", o.calibrator_for,
+                                      "a calibrator serving this vehicle alone over LCM (its fly-by anchors only)")
+                             ->type_name("NAME");
+  CLI::Option* for_all =
+      cli.flag("fleet-calibrator", o.fleet_calibrator,
+               "one calibrator serving every vehicle over LCM (calibrator --fleet): each vehicle's fly-by anchors from "
+               "every vehicle's ranges, each vehicle's ANCHOR_INIT on its own bus; CALIB_CMD, CALIB_STATUS and the "
+               "mission on the first vehicle's bus");
+  for_all->excludes(for_one);
+  cli.optional("mission", o.mission,
+               "with --calibrator-for or --fleet-calibrator: the mission file (e.g. the fleet's mission.yaml; the "
+               "fleet's mission hears the first vehicle)")
+      ->type_name("FILE");
+  cli.option("calibrator-config", o.calibrator_config,
+             "with --calibrator-for or --fleet-calibrator: the calibrator's options; made absolute when it exists")
       ->type_name("FILE");
   cli.option("bus", bus,
              "per-vehicle: vehicle k (its index in --fleet, from 0) on the --lcm-url's port + 1 + k, so that its "
@@ -58,6 +65,10 @@ int main(int argc, char** argv) {
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   setupLogging("meshnav_fleet_launch");
+  if (!o.mission.empty() && o.calibrator_for.empty() && !o.fleet_calibrator) {
+    spdlog::error("--mission needs --calibrator-for or --fleet-calibrator (a mission drives a calibrator)");
+    return 2;
+  }
   try {
     std::vector<FleetEntry> vehicles = loadFleetFile(fleet);
     for (FleetEntry& v : vehicles) v.dataset = fs::absolute(v.dataset).lexically_normal().string();
@@ -73,7 +84,9 @@ int main(int argc, char** argv) {
     f.close();
     if (!f) throw std::runtime_error("cannot write " + out);
     spdlog::info("{}: {} vehicles, {} bus{}", out, vehicles.size(), bus,
-                 o.calibrator_for.empty() ? std::string() : ", a calibrator for " + o.calibrator_for);
+                 o.fleet_calibrator         ? std::string(", a calibrator for the fleet")
+                 : o.calibrator_for.empty() ? std::string()
+                                            : ", a calibrator for " + o.calibrator_for);
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 1;

@@ -10,7 +10,6 @@
 /// meshnav_fleet_launch writes them): the probe then opens one LCM instance per bus and polls them
 /// all from its one thread (the receive times are LCM's, taken in each instance's receive thread).
 /// It runs until SIGINT/SIGTERM or --duration, then writes --out (YAML) and prints it.
-#include <poll.h>
 
 #include <cerrno>
 #include <chrono>
@@ -211,20 +210,9 @@ int main(int argc, char** argv) {
       return duration_s > 0.0 &&
              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= duration_s;
     };
-    if (nodes.size() == 1) {
-      if (nodes[0]->spin(until) != 0) return 1;
-    } else {
-      // Several buses from one thread: wait on every instance's descriptor, handle the ready ones.
-      std::vector<pollfd> fds;
-      for (auto& n : nodes) fds.push_back({n->lcm().getFileno(), POLLIN, 0});
-      while (!StopSignal::requested() && !until()) {
-        const int ready = ::poll(fds.data(), fds.size(), 100);
-        if (ready < 0 && errno != EINTR) throw std::runtime_error("poll on the LCM buses failed");
-        for (size_t i = 0; ready > 0 && i < fds.size(); ++i)
-          if ((fds[i].revents & POLLIN) && nodes[i]->spinOnce(0) < 0)
-            throw std::runtime_error("LCM handle failed on " + nodes[i]->url());
-      }
-    }
+    std::vector<LcmNode*> all;
+    for (auto& n : nodes) all.push_back(n.get());
+    if (LcmNode::spinAll(all, until) != 0) return 1;
   } catch (const std::exception& ex) {
     std::cerr << "meshnav_lcm_probe: " << ex.what() << "\n";
     return 1;

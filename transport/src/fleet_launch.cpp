@@ -45,6 +45,11 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
   if (!o.calibrator_for.empty() &&
       std::none_of(vehicles.begin(), vehicles.end(), [&](const FleetEntry& v) { return v.name == o.calibrator_for; }))
     throw std::invalid_argument("fleet launch: --calibrator-for '" + o.calibrator_for + "' is no vehicle of the fleet");
+  if (o.fleet_calibrator && !o.calibrator_for.empty())
+    throw std::invalid_argument("fleet launch: a fleet calibrator and --calibrator-for '" + o.calibrator_for +
+                                "' exclude each other (the fleet's serves that vehicle too)");
+  if (o.fleet_calibrator && o.source.empty())
+    throw std::invalid_argument("fleet launch: the fleet calibrator needs the fleet file's path");
   // Each vehicle's bus, checked before anything is written.
   const std::string base_url = resolveLcmUrl(o.lcm_url);
   std::vector<std::string> bus_urls;
@@ -65,6 +70,22 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
   if (o.logging) y << YAML::Key << "stop_last" << YAML::Value << YAML::Flow << loggers;
   y << YAML::Key << "processes" << YAML::Value << YAML::BeginSeq;
   const std::string wait = fmtSeconds(o.wait_timeout_s);
+  if (o.fleet_calibrator) {
+    // Not required, as a vehicle's own calibrator: navigation goes on without it. It opens every
+    // vehicle's bus itself from the base URL (calibrator --fleet --bus).
+    std::vector<std::string> args = {"--fleet", o.source, "--bus", toString(o.bus)};
+    if (o.bus == FleetBus::kPerVehicle || !o.lcm_url.empty()) args.insert(args.end(), {"--lcm-url", base_url});
+    args.insert(args.end(), {"--config", "${CALIBRATOR_CONFIG:-" + o.calibrator_config + "}"});
+    if (o.logging) args.insert(args.end(), {"--state-dir", "${OUT}/fleet_calibrator_state"});  // a respawn resumes
+    emitProcess(y, "fleet_calibrator", "calibrator", args, false, 0.0, 5);
+    if (!o.mission.empty()) {
+      // On the first vehicle's prefix and bus: its ESTIMATOR_STATUS and POSE, the fleet's CALIB_CMD.
+      std::vector<std::string> m = {"--channel-prefix", vehicles[0].name};
+      if (o.bus == FleetBus::kPerVehicle || !o.lcm_url.empty()) m.insert(m.end(), {"--lcm-url", bus_urls[0]});
+      m.insert(m.end(), {"--mission", o.mission, "--t0", "${MISSION_T0:-0}"});
+      emitProcess(y, "fleet_mission", "mission", m, false, 0.0, 3);
+    }
+  }
   for (size_t k = 0; k < vehicles.size(); ++k) {
     const FleetEntry& v = vehicles[k];
     const std::string& p = v.name;  // the vehicle's channel prefix

@@ -1,10 +1,12 @@
 #include "transport/lcm_node.h"
 
+#include <poll.h>
 #include <spdlog/spdlog.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
 #include <stdexcept>
 
 #include "transport/replay/clock.h"
@@ -151,6 +153,37 @@ int LcmNode::spin(const std::function<bool()>& until) {
     if (rc < 0) {
       spdlog::error("{}: LCM handle failed (URL {})", name_, url_);
       return 1;
+    }
+  }
+  return 0;
+}
+
+int LcmNode::spinAll(const std::vector<LcmNode*>& nodes, const std::function<bool()>& until) {
+  if (nodes.size() == 1) return nodes.front()->spin(until);
+  for (LcmNode* n : nodes) {
+    n->serving_ = true;
+    n->runHeartbeatIfDue();
+  }
+  std::vector<pollfd> fds;
+  for (LcmNode* n : nodes) fds.push_back({n->lcm().getFileno(), POLLIN, 0});
+  const auto stopped = [&] { return std::any_of(nodes.begin(), nodes.end(), [](LcmNode* n) { return n->stopRequested(); }); };
+  while (!stopped() && !(until && until())) {
+    // Wake for the next heartbeat of any node, at the latest after 100 ms (the stop check).
+    int64_t timeout_ms = 100;
+    for (LcmNode* n : nodes)
+      if (n->heartbeat_ && n->heartbeat_period_.us > 0)
+        timeout_ms = std::min<int64_t>(timeout_ms, (n->next_heartbeat_us_ - replay::wallUtimeNow()) / 1000);
+    const int ready = ::poll(fds.data(), fds.size(), static_cast<int>(std::max<int64_t>(0, timeout_ms)));
+    if (ready < 0 && errno != EINTR) {
+      spdlog::error("{}: poll on {} LCM buses failed", nodes.front()->name_, nodes.size());
+      return 1;
+    }
+    for (size_t i = 0; i < fds.size(); ++i) {
+      if (ready > 0 && (fds[i].revents & POLLIN) && nodes[i]->spinOnce(0) < 0 && !nodes[i]->stopRequested()) {
+        spdlog::error("{}: LCM handle failed (URL {})", nodes[i]->name_, nodes[i]->url_);
+        return 1;
+      }
+      nodes[i]->runHeartbeatIfDue();
     }
   }
   return 0;

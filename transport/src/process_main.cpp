@@ -63,6 +63,12 @@ int ProcessMain::run(int argc, char** argv, const std::function<int()>& body) {
   }
 }
 
+void ProcessMain::useLcm(std::string url, std::string prefix) {
+  if (lcm_) throw std::logic_error("ProcessMain::useLcm after the LCM instance was created");
+  lcm_url_ = std::move(url);
+  channel_prefix_ = std::move(prefix);
+}
+
 LcmNode& ProcessMain::lcm() {
   if (!lcm_) lcm_ = std::make_unique<LcmNode>(name_, lcm_url_, channel_prefix_);
   return *lcm_;

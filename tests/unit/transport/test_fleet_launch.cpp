@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <map>
 #include <string>
 #include <vector>
@@ -114,6 +115,56 @@ TEST(FleetLaunch, CalibratorAndMissionForOneVehicle) {
   EXPECT_EQ(after(args["v0_estimator"], "--lcm-url"), "udpm://239.255.76.67:7668?ttl=0");
   o.calibrator_for = "v7";
   EXPECT_THROW(fleetLaunchYaml({{"v0", "/d/v0"}}, o), std::invalid_argument);
+}
+
+// One calibrator for the whole fleet: it opens every vehicle's bus itself from the base URL; the
+// fleet's mission runs on the first vehicle's prefix and bus, where the calibrator's CALIB_CMD and
+// CALIB_STATUS are.
+TEST(FleetLaunch, OneCalibratorForTheFleetAndItsMissionOnTheFirstVehiclesBus) {
+  FleetLaunchOptions o;
+  o.fleet_calibrator = true;
+  o.source = "/d/fleet.yaml";
+  o.mission = "/d/mission.yaml";
+  o.calibrator_config = "/cfg/calibrator.yaml";
+  o.lcm_url = "udpm://239.255.76.67:7667?ttl=0";
+  const std::vector<FleetEntry> fleet = {{"a", "/d/a"}, {"b", "/d/b"}};
+  const YAML::Node y = YAML::Load(fleetLaunchYaml(fleet, o));
+  std::vector<std::string> names;
+  std::map<std::string, std::vector<std::string>> args;
+  for (const auto& p : y["processes"]) {
+    names.push_back(p["name"].as<std::string>());
+    args[names.back()] = strings(p["args"]);
+  }
+  ASSERT_GE(names.size(), 2u);
+  EXPECT_EQ(names[0], "fleet_calibrator");  // before the bridges start the data
+  EXPECT_EQ(names[1], "fleet_mission");
+  EXPECT_EQ(std::count_if(names.begin(), names.end(), [](const std::string& n) { return n.find("calibrator") != std::string::npos; }), 1);
+  const auto& c = args["fleet_calibrator"];
+  EXPECT_EQ(after(c, "--fleet"), "/d/fleet.yaml");
+  EXPECT_EQ(after(c, "--bus"), "per-vehicle");
+  EXPECT_EQ(after(c, "--lcm-url"), "udpm://239.255.76.67:7667?ttl=0");  // the base: it derives each bus
+  EXPECT_EQ(after(c, "--config"), "${CALIBRATOR_CONFIG:-/cfg/calibrator.yaml}");
+  EXPECT_EQ(after(c, "--channel-prefix"), "");
+  EXPECT_EQ(after(c, "--state-dir"), "${OUT}/fleet_calibrator_state");  // a respawn resumes from its journal
+  const auto& m = args["fleet_mission"];
+  EXPECT_EQ(after(m, "--channel-prefix"), "a");
+  EXPECT_EQ(after(m, "--lcm-url"), "udpm://239.255.76.67:7668?ttl=0");
+  EXPECT_EQ(after(m, "--mission"), "/d/mission.yaml");
+  // Without a logger (no OUT) no journal; on a shared bus the calibrator gets the shared URL.
+  o.logging = false;
+  o.bus = FleetBus::kShared;
+  o.mission.clear();
+  const YAML::Node shared = YAML::Load(fleetLaunchYaml(fleet, o));
+  const auto sc = strings(shared["processes"][0]["args"]);
+  EXPECT_EQ(after(sc, "--bus"), "shared");
+  EXPECT_EQ(after(sc, "--state-dir"), "");
+  EXPECT_NE(shared["processes"][1]["name"].as<std::string>(), "fleet_mission");
+  // Refused: with a calibrator for one vehicle, and without the fleet file's path.
+  o.calibrator_for = "a";
+  EXPECT_THROW(fleetLaunchYaml(fleet, o), std::invalid_argument);
+  o.calibrator_for.clear();
+  o.source.clear();
+  EXPECT_THROW(fleetLaunchYaml(fleet, o), std::invalid_argument);
 }
 
 // --bus shared: every process on the one URL of the environment (no --lcm-url), or on the one given.

@@ -1,0 +1,104 @@
+#!/usr/bin/env bash
+# One calibrator serving a fleet over LCM (docs/fleet.md, "The fleet's calibrator over LCM"): two
+# vehicles of a short scaled fleet (meshnav_sim --vehicles 2, fly-by anchors among 16) run by the
+# launch of `meshnav_fleet_launch --fleet-calibrator --mission` under scripts/supervisor.py in a
+# private network namespace, each vehicle on its own bus. The calibrator is killed (SIGKILL) once
+# it has published its first ANCHOR_INIT and respawned by the supervisor. Asserts that
+#  - the launch exits 0; one calibrator (`calibrator --fleet`) and the fleet's mission ran;
+#  - every fly-by anchor of the hall (anchors_layout.csv, known 0) reached BOTH vehicles
+#    (each one's logger: anchor_init.yaml from its own <vehicle>/ANCHOR_INIT) exactly once, within
+#    0.3 m of its true position, and each vehicle's estimator joined it (anchors.csv);
+#  - each vehicle's ANCHOR_INIT carries pair biases of its own tags and none of the other's
+#    (restrictToVehicle over LCM), and between them both vehicles' tags are references: one
+#    calibration from both vehicles' ranges;
+#  - the respawned calibrator replayed its journal (--state-dir) and calibrated nothing twice;
+#  - each vehicle's estimate.csv follows its own truth (RMSE < 0.5 m).
+#   fleet_calibrator_lcm_test.sh SOURCE_DIR BIN_DIR WORK_DIR
+set -u
+SRC=$1; BIN=$2; WORK=$3
+if [[ -z "${MESHNAV_FLEET_CALIB_TEST_INSIDE:-}" ]]; then
+  rm -rf "$WORK"; mkdir -p "$WORK"
+  export MESHNAV_FLEET_CALIB_TEST_INSIDE=1
+  exec bash "$SRC/scripts/lcm_netns.sh" bash "$0" "$@"
+fi
+SUP=""
+cleanup() { [[ -n "$SUP" ]] && kill -TERM "$SUP" 2>/dev/null; wait 2>/dev/null; }
+trap cleanup EXIT
+fail() { echo "FAIL: $*"; for f in "$WORK"/*.log; do echo "---- $f"; tail -n 25 "$f"; done; exit 1; }
+cd "$SRC" || fail "no $SRC"
+"$BIN/meshnav_sim" --vehicles 2 --anchors 16 --hall 12,12,6 --duration 40 --seed 3 --out "$WORK/data" \
+  > "$WORK/sim.log" 2>&1 || fail "meshnav_sim --vehicles 2 failed"
+"$BIN/meshnav_fleet_launch" --fleet "$WORK/data/fleet.yaml" --out "$WORK/launch.yaml" \
+  --estimator-config "$SRC/config/fleet_scale.yaml" --fleet-calibrator --mission "$WORK/data/mission.yaml" \
+  --calibrator-config "$SRC/config/calibrator.yaml" > "$WORK/fleet_launch.log" 2>&1 || fail "meshnav_fleet_launch failed"
+python3 "$SRC/scripts/supervisor.py" "$WORK/launch.yaml" BIN="$BIN" OUT="$WORK/run" RATE=3 > "$WORK/supervisor.log" 2>&1 &
+SUP=$!
+# Wait for the first ANCHOR_INIT (a condition, with a deadline), then kill the calibrator hard.
+pid=""
+for _ in $(seq 600); do
+  if grep -q "\[fleet_calibrator\].*ANCHOR_INIT" "$WORK/supervisor.log"; then
+    pid=$(sed -n 's/^\[supervisor\] started fleet_calibrator (pid \([0-9]*\)).*/\1/p' "$WORK/supervisor.log" | head -1)
+    break
+  fi
+  kill -0 "$SUP" 2>/dev/null || break
+  sleep 0.1
+done
+[[ -n "$pid" ]] || fail "no ANCHOR_INIT from the fleet calibrator within 60 s"
+kill -KILL "$pid" || fail "cannot kill the calibrator ($pid)"
+echo "killed the fleet calibrator (pid $pid) after its first ANCHOR_INIT"
+wait "$SUP"; rc=$?; SUP=""
+(( rc == 0 )) || fail "the fleet launch exited with $rc"
+grep -c "^\[supervisor\] started fleet_calibrator " "$WORK/supervisor.log" | grep -qx 2 \
+  || fail "the calibrator was not respawned once"
+grep -q "^\[supervisor\] started fleet_mission " "$WORK/supervisor.log" || fail "the fleet's mission was not started"
+grep -q "\[fleet_calibrator\].*restart: [0-9]* inputs replayed" "$WORK/supervisor.log" \
+  || fail "the respawned calibrator did not replay its journal"
+python3 - "$WORK" <<'PY' || fail "see above"
+import bisect, csv, math, os, sys, yaml
+work = sys.argv[1]
+data = os.path.join(work, "data")
+layout = {int(r["id"]): r for r in csv.DictReader(open(os.path.join(data, "anchors_layout.csv")))}
+flyby = sorted(i for i, r in layout.items() if r["known"] == "0")
+if not flyby:
+    sys.exit("FAIL: the simulated hall has no fly-by anchor")
+tags = {v: set(yaml.safe_load(open(os.path.join(data, v, "setup.yaml")))["rel_tag_positions"].keys()) for v in ("v0", "v1")}
+refs_seen = set()
+for v, other in (("v0", "v1"), ("v1", "v0")):
+    inits = yaml.safe_load(open(os.path.join(work, "run", v, "anchor_init.yaml")))["anchors"]
+    ids = [a["id"] for a in inits]
+    if sorted(ids) != flyby:
+        sys.exit(f"FAIL: {v} got ANCHOR_INIT for {ids}, expected each of the fly-by anchors {flyby} once")
+    for a in inits:
+        t = layout[a["id"]]
+        err = math.dist(a["p_AinG"], (float(t["x_m"]), float(t["y_m"]), float(t["z_m"])))
+        refs = set(a["ref_ids"])
+        print(f"{v}: anchor {a['id']} at {err:.3f} m from the truth, references {sorted(refs)}")
+        if err > 0.3:
+            sys.exit(f"FAIL: {v}'s anchor {a['id']} is {err:.3f} m from its true position")
+        if refs & tags[other]:
+            sys.exit(f"FAIL: {v}'s ANCHOR_INIT {a['id']} has pair biases of {other}'s tags {sorted(refs & tags[other])}")
+        if not refs & tags[v]:
+            sys.exit(f"FAIL: {v}'s ANCHOR_INIT {a['id']} has no pair bias of its own tags")
+        refs_seen |= refs
+    joined = {int(r["id"]) for r in csv.DictReader(open(os.path.join(work, "run", v, "anchors.csv")))}
+    if not set(flyby) <= joined:
+        sys.exit(f"FAIL: {v}'s estimator did not join {sorted(set(flyby) - joined)}")
+    truth = [list(map(float, r[:4])) for r in csv.reader(l for l in open(os.path.join(data, v, "groundtruth.csv")) if l[0].isdigit())]
+    tt = [r[0] for r in truth]
+    se, n = 0.0, 0
+    for r in csv.DictReader(open(os.path.join(work, "run", v, "estimate.csv"))):
+        t = float(r["t"])
+        i = bisect.bisect_left(tt, t)
+        i = min((j for j in (i - 1, i) if 0 <= j < len(tt)), key=lambda j: abs(tt[j] - t))  # the nearest truth
+        if abs(tt[i] - t) > 0.01:
+            continue
+        se += sum((float(r[k]) - truth[i][j]) ** 2 for j, k in ((1, "tx"), (2, "ty"), (3, "tz")))
+        n += 1
+    rmse = math.sqrt(se / max(n, 1))
+    print(f"{v}: {n} poses, RMSE {rmse:.3f} m")
+    if n < 100 or rmse > 0.5:
+        sys.exit(f"FAIL: {v}'s estimate ({n} poses scored) RMSE {rmse:.3f} m")
+if not (tags["v0"] <= refs_seen and tags["v1"] <= refs_seen):
+    sys.exit(f"FAIL: the calibrations did not use both vehicles' tags (references {sorted(refs_seen)})")
+PY
+echo "PASS"
