@@ -47,8 +47,9 @@ void declareCalibratorProcessOptions(Cli& cli, CalibratorProcessConfig& c) {
            "calibrator_node.auto_mode)");
   cli.optional("state-dir", c.state_dir,
                "folder of the input journal (calibrator_inputs.lcmlog): every RANGE, decimated POSE, ANCHORS and "
-               "CALIB_CMD the node consumed, flushed at once; a restarted calibrator replays it first and so keeps "
-               "what it had collected and calibrated (docs/faults.md)")
+               "CALIB_CMD the node consumed and every ANCHOR_INIT it sent, flushed at once; a restarted calibrator "
+               "replays it first and so keeps what it had collected and calibrated, and sends an ANCHOR_INIT the "
+               "stop kept from going out (docs/faults.md)")
       ->type_name("DIR");
   cli.optional("out-yaml", c.out_yaml,
                "write the calibration results YAML (calibrator/calibration_io.h) after every calibration and on exit")

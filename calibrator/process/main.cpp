@@ -14,6 +14,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "calibrator/node/calibrator_node.h"
@@ -111,6 +112,11 @@ class CalibratorProcess {
         return;
       }
       const size_t v = static_cast<size_t>(link - links_.begin());
+      if (ch == channels::kAnchorInit.name) {  // an output that was sent: not to be sent again
+        AnchorInit sent;
+        if (transport::InputJournal::decode(rb, channels::kAnchorInit, sent, diag)) sent_.insert({v, sent.id, sent.t.us});
+        return;
+      }
       RangeSample r;
       PoseEstimate p;
       std::vector<AnchorEstimate> a;
@@ -127,6 +133,19 @@ class CalibratorProcess {
                    node_.dataTime() ? formatSeconds(*node_.dataTime()) : std::string("none"),
                    anchorStates(node_.status()));
     journal_ = std::make_unique<transport::InputJournal>(path);
+    // A calibration the replay made again whose ANCHOR_INIT the journal does not show as sent to a
+    // vehicle (the stop came between the calibration and its publication): sent now. One that was
+    // sent is not sent again (an estimator would re-initialize the anchor and lose what it learnt).
+    for (const AnchorInit& a : replayed_inits_)
+      for (size_t v = 0; v < links_.size(); ++v)
+        if (!sent_.count({v, a.id, a.t.us})) {
+          spdlog::warn("restart: ANCHOR_INIT {} (t = {} s){} had not been sent before the stop: sent now", a.id,
+                       formatSeconds(a.t), links_[v].name.empty() ? std::string() : " to " + links_[v].name);
+          lcm_.diagnostics().count("anchor_init_sent_after_restart");
+          publishAnchorInit(v, a);
+        }
+    replayed_inits_.clear();
+    sent_.clear();
   }
 
   /// Subscribes the inputs and starts the CALIB_STATUS heartbeat (with a progress line every 10 s).
@@ -174,14 +193,23 @@ class CalibratorProcess {
     calib::CalibratorSinks s;
     s.anchor_init = [this](const AnchorInit& a) {
       logAnchorInit(a);
-      if (replaying_) return;
-      for (size_t v = 0; v < links_.size(); ++v)
-        links_[v].lcm->publishAs(links_[v].prefix, channels::kAnchorInit, feed_.forVehicle(v, a));
+      if (replaying_) {
+        replayed_inits_.push_back(a);
+        return;
+      }
+      for (size_t v = 0; v < links_.size(); ++v) publishAnchorInit(v, a);
     };
     s.status = [this](const CalibStatus& st) {
       if (!replaying_) lcm_.publish(channels::kCalibStatus, process_.stamped(st));
     };
     return s;
+  }
+  /// ANCHOR_INIT `a` to vehicle v (as it may fuse it), then its record in the journal: what a
+  /// restart must not send again.
+  void publishAnchorInit(size_t v, const AnchorInit& a) {
+    const AnchorInit to_v = feed_.forVehicle(v, a);
+    links_[v].lcm->publishAs(links_[v].prefix, channels::kAnchorInit, to_v);
+    if (journal_) journal_->writeAs(links_[v].name, channels::kAnchorInit, to_v, a.t.us);
   }
   void writeResults(bool force) {
     const int64_t attempts = node_.diagnostics().get("calibrations_ok") + node_.diagnostics().get("calibrations_refused");
@@ -237,6 +265,8 @@ class CalibratorProcess {
   calib::CalibratorNode node_;
   calib::CalibrationYamlWriter results_file_;
   std::unique_ptr<transport::InputJournal> journal_;
+  std::vector<AnchorInit> replayed_inits_;                   ///< the calibrations the replay made again
+  std::set<std::tuple<size_t, SensorId, int64_t>> sent_;  ///< (vehicle, anchor, t µs) of the ANCHOR_INITs journaled as sent
   Duration pose_period_;
   int64_t next_progress_ = 0;
 };

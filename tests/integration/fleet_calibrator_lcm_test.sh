@@ -12,7 +12,10 @@
 #    (restrictToVehicle over LCM), and between them both vehicles' tags are references: one
 #    calibration from both vehicles' ranges;
 #  - the respawned calibrator replayed its journal (--state-dir) and calibrated nothing twice;
-#  - each vehicle's estimate.csv follows its own truth (RMSE < 0.5 m).
+#  - each vehicle's estimate.csv follows its own truth (RMSE < 0.5 m);
+#  - a stop between a calibration and its publication: the run's journal without v1's ANCHOR_INIT
+#    records, replayed by a new `calibrator --fleet --state-dir`, makes it send exactly v1's three
+#    again (logged "sent now", journaled as sent) and none of v0's, which the journal shows as sent.
 #   fleet_calibrator_lcm_test.sh SOURCE_DIR BIN_DIR WORK_DIR
 set -u
 SRC=$1; BIN=$2; WORK=$3
@@ -100,5 +103,57 @@ for v, other in (("v0", "v1"), ("v1", "v0")):
         sys.exit(f"FAIL: {v}'s estimate ({n} poses scored) RMSE {rmse:.3f} m")
 if not (tags["v0"] <= refs_seen and tags["v1"] <= refs_seen):
     sys.exit(f"FAIL: the calibrations did not use both vehicles' tags (references {sorted(refs_seen)})")
+PY
+# The stop between a calibration and its publication, made exact: the journal without v1's records.
+journal=$(ls "$WORK"/run/fleet_calibrator_state/*/calibrator_inputs.lcmlog 2>/dev/null | head -1)
+[[ -n "$journal" ]] || fail "no journal of the fleet calibrator under $WORK/run/fleet_calibrator_state"
+mkdir -p "$WORK/resend"
+python3 - "$journal" "$WORK/resend/calibrator_inputs.lcmlog" <<'PY' || fail "see above"
+import struct, sys
+src, dst = sys.argv[1:]
+data = open(src, "rb").read()
+out, pos, kept, dropped = bytearray(), 0, {}, 0
+while pos + 28 <= len(data):
+    sync, num, utime, clen, dlen = struct.unpack(">IqqII", data[pos:pos + 28])
+    if sync != 0xEDA1DA01:
+        sys.exit("FAIL: the journal is not an LCM log")
+    end = pos + 28 + clen + dlen
+    ch = data[pos + 28:pos + 28 + clen].decode()
+    if ch == "v1/ANCHOR_INIT":
+        dropped += 1
+    else:
+        kept[ch] = kept.get(ch, 0) + 1
+        out += data[pos:end]
+    pos = end
+open(dst, "wb").write(out)
+print(f"journal: {sum(kept.values())} events kept ({kept.get('v0/ANCHOR_INIT', 0)} v0/ANCHOR_INIT), {dropped} v1/ANCHOR_INIT dropped")
+if dropped != 3 or kept.get("v0/ANCHOR_INIT", 0) != 3:
+    sys.exit("FAIL: expected 3 ANCHOR_INIT records per vehicle in the journal")
+PY
+"$BIN/calibrator" --fleet "$WORK/data/fleet.yaml" --state-dir "$WORK/resend" --config "$SRC/config/calibrator.yaml" \
+  > "$WORK/resend.log" 2>&1 &
+cal=$!
+for _ in $(seq 300); do
+  (( $(grep -c "had not been sent before the stop: sent now" "$WORK/resend.log") >= 3 )) && break
+  kill -0 "$cal" 2>/dev/null || break
+  sleep 0.1
+done
+kill -TERM "$cal" 2>/dev/null; wait "$cal"; crc=$?
+(( crc == 0 )) || fail "the calibrator replaying the cut journal exited with $crc"
+n1=$(grep -c "ANCHOR_INIT [0-9]* (t = [0-9.]* s) to v1 had not been sent before the stop: sent now" "$WORK/resend.log")
+n0=$(grep -c " to v0 had not been sent" "$WORK/resend.log")
+(( n1 == 3 && n0 == 0 )) || fail "after the cut journal: $n1 ANCHOR_INIT re-sent to v1 (expected 3), $n0 to v0 (expected 0)"
+python3 - "$WORK/resend/calibrator_inputs.lcmlog" <<'PY' || fail "see above"
+import struct, sys
+data = open(sys.argv[1], "rb").read()
+pos, n = 0, {"v0/ANCHOR_INIT": 0, "v1/ANCHOR_INIT": 0}
+while pos + 28 <= len(data):
+    _, _, _, clen, dlen = struct.unpack(">IqqII", data[pos:pos + 28])
+    ch = data[pos + 28:pos + 28 + clen].decode()
+    n[ch] = n.get(ch, 0) + 1
+    pos += 28 + clen + dlen
+print("journal after the restart:", {k: v for k, v in n.items() if k.endswith("ANCHOR_INIT")})
+if n["v0/ANCHOR_INIT"] != 3 or n["v1/ANCHOR_INIT"] != 3:
+    sys.exit("FAIL: the journal does not show each vehicle's three ANCHOR_INIT as sent once")
 PY
 echo "PASS"

@@ -76,7 +76,8 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
     std::vector<std::string> args = {"--fleet", o.source, "--bus", toString(o.bus)};
     if (o.bus == FleetBus::kPerVehicle || !o.lcm_url.empty()) args.insert(args.end(), {"--lcm-url", base_url});
     args.insert(args.end(), {"--config", "${CALIBRATOR_CONFIG:-" + o.calibrator_config + "}"});
-    if (o.logging) args.insert(args.end(), {"--state-dir", "${OUT}/fleet_calibrator_state"});  // a respawn resumes
+    // A respawn resumes from its journal; a new launch (new T0_UTIME) never replays an older run's.
+    if (o.logging) args.insert(args.end(), {"--state-dir", "${OUT}/fleet_calibrator_state/${T0_UTIME}"});
     emitProcess(y, "fleet_calibrator", "calibrator", args, false, 0.0, 5);
     if (!o.mission.empty()) {
       // On the first vehicle's prefix and bus: its ESTIMATOR_STATUS and POSE, the fleet's CALIB_CMD.

@@ -145,7 +145,7 @@ TEST(FleetLaunch, OneCalibratorForTheFleetAndItsMissionOnTheFirstVehiclesBus) {
   EXPECT_EQ(after(c, "--lcm-url"), "udpm://239.255.76.67:7667?ttl=0");  // the base: it derives each bus
   EXPECT_EQ(after(c, "--config"), "${CALIBRATOR_CONFIG:-/cfg/calibrator.yaml}");
   EXPECT_EQ(after(c, "--channel-prefix"), "");
-  EXPECT_EQ(after(c, "--state-dir"), "${OUT}/fleet_calibrator_state");  // a respawn resumes from its journal
+  EXPECT_EQ(after(c, "--state-dir"), "${OUT}/fleet_calibrator_state/${T0_UTIME}");  // a respawn resumes, a new run not
   const auto& m = args["fleet_mission"];
   EXPECT_EQ(after(m, "--channel-prefix"), "a");
   EXPECT_EQ(after(m, "--lcm-url"), "udpm://239.255.76.67:7668?ttl=0");
