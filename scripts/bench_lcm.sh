@@ -231,6 +231,11 @@ with open(os.path.join(out, "table.md"), "w") as t:
         return ("–" if not w else f"{min(w):.0f} µs" if len(w) == 1 else f"{min(w):.0f}–{max(w):.0f} µs")
     t.write(f"\nmean wait on a run queue for a core, per time put on one: estimators {waits('_estimator')}, "
             f"bridges {waits('_bridge')}, probe {waits('lcm_probe')}\n")
+    t.write("\nwhere the tail is: tag-anchor RANGE answered later than 2 ms, per 10 s of data time "
+            "(window start [s]: count)\n\n")
+    for v, f in probe["vehicles"].items():
+        w = f.get("range_to_pose_over_2ms_per_10s") or {}
+        t.write(f"- {v}: " + (", ".join(f"{k}: {n}" for k, n in sorted(w.items())) or "none") + "\n")
 PY
   cat "$out/bench_lcm.yaml"; echo; cat "$out/table.md"
   grep -q "imu_to_pose: {n: 0," "$out/bench_lcm.yaml" && fail "a vehicle's POSE answered no IMU sample: its estimator never initialized?"

@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace meshnav::transport {
@@ -58,6 +59,10 @@ class LatencyRecorder {
   LatencyStats rangeToPose() const;
   /// The same over the ranges not marked `fused` (empty when every range was).
   LatencyStats otherRangeToPose() const;
+  /// Where in the flight the RANGE → POSE tail is: the fused ranges answered later than
+  /// `bound_us`, counted per `window_s` of data time; key = the window's start [s] after the first
+  /// IMU sample's time (windows without one are left out).
+  std::map<int64_t, size_t> rangeToPoseOverByWindow(double bound_us, double window_s) const;
   /// RANGE, fused or not, that no later POSE answers, not counting those received after the last
   /// POSE (rangesAfterLastPose: no POSE could answer them).
   size_t rangesUnanswered() const;
@@ -78,6 +83,10 @@ class LatencyRecorder {
   std::map<int64_t, int64_t> imu_;    ///< utime → receive utime
   std::map<int64_t, int64_t> poses_;  ///< utime → receive utime
   struct Stamped { int64_t utime, recv_utime; };
+  /// (range time, RANGE → POSE latency [µs]) of every range a later POSE answers.
+  static std::vector<std::pair<int64_t, double>> toPoseSamples(const std::vector<Stamped>& ranges,
+                                                               const std::map<int64_t, int64_t>& poses,
+                                                               const std::map<int64_t, int64_t>& imu);
   static LatencyStats toPose(const std::vector<Stamped>& ranges, const std::map<int64_t, int64_t>& poses,
                              const std::map<int64_t, int64_t>& imu);
   std::vector<Stamped> ranges_, other_ranges_;

@@ -100,6 +100,12 @@ class EstimatorProcess {
     lcm_.publish(channels::kEstimatorStatus, st);
     spdlog::info("stopped at t = {} s ({}); counters: {}", formatSeconds(st.t),
                  st.initialized ? "initialized" : "never initialized", transport::formatCounters(st.counters));
+    // The filter's steps (as timings.csv of meshnav run): what a handler's time is made of.
+    std::string steps;
+    for (const auto& [type, t] : node_.timings().stats())
+      steps += fmt::format("{}{} n {} mean {:.0f} µs max {:.1f} ms", steps.empty() ? "" : "; ", type, t.count, t.mean_us,
+                           t.max_us / 1000.0);
+    if (!steps.empty()) spdlog::info("filter steps: {}", steps);
   }
 
   const estimator::EstimatorNode& node() const { return node_; }

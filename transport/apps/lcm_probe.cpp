@@ -58,6 +58,14 @@ std::string figures(const LatencyRecorder& rec, const std::string& indent) {
   };
   stats("imu_to_pose", rec.imuToPose());
   stats("range_to_pose", rec.rangeToPose());
+  // Where the tail is: RANGE answered later than 2 ms (issue 38's bound), per 10 s of data time.
+  y << indent << "range_to_pose_over_2ms_per_10s: {";
+  bool first = true;
+  for (const auto& [t, n] : rec.rangeToPoseOverByWindow(2000.0, 10.0)) {
+    y << (first ? "" : ", ") << t << ": " << n;
+    first = false;
+  }
+  y << "}  # window start [s of data time]: RANGE answered later than 2 ms\n";
   if (rec.otherRangeToPose().n > 0) stats("other_range_to_pose", rec.otherRangeToPose());
   y << indent << "fused_ranges: " << rec.fusedRanges() << "  # RANGE the estimator updates with (all without --fleet)\n";
   y << indent << "ranges_unanswered: " << rec.rangesUnanswered() << "  # received before the last POSE, answered by none\n";

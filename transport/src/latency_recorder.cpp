@@ -34,9 +34,10 @@ LatencyStats LatencyRecorder::rangeToPose() const { return toPose(ranges_, poses
 
 LatencyStats LatencyRecorder::otherRangeToPose() const { return toPose(other_ranges_, poses_, imu_); }
 
-LatencyStats LatencyRecorder::toPose(const std::vector<Stamped>& ranges, const std::map<int64_t, int64_t>& poses,
-                                     const std::map<int64_t, int64_t>& imu) {
-  std::vector<double> s;
+std::vector<std::pair<int64_t, double>> LatencyRecorder::toPoseSamples(const std::vector<Stamped>& ranges,
+                                                                       const std::map<int64_t, int64_t>& poses,
+                                                                       const std::map<int64_t, int64_t>& imu) {
+  std::vector<std::pair<int64_t, double>> s;
   for (const Stamped& r : ranges) {
     // The first POSE at or after r that left after the RANGE came (a RANGE received after the
     // POSE of its time was out is in a later one: the estimator re-ran it as a late input).
@@ -45,9 +46,26 @@ LatencyStats LatencyRecorder::toPose(const std::vector<Stamped>& ranges, const s
     if (pose == poses.end()) continue;
     const auto sample = imu.find(pose->first);
     if (sample == imu.end()) continue;
-    s.push_back(static_cast<double>(pose->second - std::max(r.recv_utime, sample->second)));
+    s.emplace_back(r.utime, static_cast<double>(pose->second - std::max(r.recv_utime, sample->second)));
   }
+  return s;
+}
+
+LatencyStats LatencyRecorder::toPose(const std::vector<Stamped>& ranges, const std::map<int64_t, int64_t>& poses,
+                                     const std::map<int64_t, int64_t>& imu) {
+  std::vector<double> s;
+  for (const auto& [t, latency] : toPoseSamples(ranges, poses, imu)) s.push_back(latency);
   return LatencyStats::of(std::move(s));
+}
+
+std::map<int64_t, size_t> LatencyRecorder::rangeToPoseOverByWindow(double bound_us, double window_s) const {
+  std::map<int64_t, size_t> out;
+  if (imu_.empty() || !(window_s > 0.0)) return out;
+  const int64_t first = imu_.begin()->first;
+  for (const auto& [t, latency] : toPoseSamples(ranges_, poses_, imu_))
+    if (latency > bound_us)
+      ++out[static_cast<int64_t>(std::floor(static_cast<double>(t - first) * 1e-6 / window_s) * window_s)];
+  return out;
 }
 
 size_t LatencyRecorder::rangesAfterLastPose() const {

@@ -1,12 +1,14 @@
 #include "transport/lcm_node.h"
 
 #include <poll.h>
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <algorithm>
+#include <chrono>
 #include <stdexcept>
 
 #include "transport/replay/clock.h"
@@ -95,6 +97,17 @@ void LcmNode::subscribeRaw(const std::string& channel_regex, RawHandler fn) {
   if (sub) sub->setQueueCapacity(kQueueCapacity);
 }
 
+void LcmNode::handled(const std::string& ch, const std::function<void()>& body) {
+  const auto start = std::chrono::steady_clock::now();
+  guarded(ch, body);
+  const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  HandlerTime& h = handler_times_[ch];
+  ++h.n;
+  h.total_us += us;
+  h.max_us = std::max(h.max_us, us);
+  h.over_1ms += us > 1000.0;
+}
+
 void LcmNode::guarded(const std::string& ch, const std::function<void()>& body) {
   try {
     body();
@@ -103,6 +116,14 @@ void LcmNode::guarded(const std::string& ch, const std::function<void()>& body) 
   } catch (const std::exception& e) {
     diag_.report(ch + ":handler_error", "channel " + ch + ": handler failed: " + e.what());
   }
+}
+
+std::string LcmNode::handlerTimeSummary() const {
+  std::string out;
+  for (const auto& [ch, h] : handler_times_)
+    out += fmt::format("{}{} n {} mean {:.0f} µs max {:.1f} ms >1 ms {}", out.empty() ? "" : "; ", ch, h.n,
+                       h.total_us / static_cast<double>(std::max<int64_t>(1, h.n)), h.max_us / 1000.0, h.over_1ms);
+  return out;
 }
 
 void LcmNode::setHeartbeat(Duration period, std::function<void()> fn) {
@@ -116,7 +137,7 @@ void LcmNode::runHeartbeatIfDue() {
   const int64_t now = replay::wallUtimeNow();
   if (now < next_heartbeat_us_) return;
   next_heartbeat_us_ = now + heartbeat_period_.us;
-  guarded("heartbeat", heartbeat_);
+  handled("heartbeat", heartbeat_);
 }
 
 bool LcmNode::sizeOk(const lcm::ReceiveBuffer& rbuf, const std::string& ch) {

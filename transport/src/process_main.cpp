@@ -46,6 +46,7 @@ int ProcessMain::run(int argc, char** argv, const std::function<int()>& body) {
   StopSignal::install();
   try {
     const int rc = body();
+    if (lcm_ && !lcm_->handlerTimes().empty()) spdlog::info("time in handlers: {}", lcm_->handlerTimeSummary());
     if (lcm_ && !lcm_->secondInstance().empty()) {
       spdlog::error("refused to run beside another instance (exit {})", kExitSecondInstance);
       return kExitSecondInstance;

@@ -102,3 +102,21 @@ TEST(LatencyRecorder, ARangeBeforeTheLastPoseWithoutAnswerIsUnanswered) {
   EXPECT_EQ(r.rangesUnanswered(), 1u);
   EXPECT_EQ(r.rangesAfterLastPose(), 1u);
 }
+
+// Where the tail is: the ranges answered later than a bound, per window of data time.
+TEST(LatencyRecorder, TheTailIsCountedPerWindowOfDataTime) {
+  LatencyRecorder r;
+  for (int k = 0; k < 400; ++k) {  // 20 s at 20 Hz; from 12 s on every POSE leaves 5 ms after its IMU
+    const int64_t t = 1'000'000 + k * 50'000;
+    const int64_t delay = k >= 240 ? 5'000 : 30;
+    r.onImu(t, t + 100);
+    r.onPose(t, t + 100 + delay);
+    r.onRange(t, t + 50);
+  }
+  const auto over = r.rangeToPoseOverByWindow(2'000.0, 10.0);
+  ASSERT_EQ(over.size(), 1u);
+  EXPECT_EQ(over.begin()->first, 10);  // 12-20 s of data time
+  EXPECT_EQ(over.begin()->second, 160u);
+  EXPECT_TRUE(r.rangeToPoseOverByWindow(10'000.0, 10.0).empty());
+  EXPECT_EQ(r.rangeToPoseOverByWindow(10.0, 5.0).size(), 4u);  // every answer > 10 µs: 0, 5, 10, 15 s
+}

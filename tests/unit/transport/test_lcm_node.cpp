@@ -3,6 +3,7 @@
 // counted without a crash, heartbeat, wait-for-message, and SIGTERM handling.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <csignal>
 #include <cstring>
 #include <limits>
@@ -28,17 +29,23 @@ void drain(LcmNode& node) {
   }
 }
 
+/// A range of tag 100 to anchor 101, 3.5 m, at 42 µs.
+RangeSample sampleRange() {
+  RangeSample r;
+  r.t = Timestamp{42};
+  r.id_initiator = 100;
+  r.id_responder = 101;
+  r.range_m = 3.5;
+  return r;
+}
+
 }  // namespace
 
 TEST(LcmNode, TypedRoundTrip) {
   LcmNode node("test", "memq://");
   std::vector<RangeSample> got;
   node.subscribe(channels::kRange, [&](const RangeSample& r) { got.push_back(r); });
-  RangeSample r;
-  r.t = Timestamp{42};
-  r.id_initiator = 100;
-  r.id_responder = 101;
-  r.range_m = 3.5;
+  const RangeSample r = sampleRange();
   ASSERT_TRUE(node.publish(channels::kRange, r));
   drain(node);
   ASSERT_EQ(got.size(), 1u);
@@ -46,6 +53,28 @@ TEST(LcmNode, TypedRoundTrip) {
   EXPECT_EQ(got[0].range_m, 3.5);
   EXPECT_EQ(node.received(channels::kRange.name), 1);
   EXPECT_EQ(node.diagnostics().total(), 0);
+}
+
+// What each channel's handlers cost, apart from the wait for a core: counted per channel.
+TEST(LcmNode, TimeInTheHandlersIsKeptPerChannel) {
+  LcmNode node("test", "memq://");
+  node.subscribe(channels::kRange, [&](const RangeSample&) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(3);
+    while (std::chrono::steady_clock::now() < until) {
+    }
+  });
+  node.subscribe(channels::kPose, [&](const PoseEstimate&) {});
+  const RangeSample r = sampleRange();
+  ASSERT_TRUE(node.publish(channels::kRange, r));
+  ASSERT_TRUE(node.publish(channels::kRange, r));
+  drain(node);
+  const auto& h = node.handlerTimes();
+  ASSERT_EQ(h.count("RANGE"), 1u);
+  EXPECT_EQ(h.at("RANGE").n, 2);
+  EXPECT_EQ(h.at("RANGE").over_1ms, 2);
+  EXPECT_GE(h.at("RANGE").max_us, 3000.0);
+  EXPECT_EQ(h.count("POSE"), 0u);  // subscribed, never called
+  EXPECT_NE(node.handlerTimeSummary().find("RANGE n 2"), std::string::npos) << node.handlerTimeSummary();
 }
 
 TEST(LcmNode, GarbageBytesAreCountedNotFatal) {
