@@ -186,6 +186,11 @@ class CalibratorProcess {
     if (results_file_.enabled() && lcm_.secondInstance().empty()) writeResults(true);
     spdlog::info("stopped at t = {} s; anchors: {}counters: {}", formatSeconds(st.t), anchorStates(st),
                  transport::formatCounters(st.counters));
+    // The other buses' handlers (ProcessMain logs its own instance's, the first vehicle's).
+    std::set<const transport::LcmNode*> logged = {&lcm_};
+    for (const VehicleLink& l : links_)
+      if (logged.insert(l.lcm).second && !l.lcm->handlerTimes().empty())
+        spdlog::info("time in handlers on {}'s bus: {}", l.name, l.lcm->handlerTimeSummary());
   }
 
  private:
