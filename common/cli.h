@@ -47,6 +47,11 @@ class Cli {
   /// Comma-separated non-negative 32-bit ids (`--anchors 106,107`); an id out of range is refused.
   CLI::Option* idList(const std::string& name, std::vector<int32_t>& ids, const std::string& help);
 
+  /// `--fleet FILE` (help `fleet_help`) and `--bus per-vehicle|shared` of a process that serves a
+  /// fleet over LCM (calibrator, mission; docs/fleet.md); --fleet excludes --channel-prefix when
+  /// that is declared (transport::ProcessMain declares it first). Returns the --fleet option.
+  CLI::Option* fleetServing(std::string& fleet_path, std::string& bus, const std::string& fleet_help);
+
   /// `--config FILE`: a flat YAML map of this command's options (`rate: 10`, `wait_for:
   /// ESTIMATOR_STATUS`; `_` and `-` are the same). The command line wins over the file; a key that
   /// is not an option, or not a single value, is refused naming the file and the key.

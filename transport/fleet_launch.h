@@ -50,8 +50,8 @@ struct FleetLaunchOptions {
   /// One calibrator serving every vehicle (`calibrator --fleet source --bus ...`, process
   /// `fleet_calibrator`): each vehicle's RANGE, POSE, ANCHORS in and its own ANCHOR_INIT out on its
   /// bus; CALIB_CMD and CALIB_STATUS on the first vehicle's bus, where the fleet's mission
-  /// (`fleet_mission`, with `mission`) runs on that vehicle's prefix. Excludes calibrator_for;
-  /// needs `source`.
+  /// (`fleet_mission`, with `mission`: `mission --fleet`) follows that vehicle and from where it
+  /// sends ESTIMATOR_CMD to every vehicle on its bus. Excludes calibrator_for; needs `source`.
   bool fleet_calibrator = false;
   std::string mission;  ///< mission file of calibrator_for's or the fleet calibrator's mission ("" none)
   std::string calibrator_config = "config/calibrator.yaml";  ///< the calibrator's options

@@ -24,19 +24,11 @@ void declareCalibratorProcessOptions(Cli& cli, CalibratorProcessConfig& c) {
                                      "system setup (setup.yaml: tags, known anchors, pair biases, noise); required "
                                      "unless --fleet")
                             ->type_name("FILE");
-  CLI::Option* fleet =
-      cli.optional("fleet", c.fleet_path,
+  cli.fleetServing(c.fleet_path, c.bus,
                    "serve a fleet (fleet.yaml: each vehicle's dataset and setup): every vehicle's P/RANGE, P/POSE, "
                    "P/ANCHORS in, its own P/ANCHOR_INIT out, each on its bus (--bus); CALIB_CMD and CALIB_STATUS on "
                    "the first vehicle's bus, where the fleet's mission runs (docs/fleet.md)")
-          ->type_name("FILE");
-  fleet->excludes(setup);
-  cli.option("bus", c.bus,
-             "with --fleet: per-vehicle (vehicle k on --lcm-url's port + 1 + k, as meshnav_fleet_launch --bus) or "
-             "shared (every vehicle on --lcm-url)")
-      ->type_name("BUS")
-      ->check(CLI::IsMember({"per-vehicle", "shared"}));
-  if (CLI::Option* prefix = cli.app().get_option_no_throw("--channel-prefix")) fleet->excludes(prefix);
+      ->excludes(setup);
   cli.optional("config", c.config_path,
                "calibrator options YAML, `calibrator:` and `calibrator_node:` maps (default: built-in = "
                "config/calibrator.yaml); without calibrator.sigma_range, sigma_d is setup.yaml's "

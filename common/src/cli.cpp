@@ -237,4 +237,15 @@ void setupLogging(const std::string& program) {
   if (lvl) spdlog::set_level(spdlog::level::from_str(lvl));
 }
 
+CLI::Option* Cli::fleetServing(std::string& fleet_path, std::string& bus, const std::string& fleet_help) {
+  CLI::Option* fleet = optional("fleet", fleet_path, fleet_help)->type_name("FILE");
+  option("bus", bus,
+         "with --fleet: per-vehicle (vehicle k on --lcm-url's port + 1 + k, as meshnav_fleet_launch --bus) or "
+         "shared (every vehicle on --lcm-url)")
+      ->type_name("BUS")
+      ->check(CLI::IsMember({"per-vehicle", "shared"}));
+  if (CLI::Option* prefix = app_.get_option_no_throw("--channel-prefix")) fleet->excludes(prefix);
+  return fleet;
+}
+
 }  // namespace meshnav

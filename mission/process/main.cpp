@@ -3,11 +3,17 @@
 /// MISSION_STATUS goes out at the node's data-time rate and, as the process heartbeat, every
 /// --heartbeat seconds of wall time.
 #include <iostream>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include "common/fleet_file.h"
 #include "mission/mission.h"
 #include "mission/mission_node.h"
 #include "mission/process/mission_process_config.h"
 #include "transport/channels.h"
+#include "transport/fleet_bus.h"
 #include "transport/process_main.h"
 
 namespace {
@@ -44,10 +50,33 @@ int main(int argc, char** argv) {
     }
     process.require(!config.mission_path.empty(), "mission");
     const mission::Mission script = mission::loadMission(config.mission_path);
+    // Where ESTIMATOR_CMD goes: the followed vehicle's own channel, or with --fleet every
+    // vehicle's on its bus (the first one's bus is the process's own: it follows that vehicle).
+    std::vector<std::pair<transport::LcmNode*, std::string>> commanded;  // (bus, vehicle prefix)
+    std::vector<std::unique_ptr<transport::LcmNode>> buses;             // the buses beyond the process's own
+    if (!config.fleet_path.empty()) {
+      const std::vector<FleetEntry> fleet = loadFleetFile(config.fleet_path);
+      const transport::FleetBus bus = transport::parseFleetBus(config.bus);
+      const std::string base = transport::resolveLcmUrl(process.lcmUrlOption());
+      process.useLcm(transport::vehicleLcmUrl(bus, base, 0), fleet[0].name);
+      for (size_t k = 0; k < fleet.size(); ++k) {
+        transport::LcmNode* node = &process.lcm();
+        if (const std::string url = transport::vehicleLcmUrl(bus, base, k);
+            transport::withReceiveBuffer(url) != process.lcm().url()) {
+          buses.push_back(std::make_unique<transport::LcmNode>("mission", url));
+          node = buses.back().get();
+        }
+        commanded.emplace_back(node, fleet[k].name);
+      }
+    } else {
+      commanded.emplace_back(&process.lcm(), process.channelPrefix());
+    }
     transport::LcmNode& lcm = process.lcm();
     mission::MissionSinks sinks;
     sinks.calib_cmd = [&](const CalibCommand& c) { lcm.publish(channels::kCalibCmd, c); };
-    sinks.estimator_cmd = [&](const EstimatorCommand& c) { lcm.publish(channels::kEstimatorCmd, c); };
+    sinks.estimator_cmd = [&](const EstimatorCommand& c) {
+      for (const auto& [node, prefix] : commanded) node->publishAs(prefix, channels::kEstimatorCmd, c);
+    };
     sinks.status = [&](const MissionStatus& s) { lcm.publish(channels::kMissionStatus, process.stamped(s)); };
     mission::MissionNode node(script, sinks, mission::MissionNodeOptions{config.status_period_s, config.resend_period_s});
     if (config.t0_s) node.setT0(Timestamp::fromSec(*config.t0_s));
@@ -76,7 +105,8 @@ int main(int argc, char** argv) {
     lcm.subscribe(channels::kEstimatorStatus,
                                    [&](const EstimatorStatus& s) { node.onEstimatorStatus(s); });
     process.heartbeat<MissionStatus>(channels::kMissionStatus, config.heartbeat_s, [&] { return node.status(); });
-    spdlog::info("LCM {}; waiting for data", lcm.url());
+    spdlog::info("LCM {}; {}waiting for data", lcm.url(),
+                 commanded.size() > 1 ? "ESTIMATOR_CMD to " + std::to_string(commanded.size()) + " vehicles; " : "");
 
     const int rc = lcm.spin([&] { return !config.stay && completion.done(replay::wallUtimeNow()); });
     if (completion.timedOut(replay::wallUtimeNow()))

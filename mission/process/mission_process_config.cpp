@@ -41,6 +41,10 @@ void declareMissionProcessOptions(Cli& cli, MissionProcessConfig& c) {
   cli.option("heartbeat", c.heartbeat_s, "wall seconds between heartbeat MISSION_STATUS")
       ->type_name("S")
       ->check(cli::positive());
+  cli.fleetServing(c.fleet_path, c.bus,
+                   "the fleet's mission: follow the first vehicle of this fleet file (its P/POSE, P/RANGE, "
+                   "P/ESTIMATOR_STATUS on its bus) and send ESTIMATOR_CMD to every vehicle (P/ESTIMATOR_CMD on its "
+                   "bus); CALIB_CMD, CALIB_STATUS, MISSION_STATUS on the first vehicle's bus, as calibrator --fleet");
   cli.flag("print-config", c.print_config, "print the options and exit");
 }
 
@@ -88,6 +92,8 @@ std::string MissionProcessConfig::toString() const {
   s << "status_period: " << status_period_s << "  # [s] data time\n";
   s << "resend_period: " << resend_period_s << "  # [s] data time\n";
   s << "heartbeat: " << heartbeat_s << "  # [s] wall time\n";
+  s << "fleet: " << (fleet_path.empty() ? "(none)" : fleet_path) << "\n";
+  if (!fleet_path.empty()) s << "bus: " << bus << "\n";
   return s.str();
 }
 

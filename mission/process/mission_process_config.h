@@ -36,6 +36,11 @@ struct MissionProcessConfig {
   double status_period_s = 1.0;                 ///< --status-period: MISSION_STATUS period in data time [s]
   double resend_period_s = 2.0;                 ///< --resend-period: unanswered CALIB_CMD sent again [s] data time
                                                ///< (> the calibrator's 1 s CALIB_STATUS period, which may carry the answer)
+  /// --fleet: the fleet's mission (docs/fleet.md): it follows the first vehicle of this fleet file
+  /// (its POSE, RANGE, ESTIMATOR_STATUS, on its prefix and bus) and sends ESTIMATOR_CMD to every
+  /// vehicle on its own prefix and bus (--bus); excludes --channel-prefix
+  std::string fleet_path;
+  std::string bus = "per-vehicle";              ///< --bus with --fleet: per-vehicle | shared (transport/fleet_bus.h)
   bool print_config = false;                    ///< --print-config
   std::string t0_text = "auto";                 ///< --t0 as given (S or auto), read by finishMissionProcessConfig
   std::string time_from_text = "RANGE";         ///< --time-from as given, read by finishMissionProcessConfig

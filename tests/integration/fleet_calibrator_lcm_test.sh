@@ -12,6 +12,8 @@
 #    (restrictToVehicle over LCM), and between them both vehicles' tags are references: one
 #    calibration from both vehicles' ranges;
 #  - the respawned calibrator replayed its journal (--state-dir) and calibrated nothing twice;
+#  - the mission's `remove` of one fly-by anchor at 33 s reaches every vehicle's estimator (the
+#    fleet's mission sends ESTIMATOR_CMD on each vehicle's bus): its ANCHORS stop listing it;
 #  - each vehicle's estimate.csv follows its own truth (RMSE < 0.5 m);
 #  - a stop between a calibration and its publication: the run's journal without v1's ANCHOR_INIT
 #    records, replayed by a new `calibrator --fleet --state-dir`, makes it send exactly v1's three
@@ -31,8 +33,13 @@ fail() { echo "FAIL: $*"; for f in "$WORK"/*.log; do echo "---- $f"; tail -n 25 
 cd "$SRC" || fail "no $SRC"
 "$BIN/meshnav_sim" --vehicles 2 --anchors 16 --hall 12,12,6 --duration 40 --seed 3 --out "$WORK/data" \
   > "$WORK/sim.log" 2>&1 || fail "meshnav_sim --vehicles 2 failed"
+# The generated mission and a `remove` of the first fly-by anchor at 33 s: its ESTIMATOR_CMD must
+# reach every vehicle (mission --fleet), as in one process.
+removed=$(awk -F, 'NR > 1 && $9 == 0 { print $1; exit }' "$WORK/data/anchors_layout.csv")
+[[ -n "$removed" ]] || fail "no fly-by anchor in $WORK/data/anchors_layout.csv"
+{ cat "$WORK/data/mission.yaml"; echo "  - {t: 33, action: remove, anchors: [$removed]}"; } > "$WORK/mission.yaml"
 "$BIN/meshnav_fleet_launch" --fleet "$WORK/data/fleet.yaml" --out "$WORK/launch.yaml" \
-  --estimator-config "$SRC/config/fleet_scale.yaml" --fleet-calibrator --mission "$WORK/data/mission.yaml" \
+  --estimator-config "$SRC/config/fleet_scale.yaml" --fleet-calibrator --mission "$WORK/mission.yaml" \
   --calibrator-config "$SRC/config/calibrator.yaml" > "$WORK/fleet_launch.log" 2>&1 || fail "meshnav_fleet_launch failed"
 python3 "$SRC/scripts/supervisor.py" "$WORK/launch.yaml" BIN="$BIN" OUT="$WORK/run" RATE=3 > "$WORK/supervisor.log" 2>&1 &
 SUP=$!
@@ -56,9 +63,9 @@ grep -c "^\[supervisor\] started fleet_calibrator " "$WORK/supervisor.log" | gre
 grep -q "^\[supervisor\] started fleet_mission " "$WORK/supervisor.log" || fail "the fleet's mission was not started"
 grep -q "\[fleet_calibrator\].*restart: [0-9]* inputs replayed" "$WORK/supervisor.log" \
   || fail "the respawned calibrator did not replay its journal"
-python3 - "$WORK" <<'PY' || fail "see above"
+python3 - "$WORK" "$removed" <<'PY' || fail "see above"
 import bisect, csv, math, os, sys, yaml
-work = sys.argv[1]
+work, removed = sys.argv[1], int(sys.argv[2])
 data = os.path.join(work, "data")
 layout = {int(r["id"]): r for r in csv.DictReader(open(os.path.join(data, "anchors_layout.csv")))}
 flyby = sorted(i for i, r in layout.items() if r["known"] == "0")
@@ -83,9 +90,15 @@ for v, other in (("v0", "v1"), ("v1", "v0")):
         if not refs & tags[v]:
             sys.exit(f"FAIL: {v}'s ANCHOR_INIT {a['id']} has no pair bias of its own tags")
         refs_seen |= refs
-    joined = {int(r["id"]) for r in csv.DictReader(open(os.path.join(work, "run", v, "anchors.csv")))}
-    if not set(flyby) <= joined:
-        sys.exit(f"FAIL: {v}'s estimator did not join {sorted(set(flyby) - joined)}")
+    last = {}
+    for r in csv.DictReader(open(os.path.join(work, "run", v, "anchors.csv"))):
+        last[int(r["id"])] = max(last.get(int(r["id"]), 0.0), float(r["t"]))
+    if not set(flyby) <= set(last):
+        sys.exit(f"FAIL: {v}'s estimator did not join {sorted(set(flyby) - set(last))}")
+    kept = max(t for i, t in last.items() if i in flyby and i != removed)
+    print(f"{v}: anchor {removed} last reported at {last[removed]:.1f} s, the other fly-by anchors until {kept:.1f} s")
+    if not (last[removed] < 34.0 and kept > 37.0):
+        sys.exit(f"FAIL: {v}'s estimator did not remove anchor {removed} at 33 s (the fleet mission's ESTIMATOR_CMD)")
     truth = [list(map(float, r[:4])) for r in csv.reader(l for l in open(os.path.join(data, v, "groundtruth.csv")) if l[0].isdigit())]
     tt = [r[0] for r in truth]
     se, n = 0.0, 0

@@ -142,6 +142,18 @@ TEST(CalibratorProcessConfig, AFleetInsteadOfOneSetup) {
   EXPECT_EQ(shared->config.bus, "shared");
 }
 
+// The fleet's mission: a fleet file and a bus policy; --bus names one of the two.
+TEST(MissionProcessConfig, AFleetsMission) {
+  auto p = parseMission({"--mission", "m.yaml", "--fleet", "f.yaml"});
+  ASSERT_TRUE(p->ok);
+  EXPECT_EQ(p->config.fleet_path, "f.yaml");
+  EXPECT_EQ(p->config.bus, "per-vehicle");
+  EXPECT_NE(finished(*p).toString().find("fleet: f.yaml"), std::string::npos);
+  auto bad_bus = parseMission({"--mission", "m.yaml", "--fleet", "f.yaml", "--bus", "each"});
+  EXPECT_FALSE(bad_bus->ok);
+  EXPECT_EQ(bad_bus->code, 2);
+}
+
 TEST(CalibratorProcessConfig, UnknownOptionIsRejected) {
   auto p = parseCalibrator({"--autom"});
   EXPECT_FALSE(p->ok);

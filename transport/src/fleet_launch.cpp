@@ -80,9 +80,10 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
     if (o.logging) args.insert(args.end(), {"--state-dir", "${OUT}/fleet_calibrator_state/${T0_UTIME}"});
     emitProcess(y, "fleet_calibrator", "calibrator", args, false, 0.0, 5);
     if (!o.mission.empty()) {
-      // On the first vehicle's prefix and bus: its ESTIMATOR_STATUS and POSE, the fleet's CALIB_CMD.
-      std::vector<std::string> m = {"--channel-prefix", vehicles[0].name};
-      if (o.bus == FleetBus::kPerVehicle || !o.lcm_url.empty()) m.insert(m.end(), {"--lcm-url", bus_urls[0]});
+      // It follows the first vehicle (its ESTIMATOR_STATUS and POSE on its bus, with the fleet's
+      // CALIB_CMD) and sends ESTIMATOR_CMD to every vehicle on its bus (mission --fleet --bus).
+      std::vector<std::string> m = {"--fleet", o.source, "--bus", toString(o.bus)};
+      if (o.bus == FleetBus::kPerVehicle || !o.lcm_url.empty()) m.insert(m.end(), {"--lcm-url", base_url});
       m.insert(m.end(), {"--mission", o.mission, "--t0", "${MISSION_T0:-0}"});
       emitProcess(y, "fleet_mission", "mission", m, false, 0.0, 3);
     }

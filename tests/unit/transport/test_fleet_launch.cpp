@@ -117,9 +117,9 @@ TEST(FleetLaunch, CalibratorAndMissionForOneVehicle) {
   EXPECT_THROW(fleetLaunchYaml({{"v0", "/d/v0"}}, o), std::invalid_argument);
 }
 
-// One calibrator for the whole fleet: it opens every vehicle's bus itself from the base URL; the
-// fleet's mission runs on the first vehicle's prefix and bus, where the calibrator's CALIB_CMD and
-// CALIB_STATUS are.
+// One calibrator for the whole fleet: it opens every vehicle's bus itself from the base URL; so
+// does the fleet's mission, which follows the first vehicle (on whose bus the calibrator's
+// CALIB_CMD and CALIB_STATUS are) and commands every vehicle.
 TEST(FleetLaunch, OneCalibratorForTheFleetAndItsMissionOnTheFirstVehiclesBus) {
   FleetLaunchOptions o;
   o.fleet_calibrator = true;
@@ -146,9 +146,11 @@ TEST(FleetLaunch, OneCalibratorForTheFleetAndItsMissionOnTheFirstVehiclesBus) {
   EXPECT_EQ(after(c, "--config"), "${CALIBRATOR_CONFIG:-/cfg/calibrator.yaml}");
   EXPECT_EQ(after(c, "--channel-prefix"), "");
   EXPECT_EQ(after(c, "--state-dir"), "${OUT}/fleet_calibrator_state/${T0_UTIME}");  // a respawn resumes, a new run not
-  const auto& m = args["fleet_mission"];
-  EXPECT_EQ(after(m, "--channel-prefix"), "a");
-  EXPECT_EQ(after(m, "--lcm-url"), "udpm://239.255.76.67:7668?ttl=0");
+  const auto& m = args["fleet_mission"];  // follows the first vehicle, commands every one
+  EXPECT_EQ(after(m, "--fleet"), "/d/fleet.yaml");
+  EXPECT_EQ(after(m, "--bus"), "per-vehicle");
+  EXPECT_EQ(after(m, "--channel-prefix"), "");
+  EXPECT_EQ(after(m, "--lcm-url"), "udpm://239.255.76.67:7667?ttl=0");
   EXPECT_EQ(after(m, "--mission"), "/d/mission.yaml");
   // Without a logger (no OUT) no journal; on a shared bus the calibrator gets the shared URL.
   o.logging = false;
