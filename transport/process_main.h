@@ -29,7 +29,11 @@ namespace meshnav::transport {
 
 class ProcessMain {
  public:
-  /// Declares --lcm-url, --log-level and --channel-prefix on cli(); the process adds its own options.
+  /// Declares --lcm-url, --log-level, --channel-prefix and --yield-cpu on cli(); the process adds
+  /// its own options. `--yield-cpu`: a process whose latency does not matter (the fleet's
+  /// calibrator and mission) runs below the others: under a real-time policy (`chrt -f N`, which
+  /// every process of a launch inherits) one priority level lower, else niceness + 10; set before
+  /// any LCM instance, so that LCM's receive threads inherit it.
   /// `--channel-prefix P` (a vehicle of a fleet, docs/channels.md "Vehicle prefixes"): every typed
   /// channel of the process goes on the wire as channels::prefixed(channel, P); a malformed P is
   /// refused (exit 2) with the reason.
@@ -103,6 +107,7 @@ class ProcessMain {
   std::string lcm_url_;
   std::string log_level_;
   std::string channel_prefix_;
+  bool yield_cpu_ = false;  ///< --yield-cpu
   std::unique_ptr<LcmNode> lcm_;
 };
 

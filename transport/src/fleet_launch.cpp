@@ -73,7 +73,9 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
   if (o.fleet_calibrator) {
     // Not required, as a vehicle's own calibrator: navigation goes on without it. It opens every
     // vehicle's bus itself from the base URL (calibrator --fleet --bus).
-    std::vector<std::string> args = {"--fleet", o.source, "--bus", toString(o.bus)};
+    // --yield-cpu: below the estimators (under chrt one real-time level lower): a calibration of
+    // the whole fleet's anchors takes ~0.1 s of one core and must not hold it from them.
+    std::vector<std::string> args = {"--fleet", o.source, "--bus", toString(o.bus), "--yield-cpu"};
     if (o.bus == FleetBus::kPerVehicle || !o.lcm_url.empty()) args.insert(args.end(), {"--lcm-url", base_url});
     args.insert(args.end(), {"--config", "${CALIBRATOR_CONFIG:-" + o.calibrator_config + "}"});
     // A respawn resumes from its journal; a new launch (new T0_UTIME) never replays an older run's.
@@ -82,7 +84,7 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
     if (!o.mission.empty()) {
       // It follows the first vehicle (its ESTIMATOR_STATUS and POSE on its bus, with the fleet's
       // CALIB_CMD) and sends ESTIMATOR_CMD to every vehicle on its bus (mission --fleet --bus).
-      std::vector<std::string> m = {"--fleet", o.source, "--bus", toString(o.bus)};
+      std::vector<std::string> m = {"--fleet", o.source, "--bus", toString(o.bus), "--yield-cpu"};
       if (o.bus == FleetBus::kPerVehicle || !o.lcm_url.empty()) m.insert(m.end(), {"--lcm-url", base_url});
       m.insert(m.end(), {"--mission", o.mission, "--t0", "${MISSION_T0:-0}"});
       emitProcess(y, "fleet_mission", "mission", m, false, 0.0, 3);

@@ -2,6 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <sched.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
 
 #include "common/dir_lock.h"
@@ -25,7 +30,40 @@ ProcessMain::ProcessMain(std::string name, const std::string& description)
       ->check(CLI::Validator(
           [](std::string& p) { return channels::prefixProblem(p); },
           "", "vehicle prefix"));
+  cli_.flag("yield-cpu", yield_cpu_,
+            "run below the other processes (a calibrator, a mission: work whose latency does not matter): under a "
+            "real-time policy (chrt) one priority level lower, else niceness + 10");
 }
+
+namespace {
+/// --yield-cpu: one real-time priority level below the inherited one, or niceness + 10.
+void yieldCpu() {
+  const int policy = sched_getscheduler(0);
+  sched_param param{};
+  if ((policy == SCHED_FIFO || policy == SCHED_RR) && sched_getparam(0, &param) == 0) {
+    const int lowest = sched_get_priority_min(policy);
+    if (param.sched_priority > lowest) {
+      --param.sched_priority;
+      if (sched_setscheduler(0, policy, &param) == 0) {
+        spdlog::info("--yield-cpu: real-time priority {} ({})", param.sched_priority, policy == SCHED_FIFO ? "FIFO" : "RR");
+        return;
+      }
+    } else {
+      // Already at the lowest real-time level: the normal policy is below every real-time one.
+      param.sched_priority = 0;
+      if (sched_setscheduler(0, SCHED_OTHER, &param) == 0) {
+        spdlog::info("--yield-cpu: normal scheduling (below every real-time process)");
+        return;
+      }
+    }
+    spdlog::warn("--yield-cpu: could not lower the real-time priority ({})", std::strerror(errno));
+    return;
+  }
+  errno = 0;
+  if (nice(10) == -1 && errno != 0) spdlog::warn("--yield-cpu: nice failed ({})", std::strerror(errno));
+  else spdlog::info("--yield-cpu: niceness + 10");
+}
+}  // namespace
 
 namespace {
 /// A required option missing (ProcessMain::require): exit 2.
@@ -44,6 +82,7 @@ int ProcessMain::run(int argc, char** argv, const std::function<int()>& body) {
   setupLogging(name_);
   if (!log_level_.empty()) spdlog::set_level(spdlog::level::from_str(log_level_));
   StopSignal::install();
+  if (yield_cpu_) yieldCpu();
   try {
     const int rc = body();
     if (lcm_ && !lcm_->handlerTimes().empty()) spdlog::info("time in handlers: {}", lcm_->handlerTimeSummary());

@@ -145,6 +145,10 @@ TEST(FleetLaunch, OneCalibratorForTheFleetAndItsMissionOnTheFirstVehiclesBus) {
   EXPECT_EQ(after(c, "--lcm-url"), "udpm://239.255.76.67:7667?ttl=0");  // the base: it derives each bus
   EXPECT_EQ(after(c, "--config"), "${CALIBRATOR_CONFIG:-/cfg/calibrator.yaml}");
   EXPECT_EQ(after(c, "--channel-prefix"), "");
+  // Below the estimators: neither the calibrator nor the mission is on the latency path.
+  EXPECT_NE(std::find(c.begin(), c.end(), "--yield-cpu"), c.end());
+  EXPECT_NE(std::find(args["fleet_mission"].begin(), args["fleet_mission"].end(), "--yield-cpu"),
+            args["fleet_mission"].end());
   EXPECT_EQ(after(c, "--state-dir"), "${OUT}/fleet_calibrator_state/${T0_UTIME}");  // a respawn resumes, a new run not
   const auto& m = args["fleet_mission"];  // follows the first vehicle, commands every one
   EXPECT_EQ(after(m, "--fleet"), "/d/fleet.yaml");
