@@ -22,6 +22,7 @@
 
 #include "common/cli.h"
 #include "transport/channels.h"
+#include "transport/fleet_bus.h"
 #include "transport/lcm_node.h"
 #include "transport/replay/clock.h"
 
@@ -75,6 +76,11 @@ class ProcessMain {
   /// --channel-prefix: a process that serves several buses (the fleet's calibrator) names its
   /// first. Throws std::logic_error once lcm() was created.
   void useLcm(std::string url, std::string prefix);
+  /// A process serving a fleet of `vehicles` (calibrator --fleet, mission --fleet): lcm() becomes
+  /// the first vehicle's bus (vehicleLcmUrl(bus, --lcm-url or the environment's, 0); channel prefix
+  /// `first_prefix`) and one more LCM instance, owned here, is opened per further bus. Returns each
+  /// vehicle's bus (vehicles on one bus share its instance). Throws as useLcm and vehicleLcmUrl.
+  std::vector<LcmNode*> fleetBuses(size_t vehicles, FleetBus bus, const std::string& first_prefix);
 
   /// `status` as published: stamped with the wall time, and with the process's own counters
   /// (added to `counters`, or appended to `text` for a status without counters).
@@ -108,6 +114,7 @@ class ProcessMain {
   std::string log_level_;
   std::string channel_prefix_;
   bool yield_cpu_ = false;  ///< --yield-cpu
+  std::vector<std::unique_ptr<LcmNode>> fleet_buses_;  ///< fleetBuses() beyond lcm()
   std::unique_ptr<LcmNode> lcm_;
 };
 

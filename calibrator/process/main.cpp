@@ -299,29 +299,13 @@ int main(int argc, char** argv) {
     // Where each vehicle talks: one vehicle on the process's own bus; a fleet's vehicle k on its bus
     // (the first one's is the process's own, with the fleet's CALIB_CMD and CALIB_STATUS).
     std::vector<VehicleLink> links;
-    std::vector<std::unique_ptr<transport::LcmNode>> buses;  // the buses beyond the process's own
     if (config.fleet_path.empty()) {
       links.emplace_back("", process.channelPrefix(), &process.lcm());
     } else {
-      const transport::FleetBus bus = transport::parseFleetBus(config.bus);
-      const std::string base = transport::resolveLcmUrl(process.lcmUrlOption());
-      std::vector<std::string> urls;
-      for (size_t k = 0; k < served.vehicles.size(); ++k) urls.push_back(transport::vehicleLcmUrl(bus, base, k));
-      process.useLcm(urls[0], "");
-      for (size_t k = 0; k < served.vehicles.size(); ++k) {
-        transport::LcmNode* node = nullptr;
-        for (size_t j = 0; j < k && !node; ++j)
-          if (urls[j] == urls[k]) node = links[j].lcm;
-        if (!node) {
-          if (k == 0) {
-            node = &process.lcm();
-          } else {
-            buses.push_back(std::make_unique<transport::LcmNode>("calibrator", urls[k]));
-            node = buses.back().get();
-          }
-        }
-        links.emplace_back(served.vehicles[k].name, served.vehicles[k].name, node);
-      }
+      const std::vector<transport::LcmNode*> buses =
+          process.fleetBuses(served.vehicles.size(), transport::parseFleetBus(config.bus), "");
+      for (size_t k = 0; k < buses.size(); ++k)
+        links.emplace_back(served.vehicles[k].name, served.vehicles[k].name, buses[k]);
     }
     CalibratorProcess calibrator(process, config, served, links);
     spdlog::info("calibrator options:\n{}", config.toString());

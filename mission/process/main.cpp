@@ -3,7 +3,6 @@
 /// MISSION_STATUS goes out at the node's data-time rate and, as the process heartbeat, every
 /// --heartbeat seconds of wall time.
 #include <iostream>
-#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -53,21 +52,11 @@ int main(int argc, char** argv) {
     // Where ESTIMATOR_CMD goes: the followed vehicle's own channel, or with --fleet every
     // vehicle's on its bus (the first one's bus is the process's own: it follows that vehicle).
     std::vector<std::pair<transport::LcmNode*, std::string>> commanded;  // (bus, vehicle prefix)
-    std::vector<std::unique_ptr<transport::LcmNode>> buses;             // the buses beyond the process's own
     if (!config.fleet_path.empty()) {
       const std::vector<FleetEntry> fleet = loadFleetFile(config.fleet_path);
-      const transport::FleetBus bus = transport::parseFleetBus(config.bus);
-      const std::string base = transport::resolveLcmUrl(process.lcmUrlOption());
-      process.useLcm(transport::vehicleLcmUrl(bus, base, 0), fleet[0].name);
-      for (size_t k = 0; k < fleet.size(); ++k) {
-        transport::LcmNode* node = &process.lcm();
-        if (const std::string url = transport::vehicleLcmUrl(bus, base, k);
-            transport::withReceiveBuffer(url) != process.lcm().url()) {
-          buses.push_back(std::make_unique<transport::LcmNode>("mission", url));
-          node = buses.back().get();
-        }
-        commanded.emplace_back(node, fleet[k].name);
-      }
+      const std::vector<transport::LcmNode*> buses =
+          process.fleetBuses(fleet.size(), transport::parseFleetBus(config.bus), fleet[0].name);
+      for (size_t k = 0; k < buses.size(); ++k) commanded.emplace_back(buses[k], fleet[k].name);
     } else {
       commanded.emplace_back(&process.lcm(), process.channelPrefix());
     }

@@ -3,9 +3,7 @@
 #include <stdexcept>
 
 #include "common/skew.h"
-#include "pipeline/anchor_belief_intersection.h"
 #include "pipeline/fleet_calibrator_feed.h"
-#include "pipeline/fleet.h"
 
 namespace meshnav::pipeline {
 

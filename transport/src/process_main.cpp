@@ -5,6 +5,7 @@
 #include <sched.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -107,6 +108,27 @@ void ProcessMain::useLcm(std::string url, std::string prefix) {
   if (lcm_) throw std::logic_error("ProcessMain::useLcm after the LCM instance was created");
   lcm_url_ = std::move(url);
   channel_prefix_ = std::move(prefix);
+}
+
+std::vector<LcmNode*> ProcessMain::fleetBuses(size_t vehicles, FleetBus bus, const std::string& first_prefix) {
+  const std::string base = resolveLcmUrl(lcm_url_);
+  std::vector<std::string> urls;
+  for (size_t k = 0; k < vehicles; ++k) urls.push_back(vehicleLcmUrl(bus, base, k));
+  std::vector<LcmNode*> out;
+  if (urls.empty()) return out;
+  useLcm(urls[0], first_prefix);
+  for (size_t k = 0; k < urls.size(); ++k) {
+    const auto same = std::find(urls.begin(), urls.begin() + static_cast<std::ptrdiff_t>(k), urls[k]);
+    if (k == 0) {
+      out.push_back(&lcm());
+    } else if (same != urls.begin() + static_cast<std::ptrdiff_t>(k)) {
+      out.push_back(out[static_cast<size_t>(same - urls.begin())]);
+    } else {
+      fleet_buses_.push_back(std::make_unique<LcmNode>(name_, urls[k]));
+      out.push_back(fleet_buses_.back().get());
+    }
+  }
+  return out;
 }
 
 LcmNode& ProcessMain::lcm() {

@@ -10,6 +10,7 @@
 
 #include "transport/channels.h"
 #include "transport/lcm_node.h"
+#include "transport/process_main.h"
 #include "transport/replay_runner.h"
 #include "transport/replay/clock.h"
 #include "transport/stop_signal.h"
@@ -437,4 +438,27 @@ TEST(LcmUrl, UdpmGetsALargerReceiveBufferUnlessItSaysOne) {
             "udpm://239.255.76.67:7667?recv_buf_size=" + std::to_string(kUdpmReceiveBufferBytes));
   EXPECT_EQ(withReceiveBuffer("udpm://239.255.76.67:7667?recv_buf_size=65536"), "udpm://239.255.76.67:7667?recv_buf_size=65536");
   EXPECT_EQ(withReceiveBuffer("memq://"), "memq://");
+}
+
+// A process serving a fleet (calibrator --fleet, mission --fleet): on one bus every vehicle shares
+// the process's own instance, with the first vehicle's prefix; a bus per vehicle needs udpm.
+TEST(ProcessMain, AFleetOnOneBusSharesTheProcessesInstance) {
+  ProcessMain process("test", "fleet buses");
+  std::vector<LcmNode*> buses;
+  const char* argv[] = {"test", "--lcm-url", "memq://"};
+  ASSERT_EQ(process.run(3, const_cast<char**>(argv), [&] {
+    buses = process.fleetBuses(3, FleetBus::kShared, "v0");
+    return 0;
+  }),
+            0);
+  ASSERT_EQ(buses.size(), 3u);
+  for (LcmNode* b : buses) EXPECT_EQ(b, &process.lcm());
+  EXPECT_EQ(process.lcm().channelPrefix(), "v0");
+  EXPECT_THROW(process.fleetBuses(2, FleetBus::kShared, ""), std::logic_error);  // lcm() exists already
+  ProcessMain per_vehicle("test", "fleet buses");
+  EXPECT_EQ(per_vehicle.run(3, const_cast<char**>(argv), [&] {
+    per_vehicle.fleetBuses(2, FleetBus::kPerVehicle, "");
+    return 0;
+  }),
+            1);  // memq:// has no port to add to: refused, logged
 }
