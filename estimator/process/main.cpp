@@ -9,6 +9,7 @@
 #include <iostream>
 #include <thread>
 #include <optional>
+#include <set>
 
 #include "common/dir_lock.h"
 #include "common/setup.h"
@@ -26,7 +27,7 @@ using namespace meshnav;
 /// The process's own options (--lcm-url, --log-level come from transport::ProcessMain).
 struct EstimatorProcessOptions {
   std::string setup_path, config_path, strategy, state_dir;
-  double heartbeat_s = 1.0, state_period_s = 0.1;
+  double heartbeat_s = 1.0, state_period_s = 0.1, anchors_period_s = 2.0;
   bool print_config = false;
 };
 
@@ -42,6 +43,11 @@ void declareOptions(Cli& cli, EstimatorProcessOptions& o) {
   cli.optional("state-dir", o.state_dir, "folder of the restart checkpoint: written while running, resumed from at start")
       ->type_name("DIR");
   cli.option("state-period", o.state_period_s, "data seconds between two checkpoints")->type_name("S")->check(cli::positive());
+  cli.option("anchors-period", o.anchors_period_s,
+             "data seconds between two writes of the checkpoint's anchors (estimator_anchors.yaml, most of its cost); "
+             "a change of the set of anchors is written at once")
+      ->type_name("S")
+      ->check(cli::positive());
 }
 
 /// The EstimatorNode wired to LCM, with its checkpoint in --state-dir.
@@ -135,7 +141,15 @@ class EstimatorProcess {
     if (!lcm_.secondInstance().empty()) return;  // a second instance leaves the first one's checkpoint alone
     last_checkpoint_ = t;
     try {
-      estimator::writeCheckpoint(node_.checkpoint(), o_.state_dir);
+      const estimator::EstimatorCheckpoint c = node_.checkpoint();
+      std::set<SensorId> ids;
+      for (const AnchorInit& a : c.anchors) ids.insert(a.id);
+      const bool anchors = !last_anchors_ || ids != anchor_ids_ || (t - *last_anchors_).sec() >= o_.anchors_period_s;
+      estimator::writeCheckpoint(c, o_.state_dir, anchors);
+      if (anchors) {
+        last_anchors_ = t;
+        anchor_ids_ = std::move(ids);
+      }
     } catch (const std::exception& ex) {
       spdlog::error("checkpoint not written: {}", ex.what());
     }
@@ -145,6 +159,8 @@ class EstimatorProcess {
   transport::LcmNode& lcm_;
   const EstimatorProcessOptions& o_;
   std::optional<Timestamp> last_checkpoint_;
+  std::optional<Timestamp> last_anchors_;  ///< data time of the last write of the anchors' file
+  std::set<SensorId> anchor_ids_;          ///< the anchors it holds
   bool was_initialized_ = false;
   bool finishing_ = false;  ///< in finish(): POSE_SMOOTHED paced
   int64_t finish_published_ = 0;

@@ -111,7 +111,7 @@ const InstanceRecord* EstimatorCheckpoint::find(const std::string& kind, SensorI
   return nullptr;
 }
 
-void writeCheckpoint(const EstimatorCheckpoint& c, const std::string& dir) {
+void writeCheckpoint(const EstimatorCheckpoint& c, const std::string& dir, bool with_anchors) {
   fs::create_directories(dir);
   YAML::Emitter e;
   e.SetDoublePrecision(17);
@@ -130,8 +130,10 @@ void writeCheckpoint(const EstimatorCheckpoint& c, const std::string& dir) {
   for (const auto& r : c.instances) emitRecord(e, r);
   e << YAML::EndSeq << YAML::EndMap;
   // Anchors first: a state file is only read together with the anchors written before it.
-  writeAnchorInitsYaml(c.anchors, (fs::path(dir) / (std::string(kAnchorsFile) + ".tmp")).string());
-  fs::rename(fs::path(dir) / (std::string(kAnchorsFile) + ".tmp"), fs::path(dir) / kAnchorsFile);
+  if (with_anchors || !fs::exists(fs::path(dir) / kAnchorsFile)) {
+    writeAnchorInitsYaml(c.anchors, (fs::path(dir) / (std::string(kAnchorsFile) + ".tmp")).string());
+    fs::rename(fs::path(dir) / (std::string(kAnchorsFile) + ".tmp"), fs::path(dir) / kAnchorsFile);
+  }
   writeFileAtomically((fs::path(dir) / kStateFile).string(), [&](std::ostream& out) { out << e.c_str() << "\n"; });
 }
 

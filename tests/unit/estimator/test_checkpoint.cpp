@@ -122,6 +122,31 @@ TEST(Checkpoint, Layout2RoundTripsEveryKeptInstance) {
   }
 }
 
+// The anchors' file is written only when asked (the process: every --anchors-period and when the
+// set changes) or when there is none yet; the state file every time.
+TEST(Checkpoint, TheAnchorsFileIsWrittenWhenAskedOrMissing) {
+  EstimatorCheckpoint c;
+  c.t = Timestamp::fromSec(1.0);
+  AnchorInit a;
+  a.id = 106;
+  a.t = c.t;
+  a.p_AinG = {1, 2, 3};
+  a.cov_p_m2 = 0.01 * Eigen::Matrix3d::Identity();
+  c.anchors = {a};
+  const std::string dir = tempDir("meshnav_checkpoint_anchors_period");
+  writeCheckpoint(c, dir, /*with_anchors=*/false);  // no anchors' file yet: written
+  ASSERT_EQ(readCheckpoint(dir)->anchors.size(), 1u);
+  c.t = Timestamp::fromSec(1.1);
+  c.anchors[0].p_AinG.x() = 1.5;
+  writeCheckpoint(c, dir, false);
+  auto back = readCheckpoint(dir);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->t, c.t);                      // the state: new
+  EXPECT_EQ(back->anchors[0].p_AinG.x(), 1.0);  // the anchors: as written before
+  writeCheckpoint(c, dir, true);
+  EXPECT_EQ(readCheckpoint(dir)->anchors[0].p_AinG.x(), 1.5);
+}
+
 // The height bias converges in flight (true 0.25 m, prior 0 ± 0.3 m); the estimator dies at
 // t = 15 s and restarts from the checkpoint files: the bias is there from the first IMU sample with
 // its converged value and variance, and so are the tags' γ. Before issue 11 the checkpoint did not
