@@ -45,6 +45,7 @@
 namespace meshnav::pipeline {
 
 class FleetCalibratorFeed;
+class PeerRangeFeed;
 
 struct PipelineOptions {
   estimator::EstimatorOptions estimator;
@@ -154,11 +155,10 @@ class Pipeline {
   Diagnostics diag_;
   /// What the calibrator hears from the vehicles and says to each (the mesh once, the anchor beliefs' CI).
   std::unique_ptr<FleetCalibratorFeed> feed_;
-  std::set<std::tuple<int64_t, SensorId, SensorId>> peer_ranges_;  ///< (µs, ids) of inter-vehicle ranges fused
-  std::unique_ptr<PeerRangeRouter> router_;                         ///< a fleet's (null for one vehicle)
-  std::set<SensorId> calibrated_anchors_;                           ///< ids of the ANCHOR_INITs so far
-  /// An inter-vehicle range from vehicle `vehicle`'s data to the vehicle that learns more from it.
-  void routeInterVehicleRange(size_t vehicle, const RangeSample& r);
+  /// A fleet's ranges between its vehicles' tags (null for one vehicle).
+  std::unique_ptr<PeerRangeFeed> peers_;
+  /// An inter-vehicle range to the vehicle that learns more from it.
+  void routeInterVehicleRange(const RangeSample& r);
   std::vector<std::optional<Timestamp>> last_pose_to_calibrator_;  ///< per vehicle
   /// Per vehicle, the POSE instants the calibrator took whose smoothed twin has not come yet
   /// (calibrator_on_smoothed).

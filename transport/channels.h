@@ -45,6 +45,8 @@ struct Channel {
 inline constexpr Channel<ImuSample> kImu{"IMU"};                              ///< imu_t, imu_bridge → estimator
 inline constexpr Channel<BaroSample> kBaro{"BARO"};                           ///< baro_t
 inline constexpr Channel<RangeSample> kRange{"RANGE"};                        ///< range_t, uwb_bridge → estimator, calibrator
+/// peer_range_t, peer_router → estimator: a range to another vehicle's tag with where that vehicle puts it
+inline constexpr Channel<PeerRange> kPeerRange{"PEER_RANGE"};
 inline constexpr Channel<FlightStateSample> kFlightState{"FLIGHT_STATE"};     ///< flight_state_t
 inline constexpr Channel<HeightSample> kHeight{"HEIGHT"};                     ///< height_t, imu_bridge → estimator
 inline constexpr Channel<PoseSample> kGroundTruth{"GROUND_TRUTH"};            ///< ground_truth_t (simulator, logs)
@@ -69,7 +71,7 @@ inline constexpr Channel<control_status_t> kControlStatus{"CONTROL_STATUS"};
 inline constexpr auto kTyped =
     std::tuple{kImu,  kBaro,           kRange,     kFlightState, kGroundTruth,   kAnchorInit,      kPose,     kAnchors,
                kEstimatorStatus, kEstimatorCmd, kCalibCmd, kCalibStatus, kMissionStatus, kHeight, kTimeSyncRequest,
-               kTimeSync,        kPoseSmoothed,    kControlCmd,   kControlStatus};
+               kTimeSync,        kPoseSmoothed,    kControlCmd,   kControlStatus, kPeerRange};
 
 /// The name of every channel above, for tools that list or record them.
 inline constexpr auto kAll =

@@ -7,7 +7,7 @@
 /// (element (r, c) at index 3r + c), time `utime` [µs] = Timestamp::us, maps (counters, timings)
 /// as arrays sorted by name.
 ///
-/// `fromLcm` of a *measurement* (IMU, BARO, RANGE, FLIGHT_STATE, GROUND_TRUTH, ANCHOR_INIT,
+/// `fromLcm` of a *measurement* (IMU, BARO, RANGE, PEER_RANGE, FLIGHT_STATE, GROUND_TRUTH, ANCHOR_INIT,
 /// commands) validates what the decoder cannot: non-finite numbers and unknown enumeration codes
 /// throw `InvalidMessage`, which the process runtime reports and counts per channel.
 
@@ -32,6 +32,7 @@
 #include "meshnav/imu_t.hpp"
 #include "meshnav/mission_status_t.hpp"
 #include "meshnav/pair_bias_t.hpp"
+#include "meshnav/peer_range_t.hpp"
 #include "meshnav/pose_t.hpp"
 #include "meshnav/range_t.hpp"
 
@@ -50,6 +51,7 @@ range_t toLcm(const RangeSample& s);
 flight_state_t toLcm(const FlightStateSample& s);
 ground_truth_t toLcm(const PoseSample& s);
 pose_t toLcm(const PoseEstimate& s);
+peer_range_t toLcm(const PeerRange& s);
 anchor_estimate_t toLcm(const AnchorEstimate& s);
 pair_bias_t toLcm(const PairBias& s);
 anchor_init_t toLcm(const AnchorInit& s);
@@ -70,6 +72,8 @@ RangeSample fromLcm(const range_t& m);
 FlightStateSample fromLcm(const flight_state_t& m);
 PoseSample fromLcm(const ground_truth_t& m);
 PoseEstimate fromLcm(const pose_t& m);
+/// Also refuses a utime other than range.utime and a peer_tag that is no end of the range.
+PeerRange fromLcm(const peer_range_t& m);
 AnchorEstimate fromLcm(const anchor_estimate_t& m);
 PairBias fromLcm(const pair_bias_t& m);
 AnchorInit fromLcm(const anchor_init_t& m);
@@ -90,6 +94,7 @@ template <> struct LcmTypeOf<RangeSample> { using type = range_t; };
 template <> struct LcmTypeOf<FlightStateSample> { using type = flight_state_t; };
 template <> struct LcmTypeOf<PoseSample> { using type = ground_truth_t; };
 template <> struct LcmTypeOf<PoseEstimate> { using type = pose_t; };
+template <> struct LcmTypeOf<PeerRange> { using type = peer_range_t; };
 template <> struct LcmTypeOf<AnchorInit> { using type = anchor_init_t; };
 template <> struct LcmTypeOf<EstimatorStatus> { using type = estimator_status_t; };
 template <> struct LcmTypeOf<EstimatorCommand> { using type = estimator_cmd_t; };

@@ -17,7 +17,8 @@
 /// CALIB_STATUS and MISSION_STATUS (docs/decisions/017-bus-per-vehicle.md).
 ///
 /// Process names are `<vehicle>_estimator`, `<vehicle>_imu_bridge`, `<vehicle>_uwb_bridge`,
-/// `<vehicle>_logging` (and `<vehicle>_calibrator`, `<vehicle>_mission` for `calibrator_for`); the launch stops when every bridge has played its data
+/// `<vehicle>_logging` (and `<vehicle>_calibrator`, `<vehicle>_mission` for `calibrator_for`;
+/// `fleet_calibrator`, `fleet_mission`, `fleet_peer_router` for the fleet); the launch stops when every bridge has played its data
 /// (`shutdown_after`), the loggers last (`stop_last`). Variables of the generated file: BIN
 /// (default build/bin), RATE (default 1), DATA_T0 (default 0), ESTIMATOR_CONFIG (default the
 /// generator's `estimator_config`), OUT (only with `logging`: OUT/<vehicle>/ gets the logger's files
@@ -53,6 +54,11 @@ struct FleetLaunchOptions {
   /// (`fleet_mission`, with `mission`: `mission --fleet`) follows that vehicle and from where it
   /// sends ESTIMATOR_CMD to every vehicle on its bus. Excludes calibrator_for; needs `source`.
   bool fleet_calibrator = false;
+  /// With `source` and two or more vehicles: the fleet's `peer_router` (process `fleet_peer_router`,
+  /// `peer_router --fleet source --bus ...`): every vehicle's RANGE, POSE and ANCHOR_INIT in, each
+  /// inter-vehicle range out as PEER_RANGE to the vehicle that fuses it, as in one process
+  /// (docs/fleet.md "Inter-vehicle ranges over LCM"). False: every estimator drops them.
+  bool peer_router = true;
   std::string mission;  ///< mission file of calibrator_for's or the fleet calibrator's mission ("" none)
   std::string calibrator_config = "config/calibrator.yaml";  ///< the calibrator's options
   /// A bus per vehicle (each process of vehicle k: `--lcm-url` vehicleLcmUrl(bus, lcm_url, k)) or

@@ -54,12 +54,12 @@ template <> struct InputKind<EstimatorCommand> {
   static InputIds ids(const EstimatorCommand& c) { return {c.id, 0}; }
 };
 template <> struct InputKind<HeightSample> { static constexpr int rank = 6; static constexpr const char* name = "HEIGHT"; static constexpr auto kDataset = &Dataset::heights; };
-/// A fleet's inter-vehicle range with the peer's tag position (pipeline/fleet.h composes it from the
-/// peer's POSE); no channel yet: the fleet runs in one process.
+/// A fleet's inter-vehicle range with the peer's tag position (pipeline/peer_range_feed.h composes
+/// it from the peer's pose: in one process, or over LCM in `peer_router` on PEER_RANGE).
 template <> struct InputKind<PeerRange> {
   // First at equal time: the receiver's own IMU sample of that instant comes after it (the fleet's
   // other vehicle is earlier in the merged order), and a later rank would rewind for every range.
-  static constexpr int rank = -1; static constexpr const char* name = "PEER_RANGE"; static constexpr bool kDatasetOnly = true;
+  static constexpr int rank = -1; static constexpr const char* name = "PEER_RANGE";
   static InputIds ids(const PeerRange& r) { return {r.range.id_initiator, r.range.id_responder}; }
 };
 

@@ -2,8 +2,8 @@
 
 #include <stdexcept>
 
-#include "common/skew.h"
 #include "pipeline/fleet_calibrator_feed.h"
+#include "pipeline/peer_range_feed.h"
 
 namespace meshnav::pipeline {
 
@@ -24,7 +24,7 @@ Pipeline::Pipeline(const PipelineOptions& options, std::vector<Vehicle> vehicles
     es.status = [this, v](const EstimatorStatus& s) { queue_.push_back({v, s}); };
     estimators_.push_back(std::make_unique<estimator::EstimatorNode>(options_.estimator, vehicles_[v].setup, es));
   }
-  if (vehicles_.size() > 1) router_ = std::make_unique<PeerRangeRouter>(options_.peer_routing, vehicles_.size());
+  if (vehicles_.size() > 1) peers_ = std::make_unique<PeerRangeFeed>(vehicles_, fleet_setup, options_.peer_routing, diag_);
   last_pose_to_calibrator_.resize(vehicles_.size());
   awaiting_smoothed_.resize(vehicles_.size());
   if (options_.calibration_enabled) {
@@ -55,23 +55,13 @@ void Pipeline::onInput(size_t vehicle, const estimator::EstimatorInput& in) {
     if (mission_) mission_->setT0(t);
     t0_set_ = true;
   }
-  if (vehicles_.size() > 1)
-    if (const auto* r = std::get_if<RangeSample>(&in)) {
-      const SystemSetup& mine = vehicles_[vehicle].setup;
-      const auto foreign = [&](SensorId id) { return fleet_setup_.isTag(id) && !mine.isTag(id); };
-      if (foreign(r->id_initiator) || foreign(r->id_responder)) {
-        // A range to another vehicle's tag (the calibrator needs it not).
-        diag_.count("inter_vehicle_range:" + vehicles_[vehicle].name);
-        if (!options_.inter_vehicle_ranges) return;
-        routeInterVehicleRange(vehicle, *r);
-        drain();  // the receiver's outputs
-        return;
-      }
-      // A range of this vehicle's tag to an anchor it can use (known or calibrated): its anchor count.
-      const SensorId other = mine.isTag(r->id_initiator) ? r->id_responder : r->id_initiator;
-      if ((mine.isTag(r->id_initiator) || mine.isTag(r->id_responder)) &&
-          (fleet_setup_.isKnownAnchor(other) || calibrated_anchors_.count(other)))
-        router_->noteAnchorRange(vehicle, other, r->t);
+  if (peers_)
+    if (const auto* r = std::get_if<RangeSample>(&in); r && peers_->interVehicle(vehicle, *r)) {
+      // A range to another vehicle's tag (the calibrator needs it not).
+      if (!options_.inter_vehicle_ranges) return;
+      routeInterVehicleRange(*r);
+      drain();  // the receiver's outputs
+      return;
     }
   node.onInput(in);
   if (calibrator_) {
@@ -82,78 +72,29 @@ void Pipeline::onInput(size_t vehicle, const estimator::EstimatorInput& in) {
   drain();
 }
 
-void Pipeline::routeInterVehicleRange(size_t vehicle, const RangeSample& r) {
-  // Each range once: the same exchange may be logged by both vehicles (as the anchors' mesh is).
-  constexpr int64_t kKeepUs = 10'000'000;
-  while (!peer_ranges_.empty() && std::get<0>(*peer_ranges_.begin()) < r.t.us - kKeepUs)
-    peer_ranges_.erase(peer_ranges_.begin());
-  const auto key = pairKey(r.id_initiator, r.id_responder);
-  if (!peer_ranges_.emplace(r.t.us, key.first, key.second).second) {
-    diag_.count("inter_vehicle_range_duplicate");
-    return;
-  }
-  // The two vehicles: whose tag is at each end.
-  auto owner = [&](SensorId id) -> std::optional<size_t> {
-    for (size_t k = 0; k < vehicles_.size(); ++k)
-      if (vehicles_[k].setup.isTag(id)) return k;
-    return std::nullopt;
-  };
-  const auto va = owner(r.id_initiator), vb = owner(r.id_responder);
-  if (!va || !vb || *va == *vb) {
-    diag_.count("inter_vehicle_range_not_between_two_vehicles");
-    return;
-  }
+void Pipeline::routeInterVehicleRange(const RangeSample& r) {
+  const std::optional<PeerRangeFeed::Ends> ends = peers_->admit(r);
+  if (!ends) return;
   if (options_.peer_truth) {
     // The oracle: both vehicles, each with the other's true tag (independent of either estimate).
     for (const auto& [receiver, sender, peer_tag] :
-         {std::tuple{*va, *vb, r.id_responder}, std::tuple{*vb, *va, r.id_initiator}}) {
+         {std::tuple{ends->a, ends->b, r.id_responder}, std::tuple{ends->b, ends->a, r.id_initiator}}) {
       const std::optional<PoseSample> truth = options_.peer_truth(sender, r.t);
       if (!truth || !estimators_[receiver]->pose()) continue;
       PeerRange pr;
       pr.t = r.t;
       pr.range = r;
       pr.peer_tag = peer_tag;
-      pr.p_peer_tag_in_G = truth->p_IinG + truth->q_ItoG * vehicles_[sender].setup.rel_tag_positions.at(peer_tag);
+      pr.p_peer_tag_in_G = truth->p_IinG + truth->q_ItoG * peers_->leverArm(sender, peer_tag);
       pr.cov_peer_tag_m2.setZero();
       diag_.count("inter_vehicle_range_to:" + vehicles_[receiver].name);
       estimators_[receiver]->onInput(pr);
     }
     return;
   }
-  const std::optional<PoseEstimate> pa = estimators_[*va]->pose(), pb = estimators_[*vb]->pose();
-  // One of the two learns from the range, with the other's estimate as its anchor (never both:
-  // each would count the other's information as independent of its own), and only where that
-  // estimate holds nothing of the receiver's (PeerRangeRouter: from a vehicle with anchors to one
-  // without, docs/decisions/016-fleet-sharing.md).
-  PeerSide sa, sb;
-  sa.has_estimate = pa.has_value();
-  sb.has_estimate = pb.has_value();
-  if (pa) sa.cov_p_trace_m2 = pa->cov_p_m2.trace();
-  if (pb) sb.cov_p_trace_m2 = pb->cov_p_m2.trace();
-  const PeerRangeRouter::Decision decision = router_->decide(*va, sa, *vb, sb, r.t);
-  if (!decision.receiver) {
-    diag_.count("inter_vehicle_range_" + decision.why);
-    return;
-  }
-  const bool to_a = *decision.receiver == *va;
-  const size_t receiver = to_a ? *va : *vb, sender = to_a ? *vb : *va;
-  const PoseEstimate& ps = to_a ? *pb : *pa;
-  const SensorId peer_tag = to_a ? r.id_responder : r.id_initiator;
-  // The sender's tag at the range's time, from its pose (at most one input older): p_S = p_I +
-  // v dt + R l, with δθ local (R = R̂ Exp(δθ)): ∂p_S/∂δθ = −R̂ [l]×; Σ_S = Σ_p + dt² Σ_v + J Σ_θ Jᵀ.
-  const Eigen::Vector3d& l = vehicles_[sender].setup.rel_tag_positions.at(peer_tag);
-  const double dt = (r.t - ps.t).sec();
-  const Eigen::Matrix3d R = ps.q_ItoG.toRotationMatrix();
-  const Eigen::Matrix3d J = -R * skew(l);
-  PeerRange pr;
-  pr.t = r.t;
-  pr.range = r;
-  pr.peer_tag = peer_tag;
-  pr.p_peer_tag_in_G = ps.p_IinG + dt * ps.v_IinG + R * l;
-  pr.cov_peer_tag_m2 = ps.cov_p_m2 + dt * dt * ps.cov_v + J * ps.cov_theta_rad2 * J.transpose();
-  diag_.count("inter_vehicle_range_to:" + vehicles_[receiver].name);
-  router_->noteReceived(receiver, sender, r.t);
-  estimators_[receiver]->onInput(pr);
+  // The sender's pose: its estimator's now, at most one input older than the range.
+  if (auto routed = peers_->route(r, *ends, estimators_[ends->a]->pose(), estimators_[ends->b]->pose()))
+    estimators_[routed->receiver]->onInput(routed->range);
 }
 
 void Pipeline::finish() {
@@ -199,7 +140,7 @@ void Pipeline::drain() {
             if (sinks_.estimator_status) sinks_.estimator_status(v, m);
           } else if constexpr (std::is_same_v<T, AnchorInit>) {
             anchor_inits_.push_back(m);
-            calibrated_anchors_.insert(m.id);
+            if (peers_) peers_->onAnchorInit(m.id);
             for (size_t i = 0; i < estimators_.size(); ++i)
               estimators_[i]->onAnchorInit(feed_->forVehicle(i, m));
             if (sinks_.anchor_init) sinks_.anchor_init(m);

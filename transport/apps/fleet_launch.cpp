@@ -46,6 +46,10 @@ int main(int argc, char** argv) {
                "every vehicle's ranges, each vehicle's ANCHOR_INIT on its own bus; CALIB_CMD, CALIB_STATUS and the "
                "mission on the first vehicle's bus");
   for_all->excludes(for_one);
+  bool no_peer_router = false;
+  cli.flag("no-peer-router", no_peer_router,
+           "no peer_router: every estimator drops the ranges to other vehicles' tags (by default the fleet's "
+           "peer_router sends each to the vehicle that fuses it, as meshnav_run --fleet does)");
   cli.optional("mission", o.mission,
                "with --calibrator-for or --fleet-calibrator: the mission file (e.g. the fleet's mission.yaml; the "
                "fleet's mission hears the first vehicle)")
@@ -74,6 +78,7 @@ int main(int argc, char** argv) {
     for (FleetEntry& v : vehicles) v.dataset = fs::absolute(v.dataset).lexically_normal().string();
     if (fs::exists(o.estimator_config)) o.estimator_config = fs::absolute(o.estimator_config).lexically_normal().string();
     o.logging = !no_logging;
+    o.peer_router = !no_peer_router;
     o.bus = transport::parseFleetBus(bus);
     if (fs::exists(o.calibrator_config)) o.calibrator_config = fs::absolute(o.calibrator_config).lexically_normal().string();
     if (!o.mission.empty()) o.mission = fs::absolute(o.mission).lexically_normal().string();

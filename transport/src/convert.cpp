@@ -241,6 +241,31 @@ PoseEstimate fromLcm(const pose_t& m) {
   return s;
 }
 
+peer_range_t toLcm(const PeerRange& s) {
+  peer_range_t m;
+  m.sender_id = 0;  // set by LcmNode::publish
+  m.utime = s.t.us;
+  m.range = toLcm(s.range);
+  m.peer_tag = s.peer_tag;
+  put3(s.p_peer_tag_in_G, m.p_peer_tag_in_G);
+  put33(s.cov_peer_tag_m2, m.cov_peer_tag);
+  return m;
+}
+PeerRange fromLcm(const peer_range_t& m) {
+  requireFinite(m.p_peer_tag_in_G, "p_peer_tag_in_G");
+  requireCovariance(m.cov_peer_tag, "cov_peer_tag");
+  if (m.range.utime != m.utime) throw InvalidMessage("utime differs from range.utime");
+  if (m.peer_tag != m.range.id_initiator && m.peer_tag != m.range.id_responder)
+    throw InvalidMessage("peer_tag " + std::to_string(m.peer_tag) + " is no end of the range");
+  PeerRange s;
+  s.t = Timestamp::fromUtime(m.utime);
+  s.range = fromLcm(m.range);
+  s.peer_tag = m.peer_tag;
+  s.p_peer_tag_in_G = get3(m.p_peer_tag_in_G);
+  s.cov_peer_tag_m2 = get33(m.cov_peer_tag);
+  return s;
+}
+
 anchor_estimate_t toLcm(const AnchorEstimate& s) {
   anchor_estimate_t m;
   m.utime = s.t.us;

@@ -90,6 +90,13 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
       emitProcess(y, "fleet_mission", "mission", m, false, 0.0, 3);
     }
   }
+  if (o.peer_router && !o.source.empty() && vehicles.size() > 1) {
+    // Not required: each vehicle navigates on its anchors without it. Not --yield-cpu: a
+    // vehicle short of anchors waits on it. It opens every vehicle's bus itself (--bus).
+    std::vector<std::string> args = {"--fleet", o.source, "--bus", toString(o.bus)};
+    if (o.bus == FleetBus::kPerVehicle || !o.lcm_url.empty()) args.insert(args.end(), {"--lcm-url", base_url});
+    emitProcess(y, "fleet_peer_router", "peer_router", args, false, 0.0, 5);
+  }
   for (size_t k = 0; k < vehicles.size(); ++k) {
     const FleetEntry& v = vehicles[k];
     const std::string& p = v.name;  // the vehicle's channel prefix

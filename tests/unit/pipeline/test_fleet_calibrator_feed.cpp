@@ -3,29 +3,16 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/anchor_belief_intersection.h"
+#include "fleet_test_data.h"
 #include "pipeline/fleet.h"
 #include "pipeline/fleet_calibrator_feed.h"
 
 using namespace meshnav;
 using namespace meshnav::pipeline;
+using meshnav::pipeline::test::range;
+using meshnav::pipeline::test::vehicleSetup;
 
 namespace {
-
-SystemSetup vehicleSetup(std::map<SensorId, Eigen::Vector3d> tags) {
-  SystemSetup s;
-  s.rel_tag_positions = std::move(tags);
-  s.abs_anchor_positions = {{101, {0, 0, 2}}, {102, {4, 0, 2}}};
-  return s;
-}
-
-RangeSample range(double t, SensorId a, SensorId b) {
-  RangeSample r;
-  r.t = Timestamp::fromSec(t);
-  r.id_initiator = a;
-  r.id_responder = b;
-  r.range_m = r.range_corr_m = 3.0;
-  return r;
-}
 
 AnchorEstimate belief(SensorId id, double x, double var) {
   AnchorEstimate a;

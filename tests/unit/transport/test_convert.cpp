@@ -199,6 +199,52 @@ TEST(Convert, PoseEstimateEveryFieldAndRowMajor) {
   EXPECT_EQ(r.cov_theta_rad2, s.cov_theta_rad2);
 }
 
+// PEER_RANGE: the range nested, the peer's tag and its covariance row-major; a range whose
+// instant or ends disagree with the message is refused.
+TEST(Convert, PeerRangeEveryFieldAndItsConsistency) {
+  PeerRange s;
+  s.t = Timestamp{70123456};
+  s.range.t = s.t;
+  s.range.id_initiator = 11;
+  s.range.id_responder = 21;
+  s.range.type_initiator = UwbType::Tag;
+  s.range.type_responder = UwbType::Tag;
+  s.range.range_m = 3.25;
+  s.range.range_corr_m = 3.2;
+  s.range.R_m2 = 0.01;
+  s.peer_tag = 21;
+  s.p_peer_tag_in_G = {4.0, -5.5, 1.25};
+  s.cov_peer_tag_m2 = someCovariance(0.01);
+  const auto m = toLcm(s);
+  EXPECT_EQ(m.range.utime, m.utime);
+  EXPECT_EQ(m.cov_peer_tag[1], s.cov_peer_tag_m2(0, 1));  // row-major
+  const PeerRange r = fromLcm(wire(m));
+  EXPECT_EQ(r.t, s.t);
+  EXPECT_EQ(r.range.t, s.t);
+  EXPECT_EQ(r.range.id_initiator, 11);
+  EXPECT_EQ(r.range.id_responder, 21);
+  EXPECT_EQ(r.range.range_m, 3.25);
+  EXPECT_EQ(r.range.R_m2, 0.01);
+  EXPECT_EQ(r.peer_tag, 21);
+  EXPECT_EQ(r.p_peer_tag_in_G, s.p_peer_tag_in_G);
+  EXPECT_EQ(r.cov_peer_tag_m2, s.cov_peer_tag_m2);
+  auto bad = m;
+  bad.peer_tag = 12;  // no end of the range
+  EXPECT_THROW(fromLcm(bad), InvalidMessage);
+  bad = m;
+  bad.range.utime += 1;
+  EXPECT_THROW(fromLcm(bad), InvalidMessage);
+  bad = m;
+  bad.cov_peer_tag[0] = -1.0;
+  EXPECT_THROW(fromLcm(bad), InvalidMessage);
+  bad = m;
+  bad.p_peer_tag_in_G[2] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(fromLcm(bad), InvalidMessage);
+  bad = m;
+  bad.range.range = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(fromLcm(bad), InvalidMessage);
+}
+
 TEST(Convert, Anchors) {
   std::vector<AnchorEstimate> v;
   for (int i = 0; i < 3; ++i) {

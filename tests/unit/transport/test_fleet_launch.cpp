@@ -173,6 +173,37 @@ TEST(FleetLaunch, OneCalibratorForTheFleetAndItsMissionOnTheFirstVehiclesBus) {
   EXPECT_THROW(fleetLaunchYaml(fleet, o), std::invalid_argument);
 }
 
+// The fleet's inter-vehicle ranges over LCM: one peer_router for two or more vehicles of a fleet
+// file, on the base URL from which it derives each vehicle's bus, at the estimators' priority.
+TEST(FleetLaunch, APeerRouterForAFleetOfTwoOrMoreUnlessTurnedOff) {
+  FleetLaunchOptions o;
+  o.source = "/d/fleet.yaml";
+  o.lcm_url = "udpm://239.255.76.67:7667?ttl=0";
+  const std::vector<FleetEntry> fleet = {{"a", "/d/a"}, {"b", "/d/b"}};
+  auto processes = [&](const std::vector<FleetEntry>& f) {
+    std::map<std::string, YAML::Node> by_name;
+    for (const auto& p : YAML::Load(fleetLaunchYaml(f, o))["processes"])
+      by_name.emplace(p["name"].as<std::string>(), static_cast<const YAML::Node&>(p));
+    return by_name;
+  };
+  const auto with = processes(fleet);
+  ASSERT_EQ(with.count("fleet_peer_router"), 1u);
+  const YAML::Node& r = with.at("fleet_peer_router");
+  EXPECT_EQ(r["command"].as<std::string>(), "${BIN:-build/bin}/peer_router");
+  const auto args = strings(r["args"]);
+  EXPECT_EQ(after(args, "--fleet"), "/d/fleet.yaml");
+  EXPECT_EQ(after(args, "--bus"), "per-vehicle");
+  EXPECT_EQ(after(args, "--lcm-url"), "udpm://239.255.76.67:7667?ttl=0");
+  EXPECT_EQ(std::find(args.begin(), args.end(), "--yield-cpu"), args.end());  // a vehicle waits on it
+  EXPECT_FALSE(r["required"]);  // each vehicle navigates on its anchors without it
+  EXPECT_EQ(processes({fleet[0]}).count("fleet_peer_router"), 0u);  // one vehicle: no peers
+  o.peer_router = false;
+  EXPECT_EQ(processes(fleet).count("fleet_peer_router"), 0u);
+  o.peer_router = true;
+  o.source.clear();  // no fleet file to give it
+  EXPECT_EQ(processes(fleet).count("fleet_peer_router"), 0u);
+}
+
 // --bus shared: every process on the one URL of the environment (no --lcm-url), or on the one given.
 TEST(FleetLaunch, ASharedBusPutsEveryVehicleOnTheBaseUrl) {
   FleetLaunchOptions o;

@@ -1,0 +1,101 @@
+/// @file peer_range_relay.cpp
+/// @brief PeerRangeRelay: inter-vehicle ranges held until their vehicles' POSEs are there.
+
+#include "pipeline/peer_range_relay.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace meshnav::pipeline {
+
+void PeerRangeRelayOptions::validate() const {
+  if (!(max_pose_age_s > 0.0) || !std::isfinite(max_pose_age_s))
+    throw std::invalid_argument("PeerRangeRelayOptions: max_pose_age_s must be > 0 s");
+  if (!(max_wait_s >= 0.0) || !std::isfinite(max_wait_s))
+    throw std::invalid_argument("PeerRangeRelayOptions: max_wait_s must be >= 0 s");
+  if (max_held < 1) throw std::invalid_argument("PeerRangeRelayOptions: max_held must be >= 1");
+}
+
+std::string PeerRangeRelayOptions::toString() const {
+  std::ostringstream s;
+  s << "a range waits up to " << max_wait_s << " s of data time for its vehicles' POSE, uses a pose within "
+    << max_pose_age_s << " s of its instant, at most " << max_held << " wait";
+  return s.str();
+}
+
+PeerRangeRelay::PeerRangeRelay(const std::vector<Vehicle>& vehicles, const SystemSetup& fleet_setup,
+                               const PeerRangeRoutingOptions& routing, const PeerRangeRelayOptions& options,
+                               Diagnostics& diag)
+    : options_(options), diag_(diag), feed_(vehicles, fleet_setup, routing, diag), poses_(vehicles.size()) {
+  options_.validate();
+  if (vehicles.empty()) throw std::invalid_argument("PeerRangeRelay: no vehicle");
+}
+
+std::vector<PeerRangeFeed::Routed> PeerRangeRelay::onRange(size_t v, const RangeSample& r) {
+  if (v >= poses_.size()) throw std::out_of_range("PeerRangeRelay: no vehicle " + std::to_string(v));
+  if (!data_time_ || *data_time_ < r.t) data_time_ = r.t;
+  if (feed_.interVehicle(v, r)) {
+    if (const auto ends = feed_.admit(r)) {
+      if (static_cast<int>(held_.size()) >= options_.max_held) {
+        diag_.count("inter_vehicle_range_hold_full");
+        held_.pop_front();
+      }
+      held_.push_back({r, *ends});
+    }
+  }
+  return release();
+}
+
+std::vector<PeerRangeFeed::Routed> PeerRangeRelay::onPose(size_t v, const PoseEstimate& p) {
+  std::deque<PoseEstimate>& poses = poses_.at(v);
+  // In time order (a re-run may publish an instant again: the newer replaces it).
+  auto it = std::lower_bound(poses.begin(), poses.end(), p.t, [](const PoseEstimate& a, Timestamp t) { return a.t < t; });
+  if (it != poses.end() && it->t == p.t)
+    *it = p;
+  else
+    poses.insert(it, p);
+  // Kept: what a held range may still ask for (its wait plus the pose's age, and a margin).
+  const Duration keep = Duration::fromSec(options_.max_wait_s + options_.max_pose_age_s + 1.0);
+  while (poses.size() > 1 && poses.front().t < poses.back().t - keep) poses.pop_front();
+  if (!data_time_ || *data_time_ < p.t) data_time_ = p.t;
+  return release();
+}
+
+std::optional<PoseEstimate> PeerRangeRelay::poseNear(size_t v, Timestamp t) const {
+  const std::deque<PoseEstimate>& poses = poses_[v];
+  auto it = std::lower_bound(poses.begin(), poses.end(), t, [](const PoseEstimate& a, Timestamp x) { return a.t < x; });
+  const PoseEstimate* best = nullptr;
+  if (it != poses.end()) best = &*it;
+  if (it != poses.begin()) {
+    const PoseEstimate& before = *std::prev(it);
+    if (!best || (t - before.t).sec() <= (best->t - t).sec()) best = &before;  // the earlier one at a tie
+  }
+  if (!best || std::abs((t - best->t).sec()) > options_.max_pose_age_s) return std::nullopt;
+  return *best;
+}
+
+std::vector<PeerRangeFeed::Routed> PeerRangeRelay::release() {
+  std::vector<PeerRangeFeed::Routed> out;
+  if (held_.empty()) return out;
+  // Oldest instant first: the router's provenance is a function of time.
+  std::stable_sort(held_.begin(), held_.end(), [](const Held& a, const Held& b) { return a.range.t < b.range.t; });
+  const Duration wait = Duration::fromSec(options_.max_wait_s);
+  for (auto it = held_.begin(); it != held_.end();) {
+    const Timestamp t = it->range.t;
+    const bool both = reached(it->ends.a, t) && reached(it->ends.b, t);
+    const bool waited = data_time_ && *data_time_ - t >= wait;
+    if (!both && !waited) {
+      ++it;
+      continue;
+    }
+    if (!both) diag_.count("inter_vehicle_range_pose_late");
+    if (auto routed = feed_.route(it->range, it->ends, poseNear(it->ends.a, t), poseNear(it->ends.b, t)))
+      out.push_back(std::move(*routed));
+    it = held_.erase(it);
+  }
+  return out;
+}
+
+}  // namespace meshnav::pipeline
