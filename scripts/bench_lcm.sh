@@ -119,7 +119,7 @@ run_fleet() {
   local prefixes
   prefixes=$(python3 -c 'import sys, yaml; print(",".join(v["name"] for v in yaml.safe_load(open(sys.argv[1]))["vehicles"]))' \
     "$data/fleet.yaml") || fail "cannot read $data/fleet.yaml"
-  "$BIN/meshnav_lcm_probe" --fleet "$data/fleet.yaml" --bus "$bus" --out "$out/probe.yaml" > "$out/probe.log" 2>&1 &
+  "$BIN/meshnav_lcm_probe" --fleet "$data/fleet.yaml" --bus "$bus" --out "$out/probe.yaml" --samples "$out/range_to_pose.csv" > "$out/probe.log" 2>&1 &
   local probe=$!; PIDS+=("$probe")
   local load_start; load_start=$(cut -d' ' -f1-3 /proc/loadavg)
   echo "[bench lcm] launch $launch at ${rate}x (vehicles $prefixes, $bus bus; load average $load_start)" >&2

@@ -10,7 +10,11 @@
 ///  - **RANGE → POSE**: (over the ranges the estimator fuses, see `fused` below) a RANGE stamped r is in the first POSE stamped u ≥ r received after it; that POSE can only be
 ///    made once both the RANGE and the IMU sample u are in, so its latency is
 ///    recv(POSE u) − max(recv(RANGE r), recv(IMU u)): the range's update, the propagation to u and
-///    the POSE, without the wait for the next IMU sample (data time, not processing).
+///    the POSE, without the wait for the next IMU sample (data time, not processing). A RANGE
+///    stamped before the first POSE (before the estimator initialized) is not in it: the first
+///    POSE's latency is the initialization's, not a range update's (rangesBeforeFirstPose; they
+///    were 24 of each vehicle's ~2 900 in the scaled fleet, answered 16-30 ms later, 0.8 %: alone
+///    enough to move a p99).
 /// A RANGE is marked `fused` when it is one the estimator updates with (a tag of the vehicle to an
 /// anchor); the others (anchor–anchor mesh ranges, tag-to-tag ranges between vehicles), which the
 /// estimator drops at once, go to otherRangeToPose, so that they do not dilute RANGE → POSE (in
@@ -63,6 +67,17 @@ class LatencyRecorder {
   /// `bound_us`, counted per `window_s` of data time; key = the window's start [s] after the first
   /// IMU sample's time (windows without one are left out).
   std::map<int64_t, size_t> rangeToPoseOverByWindow(double bound_us, double window_s) const;
+  /// One fused range a later POSE answers (the probe's --samples).
+  struct RangeAnswer {
+    int64_t utime = 0;       ///< the range's data time
+    double latency_us = 0;   ///< RANGE → POSE
+    int64_t pose_utime = 0;  ///< the answering POSE's stamp (> the first IMU stamp ≥ utime: the range came after that POSE)
+    bool range_last = false; ///< the RANGE came after the answering POSE's IMU sample (the latency counts from the RANGE)
+  };
+  /// Every fused range a later POSE answers, in range order: the sample rangeToPose() summarizes.
+  std::vector<RangeAnswer> rangeToPoseSamples() const { return answers(ranges_, poses_, imu_); }
+  /// RANGE, fused or not, stamped before the first POSE (the estimator was not yet initialized).
+  size_t rangesBeforeFirstPose() const;
   /// RANGE, fused or not, that no later POSE answers, not counting those received after the last
   /// POSE (rangesAfterLastPose: no POSE could answer them).
   size_t rangesUnanswered() const;
@@ -83,10 +98,9 @@ class LatencyRecorder {
   std::map<int64_t, int64_t> imu_;    ///< utime → receive utime
   std::map<int64_t, int64_t> poses_;  ///< utime → receive utime
   struct Stamped { int64_t utime, recv_utime; };
-  /// (range time, RANGE → POSE latency [µs]) of every range a later POSE answers.
-  static std::vector<std::pair<int64_t, double>> toPoseSamples(const std::vector<Stamped>& ranges,
-                                                               const std::map<int64_t, int64_t>& poses,
-                                                               const std::map<int64_t, int64_t>& imu);
+  /// Every range of `ranges` a later POSE answers.
+  static std::vector<RangeAnswer> answers(const std::vector<Stamped>& ranges, const std::map<int64_t, int64_t>& poses,
+                                          const std::map<int64_t, int64_t>& imu);
   static LatencyStats toPose(const std::vector<Stamped>& ranges, const std::map<int64_t, int64_t>& poses,
                              const std::map<int64_t, int64_t>& imu);
   std::vector<Stamped> ranges_, other_ranges_;

@@ -70,6 +70,8 @@ std::string figures(const LatencyRecorder& rec, const std::string& indent) {
   y << indent << "fused_ranges: " << rec.fusedRanges() << "  # RANGE the estimator updates with (all without --fleet)\n";
   y << indent << "ranges_unanswered: " << rec.rangesUnanswered() << "  # received before the last POSE, answered by none\n";
   y << indent << "ranges_after_last_pose: " << rec.rangesAfterLastPose() << "  # the end of the data: no POSE could answer them\n";
+  y << indent << "ranges_before_first_pose: " << rec.rangesBeforeFirstPose()
+    << "  # stamped before the estimator initialized: not in RANGE -> POSE\n";
   y << indent << "imus_unanswered: " << rec.imusUnanswered() << "  # IMU between the first and the last POSE without its POSE\n";
   y << indent << "poses_without_imu: " << rec.posesWithoutImu() << "  # POSE whose IMU sample the probe did not receive\n";
   y << indent << "channels:\n";
@@ -86,7 +88,7 @@ int main(int argc, char** argv) {
           "Measures IMU -> POSE and RANGE -> POSE latency (median, p99, max, from this process's receive times), lost "
           "messages and messages per second per channel over LCM, for one vehicle or per vehicle of a fleet "
           "(--channel-prefixes), until SIGINT/SIGTERM or --duration; writes --out (YAML).");
-  std::string out, url, prefix_list, fleet_file, bus_name = "per-vehicle";
+  std::string out, url, prefix_list, fleet_file, bus_name = "per-vehicle", samples_path;
   double duration_s = 0.0;
   cli.optional("out", out, "where to write the figures (YAML)")->type_name("FILE")->required();
   cli.option("duration", duration_s, "stop after S seconds of wall time (0: at SIGINT/SIGTERM) [s]")
@@ -122,6 +124,11 @@ int main(int argc, char** argv) {
              "--channel-prefixes from 0, on the --lcm-url's port + 1 + k) or shared (every vehicle on --lcm-url)")
       ->type_name("POLICY")
       ->check(CLI::IsMember({"per-vehicle", "shared"}));
+  cli.optional("samples", samples_path,
+               "also write every answered tag-anchor RANGE as a CSV row vehicle,t_s,range_to_pose_us,pose_t_s,range_last "
+               "(t: its data time, pose_t: the answering POSE's [s]; range_last 1: the RANGE came after that POSE's IMU "
+               "sample): where in the flight the tail is")
+      ->type_name("FILE");
   int code = 0;
   if (!cli.parse(argc, argv, code)) return code;
   StopSignal::install();
@@ -245,6 +252,18 @@ int main(int argc, char** argv) {
         first = false;
       }
       y << "}\n";
+    }
+  }
+  if (!samples_path.empty()) {
+    std::ofstream s(samples_path);
+    s << "vehicle,t_s,range_to_pose_us,pose_t_s,range_last\n";
+    for (const auto& [p, rec] : per_vehicle)
+      for (const auto& a : rec.rangeToPoseSamples())
+        s << p << "," << Timestamp{a.utime}.sec() << "," << a.latency_us << "," << Timestamp{a.pose_utime}.sec() << ","
+          << a.range_last << "\n";
+    if (!s) {
+      std::cerr << "meshnav_lcm_probe: cannot write " << samples_path << "\n";
+      return 1;
     }
   }
   std::ofstream f(out);

@@ -34,11 +34,13 @@ LatencyStats LatencyRecorder::rangeToPose() const { return toPose(ranges_, poses
 
 LatencyStats LatencyRecorder::otherRangeToPose() const { return toPose(other_ranges_, poses_, imu_); }
 
-std::vector<std::pair<int64_t, double>> LatencyRecorder::toPoseSamples(const std::vector<Stamped>& ranges,
-                                                                       const std::map<int64_t, int64_t>& poses,
-                                                                       const std::map<int64_t, int64_t>& imu) {
-  std::vector<std::pair<int64_t, double>> s;
+std::vector<LatencyRecorder::RangeAnswer> LatencyRecorder::answers(const std::vector<Stamped>& ranges,
+                                                                    const std::map<int64_t, int64_t>& poses,
+                                                                    const std::map<int64_t, int64_t>& imu) {
+  std::vector<RangeAnswer> out;
+  if (poses.empty()) return out;
   for (const Stamped& r : ranges) {
+    if (r.utime < poses.begin()->first) continue;  // before the first POSE: the initialization's
     // The first POSE at or after r that left after the RANGE came (a RANGE received after the
     // POSE of its time was out is in a later one: the estimator re-ran it as a late input).
     auto pose = poses.lower_bound(r.utime);
@@ -46,15 +48,16 @@ std::vector<std::pair<int64_t, double>> LatencyRecorder::toPoseSamples(const std
     if (pose == poses.end()) continue;
     const auto sample = imu.find(pose->first);
     if (sample == imu.end()) continue;
-    s.emplace_back(r.utime, static_cast<double>(pose->second - std::max(r.recv_utime, sample->second)));
+    out.push_back({r.utime, static_cast<double>(pose->second - std::max(r.recv_utime, sample->second)), pose->first,
+                   r.recv_utime >= sample->second});
   }
-  return s;
+  return out;
 }
 
 LatencyStats LatencyRecorder::toPose(const std::vector<Stamped>& ranges, const std::map<int64_t, int64_t>& poses,
                                      const std::map<int64_t, int64_t>& imu) {
   std::vector<double> s;
-  for (const auto& [t, latency] : toPoseSamples(ranges, poses, imu)) s.push_back(latency);
+  for (const RangeAnswer& a : answers(ranges, poses, imu)) s.push_back(a.latency_us);
   return LatencyStats::of(std::move(s));
 }
 
@@ -62,9 +65,9 @@ std::map<int64_t, size_t> LatencyRecorder::rangeToPoseOverByWindow(double bound_
   std::map<int64_t, size_t> out;
   if (imu_.empty() || !(window_s > 0.0)) return out;
   const int64_t first = imu_.begin()->first;
-  for (const auto& [t, latency] : toPoseSamples(ranges_, poses_, imu_))
-    if (latency > bound_us)
-      ++out[static_cast<int64_t>(std::floor(static_cast<double>(t - first) * 1e-6 / window_s) * window_s)];
+  for (const RangeAnswer& a : answers(ranges_, poses_, imu_))
+    if (a.latency_us > bound_us)
+      ++out[static_cast<int64_t>(std::floor(static_cast<double>(a.utime - first) * 1e-6 / window_s) * window_s)];
   return out;
 }
 
@@ -77,8 +80,24 @@ size_t LatencyRecorder::rangesAfterLastPose() const {
   return n;
 }
 
+size_t LatencyRecorder::rangesBeforeFirstPose() const {
+  if (poses_.empty()) return 0;
+  size_t n = 0;
+  for (const auto* v : {&ranges_, &other_ranges_})
+    for (const Stamped& r : *v) n += r.utime < poses_.begin()->first;
+  return n;
+}
+
 size_t LatencyRecorder::rangesUnanswered() const {
-  return ranges_.size() + other_ranges_.size() - rangeToPose().n - otherRangeToPose().n - rangesAfterLastPose();
+  // A range both before the first POSE (stamp) and after the last (receipt) is counted once.
+  size_t both = 0;
+  int64_t last = 0;
+  for (const auto& [u, recv] : poses_) last = std::max(last, recv);
+  if (!poses_.empty())
+    for (const auto* v : {&ranges_, &other_ranges_})
+      for (const Stamped& r : *v) both += r.utime < poses_.begin()->first && r.recv_utime > last;
+  return ranges_.size() + other_ranges_.size() - rangeToPose().n - otherRangeToPose().n - rangesAfterLastPose() -
+         rangesBeforeFirstPose() + both;
 }
 
 size_t LatencyRecorder::imusUnanswered() const {

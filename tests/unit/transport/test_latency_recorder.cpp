@@ -47,6 +47,8 @@ TEST(LatencyRecorder, ImuAndRangeToPoseWithoutTheWaitForTheNextImuSample) {
 // answered by the first POSE that leaves after it, never by one that left before it came.
 TEST(LatencyRecorder, ALateRangeIsAnsweredByTheFirstPoseAfterItCame) {
   LatencyRecorder r;
+  r.onImu(5'000, 5'000);  // initialized before the range's instant
+  r.onPose(5'000, 5'050);
   r.onImu(10'000, 10'000);
   r.onPose(10'000, 10'050);
   r.onRange(9'000, 11'000);  // stamped before IMU 10 ms, received after its POSE
@@ -76,6 +78,8 @@ TEST(LatencyRecorder, CountsImuSamplesWithoutPoseAndPosesWithoutImu) {
 // POSE is over the fused ones only, and every range counts when it is unanswered.
 TEST(LatencyRecorder, RangesNotFusedAreMeasuredApart) {
   LatencyRecorder r;
+  r.onImu(8'000, 8'000);
+  r.onPose(8'000, 8'100);
   r.onImu(10'000, 10'000);
   r.onRange(9'000, 9'500, true);
   r.onRange(9'100, 9'600, false);
@@ -88,6 +92,24 @@ TEST(LatencyRecorder, RangesNotFusedAreMeasuredApart) {
   EXPECT_EQ(r.rangesUnanswered(), 0u);
   EXPECT_EQ(r.rangesAfterLastPose(), 1u);
   EXPECT_EQ(r.counts().at("RANGE"), 3);
+}
+
+// Ranges stamped before the first POSE (the estimator initializing) are answered by the
+// initialization, not by a range update: counted apart, in neither RANGE → POSE nor unanswered.
+TEST(LatencyRecorder, RangesBeforeTheFirstPoseAreTheInitializations) {
+  LatencyRecorder r;
+  r.onRange(1'000, 1'100);            // before the estimator initialized at 5 ms
+  r.onRange(2'000, 2'100, false);
+  r.onImu(5'000, 5'000);
+  r.onPose(5'000, 35'000);            // the initialization took 30 ms
+  r.onRange(6'000, 36'000);
+  r.onImu(10'000, 40'000);
+  r.onPose(10'000, 40'200);
+  EXPECT_EQ(r.rangesBeforeFirstPose(), 2u);
+  EXPECT_EQ(r.rangeToPose().n, 1u);
+  EXPECT_DOUBLE_EQ(r.rangeToPose().max_us, 200.0);
+  EXPECT_EQ(r.rangesUnanswered(), 0u);
+  EXPECT_TRUE(r.rangeToPoseOverByWindow(2'000.0, 10.0).empty());
 }
 
 // A RANGE whose POSE was lost (received before the last POSE, none after it at or past its time)
@@ -119,4 +141,12 @@ TEST(LatencyRecorder, TheTailIsCountedPerWindowOfDataTime) {
   EXPECT_EQ(over.begin()->second, 160u);
   EXPECT_TRUE(r.rangeToPoseOverByWindow(10'000.0, 10.0).empty());
   EXPECT_EQ(r.rangeToPoseOverByWindow(10.0, 5.0).size(), 4u);  // every answer > 10 µs: 0, 5, 10, 15 s
+  // Each answered range with its latency (the probe's --samples): POSE − max(RANGE, IMU) = 30 µs, then 5 ms.
+  const auto samples = r.rangeToPoseSamples();
+  ASSERT_EQ(samples.size(), 400u);
+  EXPECT_EQ(samples.front().utime, 1'000'000);
+  EXPECT_EQ(samples.front().pose_utime, 1'000'000);
+  EXPECT_FALSE(samples.front().range_last);  // the RANGE (at +50 µs) came before its IMU sample (+100)
+  EXPECT_DOUBLE_EQ(samples.front().latency_us, 30.0);
+  EXPECT_DOUBLE_EQ(samples.back().latency_us, 5'000.0);
 }
