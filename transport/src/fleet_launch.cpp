@@ -124,14 +124,20 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
         emitProcess(y, p + "_mission", "mission", on_bus({"--mission", o.mission, "--t0", "${MISSION_T0:-0}"}),
                     false, 0.0, 3);
     }
+    // The estimators answer first: the logger yields (--yield-cpu), the bridges one real-time
+    // level (--yield-rt). Under a real-time policy every process of equal priority runs until it
+    // blocks, so on two cores ten bridges waking with the estimators' inputs held RANGE -> POSE
+    // p99 at 4-6.8 ms; one level below, 0.4-0.7 ms (docs/fleet.md "Who answers first"). A replay's
+    // pacing lags more (max 25 -> 54 ms), which the estimators take as any arrival jitter. Without
+    // a real-time policy the bridges keep their niceness: + 10 held the answers back (6-10 ms).
     if (o.logging)
       emitProcess(y, p + "_logging", "logging",
-                  on_bus({"--out", "${OUT}/" + p, "--channels", p + "/.*", "--run-id", "${T0_UTIME}"}),
+                  on_bus({"--out", "${OUT}/" + p, "--channels", p + "/.*", "--run-id", "${T0_UTIME}", "--yield-cpu"}),
                   true, 0.0, 5);
     for (const char* bridge : {"imu_bridge", "uwb_bridge"})
       emitProcess(y, p + "_" + bridge, bridge,
                   on_bus({"--dataset", v.dataset, "--rate", "${RATE:-1}", "--t0-utime", "${T0_UTIME}", "--data-t0",
-                          "${DATA_T0:-0}", "--wait-for", "ESTIMATOR_STATUS", "--wait-timeout", wait}),
+                          "${DATA_T0:-0}", "--wait-for", "ESTIMATOR_STATUS", "--wait-timeout", wait, "--yield-rt"}),
                   false, 0.0, 3);
   }
   y << YAML::EndSeq << YAML::EndMap;

@@ -31,14 +31,20 @@ ProcessMain::ProcessMain(std::string name, const std::string& description)
       ->check(CLI::Validator(
           [](std::string& p) { return channels::prefixProblem(p); },
           "", "vehicle prefix"));
-  cli_.flag("yield-cpu", yield_cpu_,
+  CLI::Option* yield = cli_.flag("yield-cpu", yield_cpu_,
             "run below the other processes (a calibrator, a mission: work whose latency does not matter): under a "
             "real-time policy (chrt) one priority level lower, else niceness + 10");
+  CLI::Option* yield_rt = cli_.flag("yield-rt", yield_rt_,
+            "under a real-time policy (chrt) one priority level lower, so that the estimators answer first (a fleet's "
+            "bridges); else nothing: a niceness would hold back the data it carries (docs/fleet.md \"Who answers "
+            "first\")");
+  yield_rt->excludes(yield);
 }
 
 namespace {
-/// --yield-cpu: one real-time priority level below the inherited one, or niceness + 10.
-void yieldCpu() {
+/// --yield-cpu: one real-time priority level below the inherited one, or (`nice_otherwise`)
+/// niceness + 10; --yield-rt: the former only. `flag` names the option in the log.
+void yieldCpu(bool nice_otherwise, const char* flag) {
   const int policy = sched_getscheduler(0);
   sched_param param{};
   if ((policy == SCHED_FIFO || policy == SCHED_RR) && sched_getparam(0, &param) == 0) {
@@ -46,23 +52,27 @@ void yieldCpu() {
     if (param.sched_priority > lowest) {
       --param.sched_priority;
       if (sched_setscheduler(0, policy, &param) == 0) {
-        spdlog::info("--yield-cpu: real-time priority {} ({})", param.sched_priority, policy == SCHED_FIFO ? "FIFO" : "RR");
+        spdlog::info("{}: real-time priority {} ({})", flag, param.sched_priority, policy == SCHED_FIFO ? "FIFO" : "RR");
         return;
       }
     } else {
       // Already at the lowest real-time level: the normal policy is below every real-time one.
       param.sched_priority = 0;
       if (sched_setscheduler(0, SCHED_OTHER, &param) == 0) {
-        spdlog::info("--yield-cpu: normal scheduling (below every real-time process)");
+        spdlog::info("{}: normal scheduling (below every real-time process)", flag);
         return;
       }
     }
-    spdlog::warn("--yield-cpu: could not lower the real-time priority ({})", std::strerror(errno));
+    spdlog::warn("{}: could not lower the real-time priority ({})", flag, std::strerror(errno));
+    return;
+  }
+  if (!nice_otherwise) {
+    spdlog::info("{}: no real-time policy, scheduling left as it is", flag);
     return;
   }
   errno = 0;
-  if (nice(10) == -1 && errno != 0) spdlog::warn("--yield-cpu: nice failed ({})", std::strerror(errno));
-  else spdlog::info("--yield-cpu: niceness + 10");
+  if (nice(10) == -1 && errno != 0) spdlog::warn("{}: nice failed ({})", flag, std::strerror(errno));
+  else spdlog::info("{}: niceness + 10", flag);
 }
 }  // namespace
 
@@ -83,7 +93,7 @@ int ProcessMain::run(int argc, char** argv, const std::function<int()>& body) {
   setupLogging(name_);
   if (!log_level_.empty()) spdlog::set_level(spdlog::level::from_str(log_level_));
   StopSignal::install();
-  if (yield_cpu_) yieldCpu();
+  if (yield_cpu_ || yield_rt_) yieldCpu(yield_cpu_, yield_cpu_ ? "--yield-cpu" : "--yield-rt");
   try {
     const int rc = body();
     if (lcm_ && !lcm_->handlerTimes().empty()) spdlog::info("time in handlers: {}", lcm_->handlerTimeSummary());

@@ -59,6 +59,8 @@ TEST(FleetLaunch, EveryVehicleRunsItsBridgesAndEstimatorOnItsOwnPrefix) {
     EXPECT_EQ(after(log, "--lcm-url"), bus.at(v));
     EXPECT_EQ(after(log, "--out"), "${OUT}/" + v);
     EXPECT_EQ(after(log, "--channels"), v + "/.*");
+    EXPECT_NE(std::find(log.begin(), log.end(), "--yield-cpu"), log.end());
+    EXPECT_EQ(std::find(est.begin(), est.end(), "--yield-cpu"), est.end());  // the latency path
     for (const std::string b : {"_imu_bridge", "_uwb_bridge"}) {
       const YAML::Node& p = by_name.at(v + b);
       const auto args = strings(p["args"]);
@@ -69,6 +71,7 @@ TEST(FleetLaunch, EveryVehicleRunsItsBridgesAndEstimatorOnItsOwnPrefix) {
       EXPECT_EQ(after(args, "--wait-for"), "ESTIMATOR_STATUS");  // the node waits for v/ESTIMATOR_STATUS
       EXPECT_EQ(after(args, "--t0-utime"), "${T0_UTIME}");
       EXPECT_EQ(after(args, "--rate"), "${RATE:-1}");
+      EXPECT_NE(std::find(args.begin(), args.end(), "--yield-rt"), args.end());  // the estimator answers first
       EXPECT_FALSE(p["required"]);
     }
   }
