@@ -26,6 +26,11 @@ namespace meshnav::pipeline {
 using meshnav::FleetEntry;
 using meshnav::loadFleetFile;
 
+/// The vehicles of fleet file `path` with the setup.yaml of each one's dataset (what a process
+/// serving the fleet over LCM knows of it: the calibrator's and the peer_router's --fleet).
+/// Throws as loadFleetFile and loadSetup, naming the file.
+std::vector<Vehicle> loadFleetVehicles(const std::string& path);
+
 /// Makes the vehicles' anchors one map and returns what the fleet's calibrator knows: every
 /// vehicle's tags (with their lever arms) and the union of the known anchors, their σ and the pair
 /// biases of the setups. Each vehicle's setup gets the union too, so that every estimator knows

@@ -176,6 +176,7 @@ class LcmNode {
   /// and handles the ready ones, runs each node's due heartbeat; stops on StopSignal, when any
   /// node's stop was requested (a second instance included) or when `until()` returns true
   /// (checked at least every 100 ms). Returns 0, or 1 after an LCM error.
+  /// A node given more than once (vehicles sharing a bus) is served once.
   static int spinAll(const std::vector<LcmNode*>& nodes, const std::function<bool()>& until = {});
   /// Handles at most one batch of messages, waiting up to `timeout_ms`; runs a due heartbeat.
   /// Returns > 0 when something was handled, 0 on timeout, < 0 on an LCM error.

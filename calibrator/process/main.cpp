@@ -69,8 +69,7 @@ Served loadServed(const calib::CalibratorProcessConfig& config) {
     s.vehicles.push_back({"", s.setup});
     return s;
   }
-  for (const FleetEntry& e : pipeline::loadFleetFile(config.fleet_path))
-    s.vehicles.push_back({e.name, loadSetup((std::filesystem::path(e.dataset) / "setup.yaml").string())});
+  s.vehicles = pipeline::loadFleetVehicles(config.fleet_path);
   s.setup = pipeline::mergeFleetSetups(s.vehicles, config.fleet_path);
   return s;
 }
@@ -173,8 +172,7 @@ class CalibratorProcess {
   /// Every bus until a stop.
   int spin() {
     std::vector<transport::LcmNode*> buses;
-    for (const VehicleLink& l : links_)
-      if (std::find(buses.begin(), buses.end(), l.lcm) == buses.end()) buses.push_back(l.lcm);
+    for (const VehicleLink& l : links_) buses.push_back(l.lcm);
     return transport::LcmNode::spinAll(buses);
   }
 

@@ -3,14 +3,10 @@
 ///   every vehicle's P/RANGE, P/POSE, P/ANCHOR_INIT -> the receiving vehicle's P/PEER_RANGE.
 /// Vehicle k's channels are on its bus (--bus, as the fleet launch's); which vehicle fuses a range
 /// and with what is pipeline::PeerRangeFeed's, as in meshnav_run --fleet.
-#include <algorithm>
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "common/fleet_file.h"
-#include "common/setup.h"
 #include "pipeline/fleet.h"
 #include "pipeline/peer_range_relay.h"
 #include "transport/channels.h"
@@ -67,12 +63,7 @@ class PeerRouterProcess {
     }
   }
 
-  int spin() {
-    std::vector<transport::LcmNode*> distinct;
-    for (transport::LcmNode* b : buses_)
-      if (std::find(distinct.begin(), distinct.end(), b) == distinct.end()) distinct.push_back(b);
-    return transport::LcmNode::spinAll(distinct);
-  }
+  int spin() { return transport::LcmNode::spinAll(buses_); }
 
   int64_t sent() const { return sent_; }
   size_t held() const { return relay_.held(); }
@@ -102,9 +93,7 @@ int main(int argc, char** argv) {
       "the choice is meshnav_run --fleet's). Counters at exit and every --progress seconds.");
   return process.run<PeerRouterOptions>(argc, argv, declareOptions, [&](PeerRouterOptions& o) {
     process.require(!o.fleet_path.empty(), "fleet");
-    std::vector<pipeline::Vehicle> vehicles;
-    for (const FleetEntry& e : pipeline::loadFleetFile(o.fleet_path))
-      vehicles.push_back({e.name, loadSetup((std::filesystem::path(e.dataset) / "setup.yaml").string())});
+    std::vector<pipeline::Vehicle> vehicles = pipeline::loadFleetVehicles(o.fleet_path);
     const SystemSetup fleet_setup = pipeline::mergeFleetSetups(vehicles, o.fleet_path);
     const std::vector<transport::LcmNode*> buses =
         process.fleetBuses(vehicles.size(), transport::parseFleetBus(o.bus), "");

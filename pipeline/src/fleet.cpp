@@ -10,6 +10,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "common/setup.h"
 #include "common/yaml_options.h"
 
 namespace meshnav::pipeline {
@@ -24,6 +25,13 @@ bool samePairBias(const PairBias& x, const PairBias& y) {
 }
 
 }  // namespace
+
+std::vector<Vehicle> loadFleetVehicles(const std::string& path) {
+  std::vector<Vehicle> vehicles;
+  for (const FleetEntry& e : loadFleetFile(path))
+    vehicles.push_back({e.name, loadSetup((std::filesystem::path(e.dataset) / "setup.yaml").string())});
+  return vehicles;
+}
 
 SystemSetup mergeFleetSetups(std::vector<Vehicle>& vehicles, const std::string& where) {
   if (vehicles.empty()) throw std::invalid_argument(where + ": a fleet needs at least one vehicle");

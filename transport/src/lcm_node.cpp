@@ -179,7 +179,11 @@ int LcmNode::spin(const std::function<bool()>& until) {
   return 0;
 }
 
-int LcmNode::spinAll(const std::vector<LcmNode*>& nodes, const std::function<bool()>& until) {
+int LcmNode::spinAll(const std::vector<LcmNode*>& given, const std::function<bool()>& until) {
+  // Each node once: a fleet on one bus names the same node for every vehicle.
+  std::vector<LcmNode*> nodes;
+  for (LcmNode* n : given)
+    if (std::find(nodes.begin(), nodes.end(), n) == nodes.end()) nodes.push_back(n);
   if (nodes.size() == 1) return nodes.front()->spin(until);
   for (LcmNode* n : nodes) {
     n->serving_ = true;
