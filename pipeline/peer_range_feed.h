@@ -73,6 +73,10 @@ class PeerRangeFeed {
   std::optional<Routed> route(const RangeSample& r, const Ends& ends, const std::optional<PoseEstimate>& pose_a,
                               const std::optional<PoseEstimate>& pose_b);
 
+  /// The routing rule and its provenance (a restart's journal reads and restores it).
+  const PeerRangeRouter& router() const { return router_; }
+  PeerRangeRouter& router() { return router_; }
+
   /// Tag `tag` of vehicle `v` in its IMU frame [m] (std::out_of_range when v has no such tag).
   const Eigen::Vector3d& leverArm(size_t v, SensorId tag) const {
     return vehicles_.at(v).setup.rel_tag_positions.at(tag);

@@ -50,14 +50,28 @@ class PeerRangeRelay {
   /// An ANCHOR_INIT (any vehicle's): the anchor counts towards the vehicles' anchors from now on.
   void onAnchorInit(SensorId id) { feed_.onAnchorInit(id); }
 
+  /// A restart's journal (peer_router_state.h): the provenance `p` written at data time
+  /// `written`, taken at the first range or POSE from now on (PeerRangeRouter::restoreProvenance at
+  /// that input's time; counted "peer_router_state_restored" per entry kept). Refused whole when
+  /// that time is before `written` (the file is of a later data time than this stream: another
+  /// run's) or more than memory_s after it (nothing in it counts any more): reported
+  /// "peer_router_state_not_used". Throws std::invalid_argument when `p` is not of this fleet's size.
+  void restoreAtFirstData(PeerRangeRouter::Provenance p, Timestamp written);
+  /// Whether a journal given to restoreAtFirstData still waits for the first input.
+  bool restorePending() const { return pending_restore_.has_value(); }
+
   size_t held() const { return held_.size(); }
   const PeerRangeFeed& feed() const { return feed_; }
+  /// The newest range or POSE of any vehicle (data time), if any came.
+  std::optional<Timestamp> dataTime() const { return data_time_; }
 
  private:
   struct Held {
     RangeSample range;
     PeerRangeFeed::Ends ends;
   };
+  /// An input of data time t: the newest data time, and a pending journal taken at the first.
+  void noteDataTime(Timestamp t);
   /// Routes every held range whose wait is over, oldest first.
   std::vector<PeerRangeFeed::Routed> release();
   /// Vehicle v's pose nearest t, if within max_pose_age_s.
@@ -71,6 +85,11 @@ class PeerRangeRelay {
   std::vector<std::deque<PoseEstimate>> poses_;  ///< per vehicle, its recent POSEs in time order
   std::deque<Held> held_;                         ///< in arrival order
   std::optional<Timestamp> data_time_;            ///< the newest range or POSE of any vehicle
+  struct PendingRestore {
+    PeerRangeRouter::Provenance provenance;
+    Timestamp written;
+  };
+  std::optional<PendingRestore> pending_restore_;  ///< restoreAtFirstData's, until the first input
 };
 
 }  // namespace meshnav::pipeline

@@ -73,11 +73,22 @@ class PeerRangeRouter {
 
   const PeerRangeRoutingOptions& options() const { return options_; }
 
+  /// Per vehicle: whose information its estimate absorbed (directly or through another) -> the
+  /// data time it entered. What a restart must keep (peer_router_state.h): without it a respawned
+  /// router would send a vehicle's information back to it within memory_s.
+  using Provenance = std::vector<std::map<size_t, Timestamp>>;
+  const Provenance& provenance() const { return holds_; }
+  /// Takes `p` (a journal's) as the provenance at data time `now`: entries that entered after `now`
+  /// (a file of a later data time than this stream: not this run's) or more than memory_s before it
+  /// (they count no more) are dropped, as is an entry of a vehicle about itself. Returns how many
+  /// entries were kept. Throws std::invalid_argument when `p` is not of this fleet's size or names
+  /// a vehicle index out of it.
+  size_t restoreProvenance(const Provenance& p, Timestamp now);
+
  private:
   PeerRangeRoutingOptions options_;
   std::vector<std::map<SensorId, Timestamp>> anchor_seen_;  ///< per vehicle: anchor -> last range
-  /// Per vehicle: whose information it absorbed (directly or through another) -> when it entered.
-  std::vector<std::map<size_t, Timestamp>> holds_;
+  Provenance holds_;
 };
 
 }  // namespace meshnav::pipeline

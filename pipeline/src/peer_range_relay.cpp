@@ -35,7 +35,7 @@ PeerRangeRelay::PeerRangeRelay(const std::vector<Vehicle>& vehicles, const Syste
 
 std::vector<PeerRangeFeed::Routed> PeerRangeRelay::onRange(size_t v, const RangeSample& r) {
   if (v >= poses_.size()) throw std::out_of_range("PeerRangeRelay: no vehicle " + std::to_string(v));
-  if (!data_time_ || *data_time_ < r.t) data_time_ = r.t;
+  noteDataTime(r.t);
   if (feed_.interVehicle(v, r)) {
     if (const auto ends = feed_.admit(r)) {
       if (static_cast<int>(held_.size()) >= options_.max_held) {
@@ -59,8 +59,30 @@ std::vector<PeerRangeFeed::Routed> PeerRangeRelay::onPose(size_t v, const PoseEs
   // Kept: what a held range may still ask for (its wait plus the pose's age, and a margin).
   const Duration keep = Duration::fromSec(options_.max_wait_s + options_.max_pose_age_s + 1.0);
   while (poses.size() > 1 && poses.front().t < poses.back().t - keep) poses.pop_front();
-  if (!data_time_ || *data_time_ < p.t) data_time_ = p.t;
+  noteDataTime(p.t);
   return release();
+}
+
+void PeerRangeRelay::restoreAtFirstData(PeerRangeRouter::Provenance p, Timestamp written) {
+  if (p.size() != poses_.size())
+    throw std::invalid_argument("PeerRangeRelay::restoreAtFirstData: " + std::to_string(p.size()) + " vehicles, the fleet has " +
+                                std::to_string(poses_.size()));
+  pending_restore_ = PendingRestore{std::move(p), written};
+}
+
+void PeerRangeRelay::noteDataTime(Timestamp t) {
+  if (!data_time_ || *data_time_ < t) data_time_ = t;
+  if (!pending_restore_) return;
+  const PendingRestore journal = std::move(*pending_restore_);
+  pending_restore_.reset();
+  const double age_s = (t - journal.written).sec();
+  if (age_s < 0.0 || age_s > feed_.router().options().memory_s) {
+    diag_.report("peer_router_state_not_used",
+                 "peer_router: the provenance journal of t = " + formatSeconds(journal.written) + " s is not used at t = " +
+                     formatSeconds(t) + " s: " + (age_s < 0.0 ? "it is of a later data time (another run's)" : "nothing in it counts any more (older than memory_s)"));
+    return;
+  }
+  diag_.count("peer_router_state_restored", static_cast<int64_t>(feed_.router().restoreProvenance(journal.provenance, t)));
 }
 
 std::optional<PoseEstimate> PeerRangeRelay::poseNear(size_t v, Timestamp t) const {

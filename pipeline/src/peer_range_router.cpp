@@ -62,6 +62,26 @@ bool PeerRangeRouter::holds(size_t y, size_t x, Timestamp t) const {
   return it != h.end() && (t - it->second).sec() <= options_.memory_s;
 }
 
+size_t PeerRangeRouter::restoreProvenance(const Provenance& p, Timestamp now) {
+  if (p.size() != holds_.size())
+    throw std::invalid_argument("PeerRangeRouter::restoreProvenance: " + std::to_string(p.size()) + " vehicles, the fleet has " +
+                                std::to_string(holds_.size()));
+  Provenance kept(holds_.size());
+  size_t n = 0;
+  for (size_t v = 0; v < p.size(); ++v) {
+    for (const auto& [u, since] : p[v]) {
+      if (u >= holds_.size())
+        throw std::invalid_argument("PeerRangeRouter::restoreProvenance: vehicle index " + std::to_string(u) + " of " +
+                                    std::to_string(holds_.size()));
+      if (u == v || since > now || (now - since).sec() > options_.memory_s) continue;
+      kept[v].emplace(u, since);
+      ++n;
+    }
+  }
+  holds_ = std::move(kept);
+  return n;
+}
+
 PeerRangeRouter::Decision PeerRangeRouter::decide(size_t a, const PeerSide& side_a, size_t b, const PeerSide& side_b,
                                                   Timestamp t) const {
   // x can receive from y: x needs it, y's estimate exists and holds nothing of x's.

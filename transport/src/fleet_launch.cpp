@@ -95,7 +95,11 @@ std::string fleetLaunchYaml(const std::vector<FleetEntry>& vehicles, const Fleet
     // vehicle short of anchors waits on it. It opens every vehicle's bus itself (--bus).
     std::vector<std::string> args = {"--fleet", o.source, "--bus", toString(o.bus)};
     if (o.bus == FleetBus::kPerVehicle || !o.lcm_url.empty()) args.insert(args.end(), {"--lcm-url", base_url});
-    emitProcess(y, "fleet_peer_router", "peer_router", args, false, 0.0, 5);
+    // A respawn keeps whose information each vehicle holds (else it could send a vehicle's own
+    // information back to it); a new launch (new T0_UTIME) never reads an older run's journal.
+    if (o.logging) args.insert(args.end(), {"--state-dir", "${OUT}/fleet_peer_router_state/${T0_UTIME}"});
+    // Back after 0.2 s as an estimator: a vehicle short of anchors has no peer ranges meanwhile.
+    emitProcess(y, "fleet_peer_router", "peer_router", args, false, 0.2, 5);
   }
   for (size_t k = 0; k < vehicles.size(); ++k) {
     const FleetEntry& v = vehicles[k];

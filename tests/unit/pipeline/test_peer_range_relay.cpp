@@ -123,3 +123,41 @@ TEST(PeerRangeRelay, WaitingRangesAreBoundedAndOptionsChecked) {
   }
   EXPECT_THROW(f.relay.onRange(2, range(1.0, 10, 20)), std::out_of_range);
 }
+
+TEST(PeerRangeRelay, ARestartsJournalIsTakenAtTheFirstInputOfItsRunOnly) {
+  PeerRangeRouter::Provenance journal(2);
+  journal[0][1] = Timestamp::fromSec(0.5);  // a took b's information at 0.5 s
+  {
+    Relay f;
+    f.relay.restoreAtFirstData(journal, Timestamp::fromSec(0.9));
+    EXPECT_TRUE(f.relay.restorePending());
+    EXPECT_FALSE(f.relay.feed().router().holds(0, 1, Timestamp::fromSec(0.99)));
+    f.anchorsOfA(0.99);  // the first input takes it
+    EXPECT_FALSE(f.relay.restorePending());
+    EXPECT_EQ(f.diag.get("peer_router_state_restored"), 1);
+    EXPECT_TRUE(f.relay.feed().router().holds(0, 1, Timestamp::fromSec(0.99)));
+    // So a, which holds b's information, does not send to b (b ranges no anchors: short of them).
+    EXPECT_TRUE(f.relay.onPose(0, pose(1.0, 1.0)).empty());
+    EXPECT_TRUE(f.relay.onPose(1, pose(1.0, 4.0)).empty());
+    EXPECT_TRUE(f.relay.onRange(0, range(1.0, 10, 20)).empty());
+    EXPECT_TRUE(f.relay.onPose(0, pose(1.6, 1.0)).empty());  // the wait is over: not routed
+    EXPECT_EQ(f.relay.held(), 0u);
+    EXPECT_EQ(f.diag.get("inter_vehicle_range_cycle"), 1);
+  }
+  {  // the journal is of a later data time than this stream: another run's
+    Relay f;
+    f.relay.restoreAtFirstData(journal, Timestamp::fromSec(30.0));
+    f.anchorsOfA(0.99);
+    EXPECT_EQ(f.diag.get("peer_router_state_not_used"), 1);
+    EXPECT_EQ(f.diag.get("peer_router_state_restored"), 0);
+    EXPECT_FALSE(f.relay.feed().router().holds(0, 1, Timestamp::fromSec(0.99)));
+  }
+  {  // nothing in it counts any more (written more than memory_s, 10 s, before)
+    Relay f;
+    f.relay.restoreAtFirstData(journal, Timestamp::fromSec(0.9));
+    f.anchorsOfA(11.0);
+    EXPECT_EQ(f.diag.get("peer_router_state_not_used"), 1);
+  }
+  Relay f;
+  EXPECT_THROW(f.relay.restoreAtFirstData(PeerRangeRouter::Provenance(3), Timestamp::fromSec(1.0)), std::invalid_argument);
+}

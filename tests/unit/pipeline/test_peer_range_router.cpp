@@ -122,3 +122,43 @@ TEST(PeerRangeRouter, BadOptionsAreRefused) {
   EXPECT_THROW(PeerRangeRouter(PeerRangeRoutingOptions{}, 0), std::invalid_argument);
   EXPECT_NE(PeerRangeRoutingOptions{}.toString().find("3 anchors"), std::string::npos);
 }
+
+TEST(PeerRangeRouter, ARestoredProvenanceKeepsTheFlowAcyclicAndDropsWhatNoLongerCounts) {
+  PeerRangeRouter before(PeerRangeRoutingOptions{}, 3);
+  seeAnchors(before, 0, 4, 20.0);
+  before.noteReceived(1, 0, at(20.0));  // v1 took v0's information at 20 s
+  const PeerRangeRouter::Provenance journal = before.provenance();
+  ASSERT_EQ(journal.size(), 3u);
+  EXPECT_EQ(journal[1].count(0), 1u);
+  // A respawned router at 22 s: v0 lost its anchors, v1 sees four. Started empty it would let v0
+  // receive from v1, whose estimate still holds v0's own information.
+  auto roles = [](PeerRangeRouter& r) {
+    seeAnchors(r, 1, 4, 22.0);
+    return r.decide(0, side(1.0), 1, side(0.1), at(22.0));
+  };
+  PeerRangeRouter fresh(PeerRangeRoutingOptions{}, 3);
+  ASSERT_TRUE(roles(fresh).receiver);
+  PeerRangeRouter restored(PeerRangeRoutingOptions{}, 3);
+  EXPECT_EQ(restored.restoreProvenance(journal, at(22.0)), 1u);
+  const auto d = roles(restored);
+  EXPECT_FALSE(d.receiver);
+  EXPECT_EQ(d.why, "cycle");
+  // What no longer counts is not taken: an entry from after `now` (another run's file), one older
+  // than memory_s, a vehicle about itself.
+  PeerRangeRouter::Provenance odd(3);
+  odd[0][1] = at(30.0);
+  odd[1][2] = at(5.0);
+  odd[2][2] = at(21.0);
+  odd[2][0] = at(21.0);
+  PeerRangeRouter r(PeerRangeRoutingOptions{}, 3);
+  EXPECT_EQ(r.restoreProvenance(odd, at(22.0)), 1u);
+  EXPECT_TRUE(r.holds(2, 0, at(22.0)));
+  EXPECT_FALSE(r.holds(0, 1, at(22.0)));
+  EXPECT_FALSE(r.holds(1, 2, at(22.0)));
+  EXPECT_EQ(r.provenance()[2].count(2), 0u);
+  // Another fleet's provenance is refused.
+  EXPECT_THROW(r.restoreProvenance(PeerRangeRouter::Provenance(2), at(22.0)), std::invalid_argument);
+  PeerRangeRouter::Provenance out_of_fleet(3);
+  out_of_fleet[0][7] = at(21.0);
+  EXPECT_THROW(r.restoreProvenance(out_of_fleet, at(22.0)), std::invalid_argument);
+}

@@ -199,6 +199,14 @@ TEST(FleetLaunch, APeerRouterForAFleetOfTwoOrMoreUnlessTurnedOff) {
   EXPECT_EQ(after(args, "--lcm-url"), "udpm://239.255.76.67:7667?ttl=0");
   EXPECT_EQ(std::find(args.begin(), args.end(), "--yield-cpu"), args.end());  // a vehicle waits on it
   EXPECT_FALSE(r["required"]);  // each vehicle navigates on its anchors without it
+  // A respawn takes back whose information each vehicle holds, from this launch's journal only.
+  EXPECT_EQ(r["respawn"].as<std::string>(), "on-failure");
+  EXPECT_DOUBLE_EQ(r["respawn_delay"].as<double>(), 0.2);  // a vehicle short of anchors waits on it
+  EXPECT_EQ(after(args, "--state-dir"), o.logging ? "${OUT}/fleet_peer_router_state/${T0_UTIME}" : "");
+  o.logging = !o.logging;
+  EXPECT_EQ(after(strings(processes(fleet).at("fleet_peer_router")["args"]), "--state-dir"),
+            o.logging ? "${OUT}/fleet_peer_router_state/${T0_UTIME}" : "");
+  o.logging = !o.logging;
   EXPECT_EQ(processes({fleet[0]}).count("fleet_peer_router"), 0u);  // one vehicle: no peers
   o.peer_router = false;
   EXPECT_EQ(processes(fleet).count("fleet_peer_router"), 0u);
