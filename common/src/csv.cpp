@@ -1,5 +1,7 @@
 #include "common/csv.h"
 
+#include <charconv>
+
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -74,9 +76,18 @@ std::optional<double> CsvRow::number(const std::string& name) const {
   if (it == columns_->end() || it->second >= static_cast<int>(fields_.size())) return std::nullopt;
   const std::string& s = fields_[it->second];  // text(name) without its copy
   if (s.empty()) return std::nullopt;
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (end == s.c_str() || *end != '\0' || !std::isfinite(v)) return std::nullopt;
+  // from_chars (no locale, no allocation) reads the plain decimal numbers every file has; what it
+  // does not take whole (a leading '+' or space, hex) gets strtod's reading as before. Both round
+  // correctly, so a number reads the same either way.
+  double v = 0.0;
+  const char* const first = s.data();
+  const char* const last = first + s.size();
+  if (const auto [ptr, ec] = std::from_chars(first, last, v); ec != std::errc() || ptr != last) {
+    char* end = nullptr;
+    v = std::strtod(s.c_str(), &end);
+    if (end == s.c_str() || *end != '\0') return std::nullopt;
+  }
+  if (!std::isfinite(v)) return std::nullopt;
   return v;
 }
 

@@ -49,10 +49,10 @@ const char* TimeGuard::name(Verdict v) {
 TimeGuard::Verdict TimeGuard::admit(const std::string& kind, Timestamp t, Diagnostics& diag) {
   const std::optional<Timestamp> before = now_;
   const Verdict v = check(t, kind);
-  const std::string offset = std::to_string(options_.max_offset_s) + " s";
   if (v == Verdict::Ahead || v == Verdict::Behind)
     diag.report(kind + ":time_" + name(v), kind + " t=" + formatSeconds(t) + " is " + name(v) + " of the current time " +
-                                               formatSeconds(*before) + " by more than the limit (" + offset +
+                                               formatSeconds(*before) + " by more than the limit (" +
+                                               std::to_string(options_.max_offset_s) + " s" +
                                                (v == Verdict::Behind && options_.max_behind_s > options_.max_offset_s
                                                     ? ", behind " + std::to_string(options_.max_behind_s) + " s"
                                                     : std::string()) +
