@@ -154,8 +154,11 @@ class EstimatorNode : private RerunReplayer {
   /// Why the node is not initialized yet (empty once it is).
   std::string waitingFor() const;
   /// The state to persist for a restart (initialized only): IMU state and covariance, baro
-  /// reference and bias, estimated anchors with their marginal covariance and pair biases.
-  EstimatorCheckpoint checkpoint() const;
+  /// reference and bias, and (`with_anchors`) the estimated anchors with their marginal covariance
+  /// and pair biases (makeCheckpoint).
+  EstimatorCheckpoint checkpoint(bool with_anchors = true) const;
+  /// The ids of the anchors the filter estimates (empty before the initialization).
+  std::set<SensorId> estimatedAnchorIds() const;
   /// Before any input: a restart. At the first IMU sample, if it is at most `init.resume_max_age_s`
   /// newer than c.t, the estimated anchors and the baro reference and bias come back from `c`, and
   /// the pose too when the outage is at most `init.resume_max_outage_s` (else the pose is

@@ -141,11 +141,11 @@ class EstimatorProcess {
     if (!lcm_.secondInstance().empty()) return;  // a second instance leaves the first one's checkpoint alone
     last_checkpoint_ = t;
     try {
-      const estimator::EstimatorCheckpoint c = node_.checkpoint();
-      std::set<SensorId> ids;
-      for (const AnchorInit& a : c.anchors) ids.insert(a.id);
-      const bool anchors = !last_anchors_ || ids != anchor_ids_ || (t - *last_anchors_).sec() >= o_.anchors_period_s;
-      estimator::writeCheckpoint(c, o_.state_dir, anchors);
+      std::set<SensorId> ids = node_.estimatedAnchorIds();
+      const bool anchors = !last_anchors_ || ids != anchor_ids_ || (t - *last_anchors_).sec() >= o_.anchors_period_s ||
+                           !estimator::checkpointHasAnchorsFile(o_.state_dir);
+      // The anchors' part is gathered only when its file is written.
+      estimator::writeCheckpoint(node_.checkpoint(anchors), o_.state_dir, anchors);
       if (anchors) {
         last_anchors_ = t;
         anchor_ids_ = std::move(ids);

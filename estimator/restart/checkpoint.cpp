@@ -137,6 +137,8 @@ void writeCheckpoint(const EstimatorCheckpoint& c, const std::string& dir, bool 
   writeFileAtomically((fs::path(dir) / kStateFile).string(), [&](std::ostream& out) { out << e.c_str() << "\n"; });
 }
 
+bool checkpointHasAnchorsFile(const std::string& dir) { return fs::exists(fs::path(dir) / kAnchorsFile); }
+
 namespace {
 /// `format` and `version` must say layout 2; a file of layout 1 (no `version`) is refused.
 void requireVersion(YamlOptions& y) {

@@ -68,6 +68,9 @@ struct EstimatorCheckpoint {
 /// among 100) while an anchor's estimate moves by millimetres per second; the estimator process
 /// writes it every `--anchors-period` of data time and whenever the set of anchors changes.
 void writeCheckpoint(const EstimatorCheckpoint& c, const std::string& dir, bool with_anchors = true);
+/// Whether `dir` holds an anchors' file (else the next writeCheckpoint writes c.anchors, so its
+/// checkpoint must hold them: makeCheckpoint's `with_anchors`).
+bool checkpointHasAnchorsFile(const std::string& dir);
 /// Reads them back; nullopt when `dir` holds no checkpoint. Throws std::runtime_error naming the
 /// file and key on a malformed or non-finite one, or on a file of another layout version.
 std::optional<EstimatorCheckpoint> readCheckpoint(const std::string& dir);

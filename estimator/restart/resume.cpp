@@ -10,7 +10,8 @@
 namespace meshnav::estimator {
 
 EstimatorCheckpoint makeCheckpoint(const FusionStrategy& f, const UwbNetwork& network, bool landed,
-                                   const std::optional<double>& baro_reference_pa, const EstimatorOptions& options) {
+                                   const std::optional<double>& baro_reference_pa, const EstimatorOptions& options,
+                                   bool with_anchors) {
   const NominalState& x = f.state();
   EstimatorCheckpoint c;
   c.t = x.t;
@@ -27,6 +28,7 @@ EstimatorCheckpoint makeCheckpoint(const FusionStrategy& f, const UwbNetwork& ne
         c.instances.push_back({K::kName, id, K::peersOf(value), K::toVector(value), f.covariance(id, id)});
     }
   });
+  if (!with_anchors) return c;
   // Every device an anchor may have a pair bias with.
   std::vector<SensorId> devices;
   for (const auto& [id, p] : network.tags()) devices.push_back(id);

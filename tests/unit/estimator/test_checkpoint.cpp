@@ -145,6 +145,8 @@ TEST(Checkpoint, TheAnchorsFileIsWrittenWhenAskedOrMissing) {
   EXPECT_EQ(back->anchors[0].p_AinG.x(), 1.0);  // the anchors: as written before
   writeCheckpoint(c, dir, true);
   EXPECT_EQ(readCheckpoint(dir)->anchors[0].p_AinG.x(), 1.5);
+  EXPECT_TRUE(checkpointHasAnchorsFile(dir));
+  EXPECT_FALSE(checkpointHasAnchorsFile(dir + "/absent"));
 }
 
 // The height bias converges in flight (true 0.25 m, prior 0 ± 0.3 m); the estimator dies at

@@ -98,6 +98,12 @@ TEST_F(ResumeTest, TheCheckpointHoldsTheImuBlockKeptInstancesAndAnchors) {
   const EstimatorCheckpoint c2 = makeCheckpoint(*f, network, false, std::nullopt, no_baro);
   EXPECT_EQ(c2.find("baro", 2), nullptr);
   EXPECT_NE(c2.find("height", 3), nullptr);
+  // Without the anchors (a checkpoint whose anchors' file stays): the rest as with them.
+  const EstimatorCheckpoint c3 = makeCheckpoint(*f, network, true, kRef, o, /*with_anchors=*/false);
+  EXPECT_TRUE(c3.anchors.empty());
+  EXPECT_EQ(c3.t, c.t);
+  EXPECT_EQ(c3.instances.size(), c.instances.size());
+  EXPECT_TRUE(c3.cov_imu.isApprox(c.cov_imu, 0.0));
 }
 
 TEST_F(ResumeTest, ACheckpointOlderThanTheMaxAgeIsRefused) {
