@@ -83,7 +83,7 @@ class PeerRangeRelay {
   Diagnostics& diag_;
   PeerRangeFeed feed_;
   std::vector<std::deque<PoseEstimate>> poses_;  ///< per vehicle, its recent POSEs in time order
-  std::deque<Held> held_;                         ///< in arrival order
+  std::deque<Held> held_;                         ///< in time order of the ranges, oldest first
   std::optional<Timestamp> data_time_;            ///< the newest range or POSE of any vehicle
   struct PendingRestore {
     PeerRangeRouter::Provenance provenance;

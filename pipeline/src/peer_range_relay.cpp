@@ -42,7 +42,11 @@ std::vector<PeerRangeFeed::Routed> PeerRangeRelay::onRange(size_t v, const Range
         diag_.count("inter_vehicle_range_hold_full");
         held_.pop_front();
       }
-      held_.push_back({r, *ends});
+      // In time order (stable: an exchange of the same instant after those before it), so that
+      // release() routes the oldest instant first: the router's provenance is a function of time.
+      const auto at = std::upper_bound(held_.begin(), held_.end(), r.t,
+                                       [](Timestamp t, const Held& h) { return t < h.range.t; });
+      held_.insert(at, {r, *ends});
     }
   }
   return release();
@@ -101,8 +105,6 @@ std::optional<PoseEstimate> PeerRangeRelay::poseNear(size_t v, Timestamp t) cons
 std::vector<PeerRangeFeed::Routed> PeerRangeRelay::release() {
   std::vector<PeerRangeFeed::Routed> out;
   if (held_.empty()) return out;
-  // Oldest instant first: the router's provenance is a function of time.
-  std::stable_sort(held_.begin(), held_.end(), [](const Held& a, const Held& b) { return a.range.t < b.range.t; });
   const Duration wait = Duration::fromSec(options_.max_wait_s);
   for (auto it = held_.begin(); it != held_.end();) {
     const Timestamp t = it->range.t;

@@ -124,6 +124,19 @@ TEST(PeerRangeRelay, WaitingRangesAreBoundedAndOptionsChecked) {
   EXPECT_THROW(f.relay.onRange(2, range(1.0, 10, 20)), std::out_of_range);
 }
 
+TEST(PeerRangeRelay, RangesGoOutOldestFirstWhateverTheirArrivalOrder) {
+  Relay f;
+  f.anchorsOfA(0.99);
+  // Two exchanges of the same pair, the later one heard first (another bus's latency).
+  EXPECT_TRUE(f.relay.onRange(0, range(1.002, 10, 20)).empty());
+  EXPECT_TRUE(f.relay.onRange(1, range(1.001, 20, 10)).empty());
+  EXPECT_TRUE(f.relay.onPose(0, pose(1.003, 1.0)).empty());
+  const auto out = f.relay.onPose(1, pose(1.003, 4.0));
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].range.range.t, Timestamp::fromSec(1.001));
+  EXPECT_EQ(out[1].range.range.t, Timestamp::fromSec(1.002));
+}
+
 TEST(PeerRangeRelay, ARestartsJournalIsTakenAtTheFirstInputOfItsRunOnly) {
   PeerRangeRouter::Provenance journal(2);
   journal[0][1] = Timestamp::fromSec(0.5);  // a took b's information at 0.5 s
