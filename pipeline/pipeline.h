@@ -142,6 +142,9 @@ class Pipeline {
     Message msg;
   };
   void drain();
+  /// The log context of vehicle v's estimator calls (common/log_context.h): its name in a fleet,
+  /// none for one vehicle.
+  const std::string* vehicleLogName(size_t v) const;
 
   PipelineOptions options_;
   PipelineSinks sinks_;

@@ -1,4 +1,5 @@
 #include "common/cli.h"
+#include "common/log_context.h"
 
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
@@ -232,7 +233,7 @@ CLI::Validator oneOf(std::function<bool(const std::string&)> accepts, const std:
 }  // namespace cli
 
 void setupLogging(const std::string& program) {
-  spdlog::set_pattern("[%H:%M:%S.%e] [" + program + "] [%^%l%$] %v");
+  setLogPattern(program);  // with the vehicle of a fleet in one process (common/log_context.h)
   const char* lvl = std::getenv("MESHNAV_LOG_LEVEL");
   if (lvl) spdlog::set_level(spdlog::level::from_str(lvl));
 }

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "common/log_context.h"
 #include "pipeline/fleet_calibrator_feed.h"
 #include "pipeline/peer_range_feed.h"
 
@@ -63,7 +64,10 @@ void Pipeline::onInput(size_t vehicle, const estimator::EstimatorInput& in) {
       drain();  // the receiver's outputs
       return;
     }
-  node.onInput(in);
+  {
+    const LogContext::Scope scope(vehicleLogName(vehicle));
+    node.onInput(in);
+  }
   if (calibrator_) {
     if (const auto* r = std::get_if<RangeSample>(&in); r && feed_->forCalibrator(*r)) calibrator_->onRange(*r);
     calibrator_->tick(t);
@@ -88,20 +92,28 @@ void Pipeline::routeInterVehicleRange(const RangeSample& r) {
       pr.p_peer_tag_in_G = truth->p_IinG + truth->q_ItoG * peers_->leverArm(sender, peer_tag);
       pr.cov_peer_tag_m2.setZero();
       diag_.count("inter_vehicle_range_to:" + vehicles_[receiver].name);
+      const LogContext::Scope scope(vehicleLogName(receiver));
       estimators_[receiver]->onInput(pr);
     }
     return;
   }
   // The sender's pose: its estimator's now, at most one input older than the range.
-  if (auto routed = peers_->route(r, *ends, estimators_[ends->a]->pose(), estimators_[ends->b]->pose()))
+  if (auto routed = peers_->route(r, *ends, estimators_[ends->a]->pose(), estimators_[ends->b]->pose())) {
+    const LogContext::Scope scope(vehicleLogName(routed->receiver));
     estimators_[routed->receiver]->onInput(routed->range);
+  }
+}
+
+const std::string* Pipeline::vehicleLogName(size_t v) const {
+  return estimators_.size() > 1 ? &vehicles_.at(v).name : nullptr;  // one vehicle: its log says enough
 }
 
 void Pipeline::finish() {
-  for (auto& e : estimators_) {
-    e->flushHeld();
-    e->finishRerun();
-    e->flushSmoothed();
+  for (size_t v = 0; v < estimators_.size(); ++v) {
+    const LogContext::Scope scope(vehicleLogName(v));
+    estimators_[v]->flushHeld();
+    estimators_[v]->finishRerun();
+    estimators_[v]->flushSmoothed();
   }
   drain();
 }
@@ -141,8 +153,10 @@ void Pipeline::drain() {
           } else if constexpr (std::is_same_v<T, AnchorInit>) {
             anchor_inits_.push_back(m);
             if (peers_) peers_->onAnchorInit(m.id);
-            for (size_t i = 0; i < estimators_.size(); ++i)
+            for (size_t i = 0; i < estimators_.size(); ++i) {
+              const LogContext::Scope scope(vehicleLogName(i));
               estimators_[i]->onAnchorInit(feed_->forVehicle(i, m));
+            }
             if (sinks_.anchor_init) sinks_.anchor_init(m);
           } else if constexpr (std::is_same_v<T, CalibStatus>) {
             if (mission_) mission_->onCalibStatus(m);
@@ -150,7 +164,10 @@ void Pipeline::drain() {
           } else if constexpr (std::is_same_v<T, CalibCommand>) {
             if (calibrator_) calibrator_->onCommand(m);
           } else if constexpr (std::is_same_v<T, EstimatorCommand>) {
-            for (auto& e : estimators_) e->onCommand(m);
+            for (size_t i = 0; i < estimators_.size(); ++i) {
+              const LogContext::Scope scope(vehicleLogName(i));
+              estimators_[i]->onCommand(m);
+            }
           } else if constexpr (std::is_same_v<T, MissionStatus>) {
             if (sinks_.mission_status) sinks_.mission_status(m);
           }
