@@ -3,6 +3,9 @@
 ///   every vehicle's P/RANGE, P/POSE, P/ANCHOR_INIT -> the receiving vehicle's P/PEER_RANGE.
 /// Vehicle k's channels are on its bus (--bus, as the fleet launch's); which vehicle fuses a range
 /// and with what is pipeline::PeerRangeFeed's, as in meshnav_run --fleet.
+/// With --state-dir the routing's provenance (whose information each vehicle holds) is journaled
+/// there every --state-period of data time (pipeline/peer_router_state.h) and taken back by a respawn.
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>

@@ -8,13 +8,21 @@
 #include <stdexcept>
 
 #include "common/atomic_file.h"
+#include "common/time.h"
 #include "common/yaml_options.h"
 
 namespace meshnav::pipeline {
 
 namespace {
 constexpr int kLayout = 1;
+
+/// A data time's limit [µs]: the project's ±kMaxTimeSeconds (common/time.h), so that the
+/// difference of two of them fits an int64.
+bool inRange(int64_t us) {
+  constexpr auto kMaxUs = static_cast<int64_t>(kMaxTimeSeconds * 1e6);
+  return us >= -kMaxUs && us <= kMaxUs;
 }
+}  // namespace
 
 void writePeerRouterState(const std::string& path, const PeerRouterState& state, const std::vector<std::string>& names) {
   if (state.provenance.size() != names.size())
@@ -48,6 +56,7 @@ PeerRouterState readPeerRouterState(const std::string& path, const std::vector<s
   if (layout != kLayout) root.fail("layout", "must be " + std::to_string(kLayout) + ", got " + std::to_string(layout));
   PeerRouterState s;
   root.require("t_us", s.t.us);
+  if (!inRange(s.t.us)) root.fail("t_us", "must be within +-" + std::to_string(static_cast<long long>(kMaxTimeSeconds)) + " s");
   if (!root.has("holds")) root.fail("holds", "is missing");
   const YAML::Node holds_node = root.take("holds");
   if (!holds_node.IsMap()) root.fail("holds", "must be a map of vehicle names");
@@ -63,6 +72,8 @@ PeerRouterState readPeerRouterState(const std::string& path, const std::vector<s
       if (u == v) of.fail(names[u], "a vehicle does not hold its own information");
       Timestamp since;
       of.read(names[u], since.us);
+      if (since > s.t) of.fail(names[u], "is after the journal's t_us: an entry cannot be newer than its journal");
+      if (!inRange(since.us)) of.fail(names[u], "must be within +-" + std::to_string(static_cast<long long>(kMaxTimeSeconds)) + " s");
       s.provenance[v].emplace(u, since);
     }
     of.rejectUnknown();

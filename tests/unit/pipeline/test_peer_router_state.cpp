@@ -69,6 +69,9 @@ TEST(PeerRouterState, AnotherFleetsOrABrokenFileIsRefusedNamingTheKey) {
   EXPECT_NE(refusal(ok_head + "holds: {uav1: {uav1: 10}}\n").find("holds.uav1.uav1"), std::string::npos);
   EXPECT_NE(refusal(ok_head + "holds: {uav1: [uav2]}\n").find("holds.uav1"), std::string::npos);
   EXPECT_NE(refusal(ok_head + "holds: {}\nextra: 1\n").find("extra"), std::string::npos);
+  EXPECT_NE(refusal(ok_head + "holds: {uav1: {uav2: 1001}}\n").find("holds.uav1.uav2"), std::string::npos);  // after t_us
+  EXPECT_NE(refusal("layout: 1\nt_us: 9000000000000000000\nholds: {}\n").find("t_us"), std::string::npos);
+  EXPECT_NE(refusal(ok_head + "holds: {uav1: {uav2: -9000000000000000000}}\n").find("holds.uav1.uav2"), std::string::npos);
   EXPECT_NE(refusal("layout: 2\nt_us: 1000\nholds: {}\n").find("layout"), std::string::npos);
   EXPECT_NE(refusal("layout: 1\nholds: {}\n").find("t_us"), std::string::npos);
   EXPECT_NE(refusal(ok_head).find("holds"), std::string::npos);
