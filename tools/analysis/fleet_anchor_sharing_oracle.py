@@ -12,6 +12,12 @@ For each seed folder of `./meshnav fleet-scale-table` (OUT/seedN: sim/ and the f
     --no-calibration` with the table's estimator config), each vehicle's position RMSE against the
     fleet run's (result.json): what perfect anchors could move the vehicles' poses by.
 
+A seed folder is any folder with sim/ (meshnav_sim's fleet) and fleet/ (`meshnav_run --fleet
+sim/fleet.yaml --out fleet`); without fleet-scale-table's result.json the fleet run is evaluated here.
+The paper's hall with 3 vehicles (decision 016's second row):
+  build/bin/meshnav_sim --fleet 3 --seed 1 --out D/sim && build/bin/meshnav_run --fleet D/sim/fleet.yaml --out D/fleet
+  /usr/bin/python3 tools/analysis/fleet_anchor_sharing_oracle.py D --run --config config/estimator.yaml
+
 Usage: /usr/bin/python3 tools/analysis/fleet_anchor_sharing_oracle.py OUT/seedN [...]
            [--run --bin build/bin --config config/fleet_scale.yaml --work DIR] [--self-test]
 """
@@ -82,6 +88,25 @@ def known_anchor_setup(setup_text, truth):
     return "\n".join(out)
 
 
+def evaluated_rmse(bin_dir, dataset, run):
+    """Position RMSE of `run` against `dataset` (meshnav_eval, metrics.json beside the run)."""
+    js = os.path.join(run, "metrics.json")
+    subprocess.run([os.path.join(bin_dir, "meshnav_eval"), "--dataset", dataset, "--run", run, "--no-plots",
+                    "--no-baseline", "--json", js], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    with open(js) as f:
+        return json.load(f)["pose"]["position"]["rmse_m"]
+
+
+def fleet_run_rmse(seed_dir, bin_dir):
+    """Each vehicle's RMSE in the fleet run: fleet-scale-table's result.json, else evaluated here."""
+    result = os.path.join(seed_dir, "result.json")
+    if os.path.isfile(result):
+        with open(result) as f:
+            return [v["fleet_rmse"] for v in json.load(f)["vehicles"]]
+    return [evaluated_rmse(bin_dir, os.path.join(seed_dir, "sim", n), os.path.join(seed_dir, "fleet", n))
+            for n in vehicles(seed_dir)]
+
+
 def oracle_run(seed_dir, work, bin_dir, config):
     """Each vehicle's position RMSE with every anchor known at its truth."""
     names = vehicles(seed_dir)
@@ -102,15 +127,7 @@ def oracle_run(seed_dir, work, bin_dir, config):
     subprocess.run([os.path.join(bin_dir, "meshnav_run"), "--fleet", os.path.join(sim, "fleet.yaml"),
                     "--no-calibration", "--allow-lost", "--config", config, "--out", run],
                    check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    rmse = []
-    for n in names:
-        js = os.path.join(run, n, "metrics.json")
-        subprocess.run([os.path.join(bin_dir, "meshnav_eval"), "--dataset", os.path.join(sim, n), "--run",
-                        os.path.join(run, n), "--no-plots", "--no-baseline", "--json", js], check=True,
-                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        with open(js) as f:
-            rmse.append(json.load(f)["pose"]["position"]["rmse_m"])
-    return rmse
+    return [evaluated_rmse(bin_dir, os.path.join(sim, n), os.path.join(run, n)) for n in names]
 
 
 def self_test():
@@ -156,8 +173,7 @@ def main():
         line = "%s: %d fly-by anchors: error shared (CI) %.4f m, each vehicle's %.4f m, best vehicle's %.4f m" % (
             seed, len(b), sum(x[0] for x in b) / len(b), sum(x[1] for x in b) / len(b), sum(x[2] for x in b) / len(b))
         if a.run:
-            with open(os.path.join(seed, "result.json")) as f:
-                fr = [v["fleet_rmse"] for v in json.load(f)["vehicles"]]
+            fr = fleet_run_rmse(seed, a.bin)
             work = os.path.join(a.work, os.path.basename(os.path.normpath(seed))) if a.work else tempfile.mkdtemp()
             orr = oracle_run(seed, work, a.bin, a.config)
             fleet_rmse += fr
